@@ -1,0 +1,27 @@
+"""rodmol: dynamics of soft cable-driven continuum arms as Cosserat rods.
+
+Implements and extends Renda et al., "Dynamic Model of a Multibending Soft
+Robot Arm Driven by Cables", IEEE T-RO 30(5), 2014. SI units throughout.
+"""
+
+from .backends import BACKENDS
+from .base import Base
+from .cables import Cable, read_tension_csv
+from .equilibrium import equilibrium
+from .errors import EquilibriumError, IntegrationError, ParameterError, RodmolError
+from .layout import StateLayout
+from .model import Model
+from .parameters import MEDIA, Material, Medium
+from .result import Result, load_result
+from .rod import Rod
+from .semidiscrete import SemiDiscrete, StateView
+from .simulate import default_atol, simulate, straight_state
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "BACKENDS", "Base", "Cable", "EquilibriumError", "IntegrationError", "MEDIA", "Material",
+    "Medium", "Model", "ParameterError", "Result", "Rod", "RodmolError", "SemiDiscrete",
+    "StateLayout", "StateView", "default_atol", "equilibrium", "load_result", "read_tension_csv",
+    "simulate", "straight_state",
+]

@@ -1,0 +1,25 @@
+"""Exceptions raised by rodmol.
+
+Every input check raises :class:`ParameterError`, a :class:`ValueError`
+subclass whose message names the parameter and the offending value.
+"""
+
+
+class RodmolError(Exception):
+    """Base class of every rodmol exception."""
+
+
+class ParameterError(RodmolError, ValueError):
+    """An input parameter is invalid; the message names it and its value."""
+
+
+class IntegrationError(RodmolError, RuntimeError):
+    """A time integration failed; ``result`` holds what was computed so far."""
+
+    def __init__(self, message, result=None):
+        super().__init__(message)
+        self.result = result
+
+
+class EquilibriumError(RodmolError, RuntimeError):
+    """The static equilibrium could not be found."""

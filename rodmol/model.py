@@ -1,0 +1,152 @@
+"""The model: a rod, its grid, the medium, the cables and the base, with every
+sectional quantity sampled once on the staggered grid.
+
+Grid (section IV-C of the paper): N elements, ds = L/N, nodes s_i = i ds.
+Strains q, k and the stresses live on the *strain nodes* i = 0..N-1; pose u, R
+and velocities v, w on the *velocity nodes* i = 1..N. The base (node 0) has
+prescribed velocities, the tip (node N) a vanishing total stress.
+"""
+
+import numpy as np
+
+from . import _checks
+from .base import Base
+from .cables import Cable
+from .errors import ParameterError
+from .parameters import Medium
+from .rod import Rod
+
+#: Strain of the straight reference configuration, q* = (1, 0, 0).
+Q_STAR = np.array([1.0, 0.0, 0.0])
+
+
+class Model:
+    """A semi-discretised Cosserat rod with its loads.
+
+    Parameters
+    ----------
+    rod : Rod
+    n_elements : int
+        Number of elements N (>= 2); the grid has N + 1 nodes.
+    gravity : (3,) float, keyword-only
+        Gravitational acceleration G [m/s^2], global frame.
+    medium : Medium, str or None
+        The surrounding fluid: a :class:`Medium`, a preset name (``"water"``,
+        ``"air"``) or None (no fluid, unless ``medium_density`` is given).
+    medium_density : float
+        Shortcut for a fluid that only gives buoyancy [kg/m^3].
+    cables : sequence of Cable
+    base : Base or None
+        Base motion; None is a fixed clamp at the origin.
+    drag, added_mass, viscosity : bool
+        Switches to drop a load (the paper's worsened models, Table V):
+        ``viscosity=False`` sets mu = 0.
+    munk_moment : bool
+        Add the Munk moment of the added-mass model (off in the paper).
+    """
+
+    def __init__(self, rod, n_elements, *, gravity=(0.0, -9.81, 0.0), medium=None,
+                 medium_density=0.0, cables=(), base=None, drag=True, added_mass=True,
+                 viscosity=True, munk_moment=False):
+        if not isinstance(rod, Rod):
+            raise ParameterError(f"`rod` must be a rodmol.Rod, got {rod!r}")
+        self.rod = rod
+        self.n_elements = _checks.integer_at_least("n_elements", n_elements, 2)
+        self.gravity = _checks.vector3("gravity", gravity)
+        self.medium = _medium(medium, medium_density)
+        self.cables = tuple(cables)
+        for i, c in enumerate(self.cables):
+            if not isinstance(c, Cable):
+                raise ParameterError(f"`cables[{i}]` must be a rodmol.Cable, got {c!r}")
+        self.base = Base() if base is None else base
+        if not isinstance(self.base, Base):
+            raise ParameterError(f"`base` must be a rodmol.Base or None, got {base!r}")
+        self.drag, self.added_mass = bool(drag), bool(added_mass)
+        self.viscosity, self.munk_moment = bool(viscosity), bool(munk_moment)
+        self._check_cables()
+        self._sample()
+
+    def __repr__(self):
+        return (f"Model(L={self.rod.length} m, N={self.n_elements}, medium rho={self.medium.rho} "
+                f"kg/m^3, {len(self.cables)} cables)")
+
+    @property
+    def ds(self):
+        """Element length [m]."""
+        return self.rod.length / self.n_elements
+
+    @property
+    def feedback(self):
+        """True if a cable tension reads the state."""
+        return any(c.tension.feedback for c in self.cables)
+
+    def _check_cables(self):
+        L = self.rod.length
+        for c in self.cables:
+            if c.anchor > L * (1 + 1e-12):
+                raise ParameterError(
+                    f"cable {c.name!r}: `anchor` must lie in (0, L = {L!r} m], got {c.anchor!r}")
+            s = np.linspace(0.0, min(c.anchor, L), 2001)
+            r = self.rod.radius_at(s)
+            reach = np.hypot(*c.offset)
+            if np.any(reach >= r):
+                where = s[np.argmax(reach >= r)]
+                raise ParameterError(
+                    f"cable {c.name!r}: offset {c.offset} m (|p| = {reach:.6g} m) lies outside "
+                    f"the body at s = {where:.6g} m where the radius is "
+                    f"{self.rod.radius_at(where):.6g} m")
+
+    def _sample(self):
+        """Sample every sectional quantity on the grid (done once)."""
+        n, ds, rod, med = self.n_elements, self.ds, self.rod, self.medium
+        rho = rod.material.rho
+        self.s_nodes = np.linspace(0.0, rod.length, n + 1)
+        s_str, s_vel = self.s_nodes[:-1], self.s_nodes[1:]
+
+        self.kl, self.kth = rod.stiffness(s_str)
+        self.vl, self.vth = rod.viscosity(s_str)
+        if not self.viscosity:
+            self.vl, self.vth = np.zeros_like(self.vl), np.zeros_like(self.vth)
+
+        a, r = rod.area(s_vel), rod.radius_at(s_vel)
+        coeff = np.array([0.0, med.By, med.Bz]) if self.added_mass else np.zeros(3)
+        self.added = med.rho * a[:, None] * coeff
+        self.mass = rho * a[:, None] + self.added
+        self.inertia = rho * rod.second_moments(s_vel)
+        self.net_mass = (rho - med.rho) * a
+        self.drag_coefficient = (
+            med.rho * r[:, None] * np.array([0.5 * np.pi * med.Cx, med.Cy, med.Cz])
+            if self.drag else np.zeros((n, 3)))
+
+        # Fraction of each strain node's cell on the cable path: moving the
+        # anchor inside a cell shifts its concentrated load smoothly between
+        # the neighbouring nodes.
+        self.cable_offsets = np.array([c.offset3 for c in self.cables]).reshape(-1, 3)
+        anchors = np.array([c.anchor for c in self.cables]).reshape(-1, 1)
+        self.cable_weights = np.clip((anchors - s_str[None, :]) / ds, 0.0, 1.0)
+
+    def tensions(self, t, state=None):
+        """Cable tensions [N] at time t, shape (n_cables,)."""
+        return np.array([c.tension_at(t, state) for c in self.cables])
+
+    def load_scale(self, t=0.0):
+        """A force scale [N] of the applied loads: net weight plus cable tensions."""
+        weight = abs(self.rod.material.rho - self.medium.rho) * np.linalg.norm(self.gravity)
+        x, w = np.polynomial.legendre.leggauss(64)
+        s = 0.5 * self.rod.length * (x + 1.0)
+        total = 0.5 * self.rod.length * np.sum(w * weight * self.rod.area(s))
+        return total + float(np.sum(self.tensions(t))) if self.cables else total
+
+
+def _medium(medium, medium_density):
+    density = _checks.non_negative("medium_density", medium_density, " kg/m^3")
+    if medium is None:
+        return Medium(rho=density)
+    if density:
+        raise ParameterError("give either `medium` or `medium_density`, not both "
+                             f"(got medium={medium!r}, medium_density={medium_density!r})")
+    if isinstance(medium, str):
+        return Medium.preset(medium)
+    if not isinstance(medium, Medium):
+        raise ParameterError(f"`medium` must be a rodmol.Medium or a preset name, got {medium!r}")
+    return medium

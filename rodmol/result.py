@@ -1,0 +1,127 @@
+"""The result of a simulation: time series on the nodes, and its .npz file format."""
+
+import json
+import os
+
+import numpy as np
+
+from . import rotations
+from .layout import FIELDS, HEADER
+from .model import Q_STAR
+
+#: Arrays of a Result, with their units (also the keys of the .npz file).
+ARRAYS = {
+    "t": "s",
+    "s": "m",
+    "radius": "m",
+    "positions": "m, global",
+    "rotations": "local to global",
+    "linear_strain": "-, local",
+    "curvature": "1/m, local",
+    "velocity": "m/s, local",
+    "angular_velocity": "rad/s, local",
+    "internal_force": "N, local",
+    "internal_moment": "N m, local",
+    "tensions": "N",
+    "quaternion_norm_error": "-",
+}
+
+
+class Result:
+    """Time series of a run; arrays are time-first, components last.
+
+    Attributes
+    ----------
+    t : (n_t,) output times [s].
+    s : (N+1,) arc length of the nodes [m]; node 0 is the base.
+    radius : (N+1,) section radius at the nodes [m].
+    positions : (n_t, N+1, 3) centreline positions [m], global frame,
+        integrated in time (``u_t = R v``).
+    rotations : (n_t, N+1, 3, 3) local-to-global rotation matrices.
+    linear_strain, curvature : (n_t, N+1, 3) strains q [-] and k [1/m], local.
+    velocity, angular_velocity : (n_t, N+1, 3) v [m/s] and w [rad/s], local.
+    internal_force, internal_moment : (n_t, N+1, 3) Kelvin-Voigt stress N [N]
+        and M [N m] in the body, local (without the cables' own tension).
+    tensions : (n_t, n_cables) cable tensions [N].
+    quaternion_norm_error : (n_t,) max over nodes of ||Q| - 1|.
+    success, message : whether the solver reached ``t_end``, and why not.
+    stats : dict with ``steps``, ``rhs_evals``, ``jac_evals``, ``wall_time_s``,
+        ``backend``.
+    """
+
+    def __init__(self, arrays, success=True, message="", stats=None, meta=None):
+        for name in ARRAYS:
+            setattr(self, name, np.asarray(arrays[name]))
+        self.success, self.message = bool(success), str(message)
+        self.stats = dict(stats or {})
+        self.meta = dict(meta or {})
+
+    def __repr__(self):
+        return (f"Result(n_t={len(self.t)}, t_end={self.t[-1] if len(self.t) else None} s, "
+                f"nodes={len(self.s)}, success={self.success}, message={self.message!r})")
+
+    @property
+    def tip(self):
+        """(n_t, 3) tip position [m], global."""
+        return self.positions[:, -1]
+
+    def save(self, path):
+        """Write the result to ``path`` (.npz); read it back with :func:`load_result`."""
+        info = dict(success=self.success, message=self.message, stats=self.stats, meta=self.meta,
+                    units=ARRAYS)
+        tmp = f"{os.fspath(path)}.part.npz"
+        np.savez_compressed(tmp, info=json.dumps(info), **{k: getattr(self, k) for k in ARRAYS})
+        os.replace(tmp, path)  # never leave a half-written file under the real name
+
+
+def load_result(path):
+    """Read a :class:`Result` written by :meth:`Result.save`."""
+    with np.load(path, allow_pickle=False) as data:
+        info = json.loads(str(data["info"]))
+        arrays = {k: data[k] for k in ARRAYS}
+    return Result(arrays, info["success"], info["message"], info["stats"], info.get("meta"))
+
+
+def from_states(system, t, y, success, message, stats):
+    """Build a :class:`Result` from raw states ``y`` (n_t, size) of ``system``."""
+    model, lay = system.model, system.layout
+    n_t, n = len(t), model.n_elements
+    blocks = y[:, HEADER:].reshape(n_t, n, -1)
+    quat, q, k, v, w = (blocks[..., FIELDS[f]] for f in ("Q", "q", "k", "v", "w"))
+    base = [model.base.velocities(ti) for ti in t]
+    v0 = np.array([b[0] for b in base]).reshape(n_t, 3)
+    w0 = np.array([b[1] for b in base]).reshape(n_t, 3)
+    tensions = np.array([system.tensions(ti, yi) for ti, yi in zip(t, y)]).reshape(n_t, -1)
+
+    q_t, k_t, _, _ = system.balance(q, k, quat, v, w, v0, w0, tensions, model.gravity)
+    n_el, m_el, _, _ = system.stresses(q, k, q_t, k_t, tensions)
+
+    # Tip node: the body carries minus the stress of the cables anchored at the tip.
+    tip_cables = model.cable_weights[:, -1] == 1.0 if model.cables else np.zeros(0, bool)
+    n_tip, m_tip = np.zeros((n_t, 3)), np.zeros((n_t, 3))
+    if np.any(tip_cables):
+        _, _, n_tot, m_tot = system.stresses(q[:, -1:], k[:, -1:], 0 * q[:, -1:], 0 * k[:, -1:],
+                                             tensions * tip_cables)
+        n_tip, m_tip = -n_tot[:, 0], -m_tot[:, 0]
+    kl_tip, kth_tip = model.rod.stiffness(model.rod.length)
+    q_tip = Q_STAR + n_tip / kl_tip
+    k_tip = m_tip / kth_tip
+
+    quat_all = np.concatenate([y[:, None, 3:7], quat], axis=1)
+    arrays = dict(
+        t=t, s=model.s_nodes, radius=model.rod.radius_at(model.s_nodes),
+        positions=np.concatenate([y[:, None, :3], blocks[..., FIELDS["u"]]], axis=1),
+        rotations=rotations.matrices(quat_all),
+        linear_strain=np.concatenate([q, q_tip[:, None]], axis=1),
+        curvature=np.concatenate([k, k_tip[:, None]], axis=1),
+        velocity=np.concatenate([v0[:, None], v], axis=1),
+        angular_velocity=np.concatenate([w0[:, None], w], axis=1),
+        internal_force=np.concatenate([n_el, n_tip[:, None]], axis=1),
+        internal_moment=np.concatenate([m_el, m_tip[:, None]], axis=1),
+        tensions=tensions,
+        quaternion_norm_error=np.max(np.abs(np.linalg.norm(quat_all, axis=-1) - 1.0), axis=-1),
+    )
+    meta = dict(n_elements=n, length=model.rod.length,
+                cables=[dict(name=c.name, offset=list(c.offset), anchor=c.anchor)
+                        for c in model.cables])
+    return Result(arrays, success, message, stats, meta)

@@ -1,0 +1,101 @@
+"""Rod geometry (radius profile) and the sectional stiffness, viscosity and inertia."""
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from . import _checks
+from .errors import ParameterError
+from .parameters import Material
+
+
+@dataclass(frozen=True)
+class Rod:
+    """A straight rod of circular section along the local x axis.
+
+    Parameters
+    ----------
+    length : float
+        Rest length L [m].
+    radius : float, (float, float) or callable
+        Section radius [m]: a constant, a ``(base, tip)`` pair for a linear
+        taper, or a callable ``r(s)`` of the arc length s in [0, L] [m]
+        (it is called with numpy arrays).
+    material : Material
+    """
+
+    length: float
+    radius: Any
+    material: Material
+
+    def __post_init__(self):
+        object.__setattr__(self, "length", _checks.positive("length", self.length, " m"))
+        if not isinstance(self.material, Material):
+            raise ParameterError(f"`material` must be a rodmol.Material, got {self.material!r}")
+        if not callable(self.radius):
+            if np.ndim(self.radius) == 0:
+                _checks.positive("radius", self.radius, " m")
+            elif np.shape(self.radius) == (2,):
+                _checks.positive("radius[0] (base)", self.radius[0], " m")
+                _checks.positive("radius[1] (tip)", self.radius[1], " m")
+            else:
+                raise ParameterError(
+                    "`radius` must be a number, a (base, tip) pair or a callable r(s), "
+                    f"got {self.radius!r}"
+                )
+        # Callables are checked where they are sampled, on the actual grid.
+        self.radius_at(np.linspace(0.0, self.length, 65))
+
+    def radius_at(self, s):
+        """Radius [m] at arc lengths ``s`` [m] (array in, array out)."""
+        s = np.asarray(s, dtype=float)
+        if callable(self.radius):
+            try:
+                r = np.broadcast_to(np.asarray(self.radius(s), dtype=float), s.shape)
+            except Exception as exc:
+                raise ParameterError(f"`radius` callable failed on arc lengths: {exc}") from exc
+        elif np.ndim(self.radius) == 0:
+            r = np.full(s.shape, float(self.radius))
+        else:
+            base, tip = (float(x) for x in self.radius)
+            r = base + (tip - base) * s / self.length
+        bad = ~(np.isfinite(r) & (r > 0.0))
+        if np.any(bad):
+            i = np.flatnonzero(bad.ravel())[0]
+            raise ParameterError(
+                f"`radius` must be finite and > 0 m along the rod; r({s.ravel()[i]:.6g} m) = "
+                f"{r.ravel()[i]!r}"
+            )
+        return np.array(r)
+
+    def area(self, s):
+        """Section area A = pi r^2 [m^2]."""
+        return np.pi * self.radius_at(s) ** 2
+
+    def second_moments(self, s):
+        """(Jx, Jy, Jz) [m^4] as an array (..., 3): Jy = Jz = pi r^4 / 4, Jx = Jy + Jz."""
+        j = np.pi * self.radius_at(s) ** 4 / 4.0
+        return np.stack([2.0 * j, j, j], axis=-1)
+
+    def stiffness(self, s):
+        """Linear and angular stiffness diagonals Kl = (EA, GA, GA), Kth = (G Jx, E Jy, E Jz)."""
+        m = self.material
+        a = self.area(s)[..., None]
+        kl = a * np.array([m.E, m.G, m.G])
+        kth = self.second_moments(s) * np.array([m.G, m.E, m.E])
+        return kl, kth
+
+    def viscosity(self, s):
+        """Kelvin-Voigt diagonals Vl = mu (3A, A, A), Vth = mu (Jx, 3Jy, 3Jz) [N s, N m^2 s]."""
+        mu = self.material.mu
+        a = self.area(s)[..., None]
+        vl = mu * a * np.array([3.0, 1.0, 1.0])
+        vth = mu * self.second_moments(s) * np.array([1.0, 3.0, 3.0])
+        return vl, vth
+
+    def mass(self):
+        """Total mass [kg], by Gauss-Legendre quadrature of rho A(s)."""
+        x, w = np.polynomial.legendre.leggauss(64)
+        s = 0.5 * self.length * (x + 1.0)
+        return 0.5 * self.length * np.sum(w * self.material.rho * self.area(s))

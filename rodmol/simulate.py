@@ -1,0 +1,115 @@
+"""The one entry point: :func:`simulate`."""
+
+import warnings
+
+import numpy as np
+
+from . import _checks
+from .backends import DEFAULT_RTOL, get_backend
+from .equilibrium import equilibrium
+from .errors import ParameterError
+from .layout import FIELDS, HEADER
+from .model import Model
+from .result import from_states
+from .semidiscrete import SemiDiscrete
+from . import rotations
+
+
+def default_atol(model, rtol):
+    """Per-variable absolute tolerances: ``rtol`` times a scale of each field.
+
+    Scales: positions L, quaternions 1, strains q 1, curvatures 1/L,
+    velocities L/(1 s), angular velocities 1 rad/s.
+    """
+    L = model.rod.length
+    scale = {"u": L, "Q": 1.0, "q": 1.0, "k": 1.0 / L, "v": L, "w": 1.0}
+    block = np.empty(19)
+    for name, sl in FIELDS.items():
+        block[sl] = scale[name]
+    head = np.array([L] * 3 + [1.0] * 4)
+    return rtol * np.concatenate([head, np.tile(block, model.n_elements)])
+
+
+def straight_state(model):
+    """The undeformed rod at rest along the base's x axis."""
+    system = SemiDiscrete(model)
+    n = model.n_elements
+    r0 = np.asarray(model.base.rotation, dtype=float)
+    u0 = np.asarray(model.base.position, dtype=float)
+    quat0 = rotations.from_matrix(r0)
+    u = u0 + model.s_nodes[1:, None] * r0[:, 0]
+    zeros = np.zeros((n, 3))
+    q = np.tile([1.0, 0.0, 0.0], (n, 1))
+    return system.layout.pack(u0, quat0, u, np.tile(quat0, (n, 1)), q, zeros, zeros, zeros)
+
+
+def simulate(model, t_end, *, initial="equilibrium", backend="cvode", rtol=DEFAULT_RTOL,
+             atol=None, output_dt=0.01, progress=None, **backend_options):
+    """Integrate the model from t = 0 to ``t_end``.
+
+    Parameters
+    ----------
+    model : Model
+    t_end : float
+        End time [s] (> 0).
+    initial : "equilibrium", "straight" or array
+        Initial state: the static equilibrium under the loads at t = 0 (the
+        paper's choice), the undeformed straight rod at rest, or a state
+        vector (e.g. the last state of an earlier run).
+    backend : str
+        A name from ``rodmol.BACKENDS``: ``"cvode"`` (implicit BDF, default)
+        or ``"rk23"`` (explicit, cross-check).
+    rtol, atol : float, float or array
+        Tolerances shared by all backends; ``atol=None`` uses
+        :func:`default_atol`.
+    output_dt : float
+        Interval between output frames [s]; ``t_end`` is always an output.
+    progress : callable, optional
+        ``progress(t, t_end)`` is called at each output time.
+    **backend_options
+        Passed to the backend (e.g. ``linsolver="sparse"`` for CVODE).
+
+    Returns
+    -------
+    Result
+        If the solver fails or is interrupted, the result holds the frames
+        computed so far, ``success`` is False, ``message`` says where and why,
+        and a warning is issued.
+    """
+    if not isinstance(model, Model):
+        raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
+    t_end = _checks.positive("t_end", t_end, " s")
+    output_dt = _checks.positive("output_dt", output_dt, " s")
+    rtol = _checks.positive("rtol", rtol)
+    run = get_backend(backend)
+    system = SemiDiscrete(model)
+    y0 = _initial_state(model, initial, system.size)
+    if atol is None:
+        atol = default_atol(model, rtol)
+    else:
+        atol = np.asarray(atol, dtype=float)
+        if atol.shape not in ((), (system.size,)) or not np.all(np.isfinite(atol)) or np.any(atol <= 0):
+            raise ParameterError(f"`atol` must be > 0, scalar or of length {system.size}, got {atol!r}")
+        atol = np.broadcast_to(atol, (system.size,)).copy()
+
+    n_out = int(np.floor(t_end / output_dt + 1e-9))
+    t_out = np.unique(np.append(np.arange(n_out + 1) * output_dt, t_end))
+    raw = run(system, y0, t_out, rtol=rtol, atol=atol, progress=progress, **backend_options)
+    raw.stats["backend"] = backend
+    result = from_states(system, raw.t, raw.y, raw.success, raw.message, raw.stats)
+    if not raw.success:
+        warnings.warn(raw.message, RuntimeWarning, stacklevel=2)
+    return result
+
+
+def _initial_state(model, initial, size):
+    if isinstance(initial, str):
+        if initial == "equilibrium":
+            return equilibrium(model, 0.0)
+        if initial == "straight":
+            return straight_state(model)
+        raise ParameterError(f"unknown `initial` {initial!r}; use 'equilibrium', 'straight' or a state")
+    y0 = np.asarray(initial, dtype=float)
+    if y0.shape != (size,) or not np.all(np.isfinite(y0)):
+        raise ParameterError(f"`initial` state must be {size} finite numbers, got shape {y0.shape}")
+    return y0.copy()
