@@ -4,12 +4,16 @@ Implements and extends Renda et al., "Dynamic Model of a Multibending Soft
 Robot Arm Driven by Cables", IEEE T-RO 30(5), 2014. SI units throughout.
 """
 
+from . import scenarios
+from .analysis import energy, marker_errors
+from .arm import paper_arm
 from .backends import BACKENDS
 from .base import Base
 from .cables import Cable, read_tension_csv
 from .equilibrium import equilibrium
 from .errors import EquilibriumError, IntegrationError, ParameterError, RodmolError
 from .layout import StateLayout
+from .markers import Marker
 from .model import Model
 from .parameters import MEDIA, Material, Medium
 from .result import Result, load_result
@@ -20,7 +24,7 @@ from .simulate import default_atol, simulate, straight_state
 __version__ = "0.1.0"
 
 __all__ = [
-    "BACKENDS", "Base", "Cable", "EquilibriumError", "IntegrationError", "MEDIA", "Material",
+    "BACKENDS", "Base", "Cable", "Marker", "energy", "marker_errors", "paper_arm", "scenarios", "EquilibriumError", "IntegrationError", "MEDIA", "Material",
     "Medium", "Model", "ParameterError", "Result", "Rod", "RodmolError", "SemiDiscrete",
     "StateLayout", "StateView", "default_atol", "equilibrium", "load_result", "read_tension_csv",
     "simulate", "straight_state",

@@ -13,6 +13,7 @@ from . import _checks
 from .base import Base
 from .cables import Cable
 from .errors import ParameterError
+from .markers import Marker, marker_offsets
 from .parameters import Medium
 from .rod import Rod
 
@@ -43,11 +44,13 @@ class Model:
         ``viscosity=False`` sets mu = 0.
     munk_moment : bool
         Add the Munk moment of the added-mass model (off in the paper).
+    markers : sequence of Marker
+        Surface points whose trajectories the result carries.
     """
 
     def __init__(self, rod, n_elements, *, gravity=(0.0, -9.81, 0.0), medium=None,
                  medium_density=0.0, cables=(), base=None, drag=True, added_mass=True,
-                 viscosity=True, munk_moment=False):
+                 viscosity=True, munk_moment=False, markers=()):
         if not isinstance(rod, Rod):
             raise ParameterError(f"`rod` must be a rodmol.Rod, got {rod!r}")
         self.rod = rod
@@ -64,6 +67,11 @@ class Model:
         self.drag, self.added_mass = bool(drag), bool(added_mass)
         self.viscosity, self.munk_moment = bool(viscosity), bool(munk_moment)
         self._check_cables()
+        self.markers = tuple(markers)
+        for i, mk in enumerate(self.markers):
+            if not isinstance(mk, Marker):
+                raise ParameterError(f"`markers[{i}]` must be a rodmol.Marker, got {mk!r}")
+        self.marker_offsets = marker_offsets(self.markers, rod)
         self._sample()
 
     def __repr__(self):

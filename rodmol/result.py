@@ -5,7 +5,7 @@ import os
 
 import numpy as np
 
-from . import rotations
+from . import markers, rotations
 from .layout import FIELDS, HEADER
 from .model import Q_STAR
 
@@ -24,6 +24,7 @@ ARRAYS = {
     "internal_moment": "N m, local",
     "tensions": "N",
     "quaternion_norm_error": "-",
+    "markers": "m, global",
 }
 
 
@@ -44,6 +45,8 @@ class Result:
         and M [N m] in the body, local (without the cables' own tension).
     tensions : (n_t, n_cables) cable tensions [N].
     quaternion_norm_error : (n_t,) max over nodes of ||Q| - 1|.
+    markers : (n_t, n_markers, 3) marker positions [m], global; their names
+        are ``meta["markers"]``.
     success, message : whether the solver reached ``t_end``, and why not.
     stats : dict with ``steps``, ``rhs_evals``, ``jac_evals``, ``wall_time_s``,
         ``backend``.
@@ -108,10 +111,12 @@ def from_states(system, t, y, success, message, stats):
     k_tip = m_tip / kth_tip
 
     quat_all = np.concatenate([y[:, None, 3:7], quat], axis=1)
+    positions = np.concatenate([y[:, None, :3], blocks[..., FIELDS["u"]]], axis=1)
+    rots = rotations.matrices(quat_all)
     arrays = dict(
         t=t, s=model.s_nodes, radius=model.rod.radius_at(model.s_nodes),
-        positions=np.concatenate([y[:, None, :3], blocks[..., FIELDS["u"]]], axis=1),
-        rotations=rotations.matrices(quat_all),
+        positions=positions, rotations=rots,
+        markers=markers.track(model.markers, model.marker_offsets, model.s_nodes, positions, rots),
         linear_strain=np.concatenate([q, q_tip[:, None]], axis=1),
         curvature=np.concatenate([k, k_tip[:, None]], axis=1),
         velocity=np.concatenate([v0[:, None], v], axis=1),
@@ -123,5 +128,7 @@ def from_states(system, t, y, success, message, stats):
     )
     meta = dict(n_elements=n, length=model.rod.length,
                 cables=[dict(name=c.name, offset=list(c.offset), anchor=c.anchor)
-                        for c in model.cables])
+                        for c in model.cables],
+                markers=[dict(name=mk.name, s=mk.s, offset=list(model.marker_offsets[i, 1:]))
+                         for i, mk in enumerate(model.markers)])
     return Result(arrays, success, message, stats, meta)

@@ -1,0 +1,104 @@
+"""Post-processing: discrete energies and the paper's marker errors (eq. 15)."""
+
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import ParameterError
+from .model import Q_STAR
+
+
+def energy(model, result):
+    """Discrete energies [J] of every frame, consistent with the semi-discrete scheme.
+
+    Returns a dict of (n_t,) arrays: ``kinetic`` (velocity nodes 1..N, with
+    added mass), ``strain`` (strain nodes 0..N-1), ``gravity`` (potential of
+    weight minus buoyancy) and ``total``. With mu = 0, no gravity, no fluid
+    and no cables, ``kinetic + strain`` is conserved by the semi-discrete system.
+    """
+    ds = model.ds
+    v, w = result.velocity[:, 1:], result.angular_velocity[:, 1:]
+    kinetic = 0.5 * ds * (np.einsum("tni,ni,tni->t", v, model.mass, v)
+                          + np.einsum("tni,ni,tni->t", w, model.inertia, w))
+    dq = result.linear_strain[:, :-1] - Q_STAR
+    k = result.curvature[:, :-1]
+    strain = 0.5 * ds * (np.einsum("tni,ni,tni->t", dq, model.kl, dq)
+                         + np.einsum("tni,ni,tni->t", k, model.kth, k))
+    gravity = -ds * np.einsum("n,tni,i->t", model.net_mass, result.positions[:, 1:], model.gravity)
+    return dict(kinetic=kinetic, strain=strain, gravity=gravity, total=kinetic + strain + gravity)
+
+
+@dataclass(frozen=True)
+class MarkerErrors:
+    """Errors of eq. (15) between simulated and measured markers.
+
+    ``t`` [s] are the measurement times; ``tip`` is e_t(t), ``mean`` is
+    e_m(t) (both normalised by the arm length); ``tip_average`` and
+    ``mean_average`` are their time averages.
+    """
+
+    t: np.ndarray
+    tip: np.ndarray
+    mean: np.ndarray
+
+    @property
+    def tip_average(self):
+        return float(np.mean(self.tip))
+
+    @property
+    def mean_average(self):
+        return float(np.mean(self.mean))
+
+
+def read_markers_csv(path, n_markers=4):
+    """Read measured markers: columns t, x1, y1, z1, ..., xM, yM, zM [s, m] (header optional)."""
+    path = os.fspath(path)
+    try:
+        data = np.genfromtxt(path, delimiter=",", comments="#", skip_header=0)
+    except OSError as exc:
+        raise ParameterError(f"cannot read marker table {path!r}: {exc}") from None
+    if data.ndim == 2 and np.all(np.isnan(data[0])):
+        data = data[1:]
+    data = np.atleast_2d(data)
+    if data.shape[1] != 1 + 3 * n_markers or not np.all(np.isfinite(data)):
+        raise ParameterError(f"{path}: expected {1 + 3 * n_markers} numeric columns "
+                             f"(t and x, y, z of {n_markers} markers), got {data.shape[1]}")
+    if np.any(np.diff(data[:, 0]) <= 0):
+        line = int(np.flatnonzero(np.diff(data[:, 0]) <= 0)[0]) + 2
+        raise ParameterError(f"{path}: times must increase (data row {line})")
+    return data[:, 0], data[:, 1:].reshape(len(data), n_markers, 3)
+
+
+def marker_errors(result, measured, times=None, length=None):
+    """The paper's tip and mean errors (eq. 15) of ``result`` against measurements.
+
+    Parameters
+    ----------
+    result : Result
+        Its markers must be, in order, L1, L2, L3 and the tip (the
+        default of :func:`rodmol.paper_arm`).
+    measured : array (n, 4, 3) or path
+        Measured marker positions [m], global frame, or a CSV file (see
+        :func:`read_markers_csv`).
+    times : array (n,), optional
+        Measurement times [s]; default: the result's output times. The
+        simulation is interpolated linearly to them.
+    length : float, optional
+        Normalising length [m]; default: the arm's rest length.
+    """
+    if isinstance(measured, (str, os.PathLike)):
+        times, measured = read_markers_csv(measured, result.markers.shape[1])
+    measured = np.asarray(measured, dtype=float)
+    times = result.t if times is None else np.asarray(times, dtype=float)
+    if measured.shape != (len(times),) + result.markers.shape[1:]:
+        raise ParameterError(f"`measured` must have shape {(len(times),) + result.markers.shape[1:]}, "
+                             f"got {measured.shape}")
+    if times[0] < result.t[0] - 1e-12 or times[-1] > result.t[-1] + 1e-12:
+        raise ParameterError(f"measurement times [{times[0]}, {times[-1]}] s fall outside the "
+                             f"simulated interval [{result.t[0]}, {result.t[-1]}] s")
+    flat = result.markers.reshape(len(result.t), -1)
+    sim = np.stack([np.interp(times, result.t, col) for col in flat.T], axis=1).reshape(measured.shape)
+    length = result.meta.get("length") if length is None else length
+    dist = np.linalg.norm(sim - measured, axis=-1) / length
+    return MarkerErrors(times, dist[:, -1], np.mean(dist, axis=1))

@@ -1,0 +1,54 @@
+"""Markers: material points on the arm's surface, tracked like the paper's camera markers."""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _checks
+from .errors import ParameterError
+
+
+@dataclass(frozen=True)
+class Marker:
+    """A material point at arc length ``s`` [m], offset ``(p_y, p_z)`` [m] from the
+    midline in the section (local frame). ``offset=None`` puts it on the surface
+    on the local +y side, at the section radius."""
+
+    s: float
+    offset: tuple = None
+    name: str = "marker"
+
+    def __post_init__(self):
+        object.__setattr__(self, "s", _checks.non_negative(f"marker {self.name!r} s", self.s, " m"))
+        if self.offset is not None:
+            p = np.asarray(self.offset, dtype=float)
+            if p.shape != (2,) or not np.all(np.isfinite(p)):
+                raise ParameterError(f"marker {self.name!r}: `offset` must be (p_y, p_z) in m, "
+                                     f"got {self.offset!r}")
+            object.__setattr__(self, "offset", (float(p[0]), float(p[1])))
+
+
+def marker_offsets(markers, rod):
+    """(n_markers, 3) local offsets, resolving ``offset=None`` to the surface."""
+    out = np.zeros((len(markers), 3))
+    for i, m in enumerate(markers):
+        if m.s > rod.length * (1 + 1e-12):
+            raise ParameterError(f"marker {m.name!r}: `s` must lie in [0, L = {rod.length} m], got {m.s!r}")
+        out[i, 1:] = (float(rod.radius_at(min(m.s, rod.length))), 0.0) if m.offset is None else m.offset
+    return out
+
+
+def track(markers, offsets, s_nodes, positions, rotations):
+    """Global marker positions (n_t, n_markers, 3) from nodal poses.
+
+    Each marker is ``u + R p`` evaluated at the two nodes around it and
+    interpolated linearly in s.
+    """
+    out = np.empty(positions.shape[:1] + (len(markers), 3))
+    for i, m in enumerate(markers):
+        j = int(np.clip(np.searchsorted(s_nodes, m.s, side="right") - 1, 0, len(s_nodes) - 2))
+        f = (m.s - s_nodes[j]) / (s_nodes[j + 1] - s_nodes[j])
+        a = positions[:, j] + rotations[:, j] @ offsets[i]
+        b = positions[:, j + 1] + rotations[:, j + 1] @ offsets[i]
+        out[:, i] = (1.0 - f) * a + f * b
+    return out
