@@ -1,7 +1,7 @@
 """Motion of the clamped base (kinematic boundary condition at s = 0)."""
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable, Optional
 
 import numpy as np
 
@@ -28,8 +28,8 @@ class Base:
     ``Base()``, is a fixed clamp at the origin.
     """
 
-    velocity: Optional[Callable] = None
-    angular_velocity: Optional[Callable] = None
+    velocity: Callable | None = None
+    angular_velocity: Callable | None = None
     position: tuple = (0.0, 0.0, 0.0)
     rotation: tuple = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 

@@ -19,8 +19,9 @@ import csv
 import inspect
 import math
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -92,7 +93,7 @@ def read_tension_csv(path):
     path = os.fspath(path)
     rows = []
     try:
-        handle = open(path, newline="")
+        handle = open(path, newline="")  # noqa: SIM115 (closed by the with below)
     except OSError as exc:
         raise ParameterError(f"cannot read tension table {path!r}: {exc.strerror}") from None
     with handle:

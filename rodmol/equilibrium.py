@@ -74,7 +74,7 @@ def equilibrium(model, t=0.0, *, tol=1e-10, max_iter=40):
     lam, step = 0.0, 1.0
     while lam < 1.0:
         target = min(1.0, lam + step)
-        z_new = _newton(lambda x: residual(x, target), z, tol, max_iter)
+        z_new = _newton(lambda x, lam=target: residual(x, lam), z, tol, max_iter)
         if z_new is not None:
             z, lam, step = z_new, target, min(1.0, 2.0 * step)
         else:

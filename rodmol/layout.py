@@ -53,7 +53,7 @@ class StateLayout:
         y = np.empty(self.size)
         y[:3], y[3:7] = u0, quat0
         b = self.blocks(y)
-        for name, value in zip("u Q q k v w".split(), (u, quat, q, k, v, w)):
+        for name, value in zip(["u", "Q", "q", "k", "v", "w"], (u, quat, q, k, v, w)):
             b[:, FIELDS[name]] = value
         return y
 

@@ -87,7 +87,7 @@ def load_result(path):
 
 def from_states(system, t, y, success, message, stats):
     """Build a :class:`Result` from raw states ``y`` (n_t, size) of ``system``."""
-    model, lay = system.model, system.layout
+    model = system.model
     n_t, n = len(t), model.n_elements
     blocks = y[:, HEADER:].reshape(n_t, n, -1)
     quat, q, k, v, w = (blocks[..., FIELDS[f]] for f in ("Q", "q", "k", "v", "w"))
