@@ -25,7 +25,10 @@ def energy(model, result):
     k = result.curvature[:, :-1]
     strain = 0.5 * ds * (np.einsum("tni,ni,tni->t", dq, model.kl, dq)
                          + np.einsum("tni,ni,tni->t", k, model.kth, k))
-    gravity = -ds * np.einsum("n,tni,i->t", model.net_mass, result.positions[:, 1:], model.gravity)
+    # The time-integrated positions, not the rebuilt ones: their rate is exactly R v,
+    # so this potential balances the gravity work of the semi-discrete system.
+    u = result.integrated_positions[:, 1:]
+    gravity = -ds * np.einsum("n,tni,i->t", model.net_mass, u, model.gravity)
     return dict(kinetic=kinetic, strain=strain, gravity=gravity, total=kinetic + strain + gravity)
 
 

@@ -78,11 +78,20 @@ def _knots(name, knots, source="knots"):
         raise ParameterError(f"`{name}` knots must be finite, got {knots!r}")
     if np.any(np.diff(arr[:, 0]) <= 0.0):
         i = int(np.flatnonzero(np.diff(arr[:, 0]) <= 0.0)[0]) + 1
-        raise ParameterError(f"`{name}` knot times must increase; knot {i} has t = {arr[i, 0]!r}")
+        raise ParameterError(f"`{name}` knot times must increase; knot {i} has t = {float(arr[i, 0])!r}")
     if np.any(arr[:, 1] < 0.0):
         i = int(np.flatnonzero(arr[:, 1] < 0.0)[0])
-        raise ParameterError(f"`{name}` must be >= 0 N; knot {i} has T = {arr[i, 1]!r}")
+        raise ParameterError(f"`{name}` must be >= 0 N; knot {i} has T = {float(arr[i, 1])!r}")
     return PiecewiseLinearTension(arr[:, 0].copy(), arr[:, 1].copy(), source)
+
+
+def _number(cell):
+    """The finite float in ``cell``, or None."""
+    try:
+        x = float(cell)
+    except ValueError:
+        return None
+    return x if math.isfinite(x) else None
 
 
 def read_tension_csv(path):
@@ -91,7 +100,7 @@ def read_tension_csv(path):
     Errors name the file and the line.
     """
     path = os.fspath(path)
-    rows = []
+    rows, header_seen = [], False
     try:
         handle = open(path, newline="")  # noqa: SIM115 (closed by the with below)
     except OSError as exc:
@@ -101,16 +110,17 @@ def read_tension_csv(path):
             cells = [c.strip() for c in row]
             if not any(cells) or cells[0].startswith("#"):
                 continue
-            try:
-                t, tension = (float(c) if c else math.nan for c in cells[:2])
-            except ValueError:
-                if not rows and lineno == 1:
-                    continue  # header line
-                raise ParameterError(f"{path}:{lineno}: not a number in {row!r}") from None
-            if len(cells) < 2 or not math.isfinite(t):
+            values = [_number(c) for c in cells[:2]]
+            if not rows and not header_seen and any(v is None for v in values):
+                header_seen = True  # the first row that is not all numbers is a header
+                continue
+            if len(cells) < 1 or not cells[0]:
                 raise ParameterError(f"{path}:{lineno}: missing time in {row!r}")
-            if not math.isfinite(tension):
+            if len(cells) < 2 or not cells[1]:
                 raise ParameterError(f"{path}:{lineno}: missing tension in {row!r}")
+            if any(v is None for v in values):
+                raise ParameterError(f"{path}:{lineno}: not a number in {row!r}")
+            t, tension = values
             if rows and t <= rows[-1][1]:
                 raise ParameterError(
                     f"{path}:{lineno}: time {t!r} s does not increase (previous {rows[-1][1]!r} s)"
@@ -182,5 +192,5 @@ class Cable:
         """Tension [N] at time t; a negative value is an error naming the cable."""
         value = self.tension(t, state)
         if not value >= 0.0:  # also catches NaN
-            raise ParameterError(f"cable {self.name!r}: tension must be >= 0 N, got {value!r} at t = {t!r} s")
+            raise ParameterError(f"cable {self.name!r}: tension must be >= 0 N, got {float(value)!r} at t = {float(t)!r} s")
         return value

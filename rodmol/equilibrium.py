@@ -11,7 +11,7 @@ grows linearly with the number of elements.
 import numpy as np
 from scipy.linalg import solve_banded
 
-from . import rotations
+from . import centreline, rotations
 from .errors import EquilibriumError
 from .model import Q_STAR, Model
 from .semidiscrete import SemiDiscrete
@@ -137,10 +137,7 @@ def _state(model, system, z, quat0):
     zb = z.reshape(n, _BLOCK)
     q, k, quat = zb[:, :3], zb[:, 3:6], zb[:, 6:]
     quat = quat / np.linalg.norm(quat, axis=1, keepdims=True)
-    prev = np.vstack([quat0, quat[:-1]])
-    mid = rotations.multiply(prev, rotations.from_rotation_vector(0.5 * ds * k))
-    steps = ds * np.einsum("nij,nj->ni", rotations.matrices(mid), q)
     u0 = np.asarray(model.base.position, dtype=float)
-    u = u0 + np.cumsum(steps, axis=0)
+    u = centreline.positions(u0, np.vstack([quat0, quat]), q, k, ds)[1:]
     zeros = np.zeros((n, 3))
     return system.layout.pack(u0, quat0, u, quat, q, k, zeros, zeros)

@@ -26,8 +26,10 @@ _DEPENDS = {
     "Q": {0: ("Q", "w")},
     "q": {-1: ("v", "w"), 0: ("q", "k", "v")},
     "k": {-1: ("w",), 0: ("k", "w")},
-    "v": {-1: ("v", "w"), 0: ("Q", "q", "k", "v", "w"), 1: ("q", "k", "v", "w")},
-    "w": {-1: ("v", "w"), 0: ("q", "k", "v", "w"), 1: ("q", "k", "v", "w")},
+    # The next block's w reaches the force only through the moment, and the
+    # torque sees the previous block only through k_t (its w).
+    "v": {-1: ("v", "w"), 0: ("Q", "q", "k", "v", "w"), 1: ("q", "k", "v")},
+    "w": {-1: ("w",), 0: ("q", "k", "v", "w"), 1: ("q", "k", "v", "w")},
 }
 
 

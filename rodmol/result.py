@@ -5,7 +5,7 @@ import os
 
 import numpy as np
 
-from . import markers, rotations
+from . import centreline, markers, rotations
 from .layout import FIELDS, HEADER
 from .model import Q_STAR
 
@@ -15,6 +15,7 @@ ARRAYS = {
     "s": "m",
     "radius": "m",
     "positions": "m, global",
+    "integrated_positions": "m, global",
     "rotations": "local to global",
     "linear_strain": "-, local",
     "curvature": "1/m, local",
@@ -37,7 +38,10 @@ class Result:
     s : (N+1,) arc length of the nodes [m]; node 0 is the base.
     radius : (N+1,) section radius at the nodes [m].
     positions : (n_t, N+1, 3) centreline positions [m], global frame,
-        integrated in time (``u_t = R v``).
+        rebuilt from the strains and orientations (see ``rodmol.centreline``).
+    integrated_positions : (n_t, N+1, 3) positions integrated in time
+        (``u_t = R v``); they drift from the shape by O(ds) per unit time but
+        are the exact conjugate of the gravity work (used by ``rodmol.energy``).
     rotations : (n_t, N+1, 3, 3) local-to-global rotation matrices.
     linear_strain, curvature : (n_t, N+1, 3) strains q [-] and k [1/m], local.
     velocity, angular_velocity : (n_t, N+1, 3) v [m/s] and w [rad/s], local.
@@ -111,11 +115,12 @@ def from_states(system, t, y, success, message, stats):
     k_tip = m_tip / kth_tip
 
     quat_all = np.concatenate([y[:, None, 3:7], quat], axis=1)
-    positions = np.concatenate([y[:, None, :3], blocks[..., FIELDS["u"]]], axis=1)
+    positions = centreline.positions(y[:, :3], quat_all, q, k, model.ds)
     rots = rotations.matrices(quat_all)
     arrays = dict(
         t=t, s=model.s_nodes, radius=model.rod.radius_at(model.s_nodes),
         positions=positions, rotations=rots,
+        integrated_positions=np.concatenate([y[:, None, :3], blocks[..., FIELDS["u"]]], axis=1),
         markers=markers.track(model.markers, model.marker_offsets, model.s_nodes, positions, rots),
         linear_strain=np.concatenate([q, q_tip[:, None]], axis=1),
         curvature=np.concatenate([k, k_tip[:, None]], axis=1),

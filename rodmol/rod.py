@@ -65,7 +65,7 @@ class Rod:
             i = np.flatnonzero(bad.ravel())[0]
             raise ParameterError(
                 f"`radius` must be finite and > 0 m along the rod; r({s.ravel()[i]:.6g} m) = "
-                f"{r.ravel()[i]!r}"
+                f"{float(r.ravel()[i])!r}"
             )
         return np.array(r)
 

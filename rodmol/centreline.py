@@ -1,0 +1,31 @@
+"""Centreline positions rebuilt from the strains.
+
+The upwind scheme does not keep the time-integrated positions (u_t = R v)
+consistent with the strains (u' = R q): their gap grows by O(ds) per unit
+time under sustained motion. Positions are therefore rebuilt from the base
+position, the orientations and the strains, which is exact at rest and
+bounded by O(ds) at all times.
+"""
+
+import numpy as np
+
+from . import rotations
+
+
+def positions(u0, quat, q, k, ds):
+    """Node positions (..., N+1, 3) [m], global.
+
+    Parameters
+    ----------
+    u0 : (..., 3) base position [m], global.
+    quat : (..., N+1, 4) orientations of nodes 0..N (node 0 is the base).
+    q, k : (..., N, 3) strains of strain nodes 0..N-1, local.
+    ds : float, element length [m].
+
+    Element j runs from node j to node j+1 with constant strains q_j, k_j;
+    its chord is approximated by ds R(mid) q_j with R(mid) = R_j exp(ds k_j / 2).
+    """
+    mid = rotations.multiply(quat[..., :-1, :], rotations.from_rotation_vector(0.5 * ds * k))
+    steps = ds * np.einsum("...ij,...j->...i", rotations.matrices(mid), q)
+    u0 = np.asarray(u0, dtype=float)[..., None, :]
+    return np.concatenate([u0, u0 + np.cumsum(steps, axis=-2)], axis=-2)
