@@ -18,14 +18,17 @@ from .model import Model
 from .parameters import MEDIA, Material, Medium
 from .result import Result, load_result
 from .rod import Rod
+from .scenario_file import ScenarioError, load_scenario
 from .semidiscrete import SemiDiscrete, StateView
 from .simulate import default_atol, simulate, straight_state
+from .writers import write_series
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "BACKENDS", "Base", "Cable", "Marker", "energy", "marker_errors", "paper_arm", "scenarios", "EquilibriumError", "IntegrationError", "MEDIA", "Material",
-    "Medium", "Model", "ParameterError", "Result", "Rod", "RodmolError", "SemiDiscrete",
-    "StateLayout", "StateView", "default_atol", "equilibrium", "load_result", "read_tension_csv",
-    "simulate", "straight_state",
+    "BACKENDS", "Base", "Cable", "EquilibriumError", "IntegrationError", "MEDIA", "Marker",
+    "Material", "Medium", "Model", "ParameterError", "Result", "Rod", "RodmolError",
+    "ScenarioError", "SemiDiscrete", "StateLayout", "StateView", "default_atol", "energy",
+    "equilibrium", "load_result", "load_scenario", "marker_errors", "paper_arm",
+    "read_tension_csv", "scenarios", "simulate", "straight_state", "write_series",
 ]

@@ -1,0 +1,410 @@
+"""The ``rodmol`` command line: run scenario files, render and plot results.
+
+    rodmol run SCENARIO.toml [--out DIR] [--backend NAME] [--n-elements N] [--t-end T] [--quiet]
+    rodmol run --example fetching [--out DIR] ...
+    rodmol render DIR        # last_frame.png and animation.gif from DIR/result.npz
+    rodmol plot DIR          # tip_path.png, markers.png, tensions.png
+
+Exit codes: 0 done, 1 the solver failed, 2 bad scenario or arguments,
+130 interrupted (Ctrl-C); an interrupted run keeps the frames done.
+"""
+
+import argparse
+import signal
+import sys
+import time
+import warnings
+from pathlib import Path
+
+from .errors import ParameterError
+
+EXIT_FAILED, EXIT_USAGE, EXIT_INTERRUPTED = 1, 2, 130
+EXAMPLES = ("bending", "reaching", "fetching")
+
+
+def main(argv=None):
+    """Entry point of the ``rodmol`` command; returns the exit code."""
+    args = _parser().parse_args(argv)
+    try:
+        return args.command(args)
+    except ParameterError as exc:
+        print(f"rodmol: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except KeyboardInterrupt:
+        print("rodmol: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+
+
+def _parser():
+    parser = argparse.ArgumentParser(prog="rodmol", description="Soft cable-driven arms as Cosserat rods.")
+    commands = parser.add_subparsers(required=True, metavar="COMMAND")
+
+    run = commands.add_parser("run", help="run a scenario file and write result.npz and a ParaView series")
+    run.add_argument("scenario", nargs="?", help="TOML scenario file (see docs/scenario-reference.md)")
+    run.add_argument("--example", choices=EXAMPLES, metavar="NAME", help="run one of the paper's tests instead of a file: "
+                                                                  + ", ".join(EXAMPLES))
+    _run_options(run)
+    run.set_defaults(command=_run)
+
+    example = commands.add_parser("example", help="run one of the paper's tests without a file")
+    example.add_argument("example", choices=EXAMPLES)
+    _run_options(example)
+    example.set_defaults(command=_run, scenario=None)
+
+    render = commands.add_parser("render", help="render the last frame (PNG) and an animation (GIF)")
+    render.add_argument("directory", type=Path, help="output directory of `rodmol run`")
+    render.add_argument("--frames", type=int, default=60, help="animation frames (default 60; 0: none)")
+    render.add_argument("--size", default="960x720", help="picture size in pixels, WxH (default 960x720)")
+    render.set_defaults(command=_render)
+
+    plot = commands.add_parser("plot", help="plot tip path, markers and tensions vs time (PNG)")
+    plot.add_argument("directory", type=Path, help="output directory of `rodmol run`")
+    plot.set_defaults(command=_plot)
+    return parser
+
+
+def _run_options(parser):
+    parser.add_argument("--out", type=Path, metavar="DIR", help="output directory (default: [output] directory, "
+                                                 "else out/NAME)")
+    parser.add_argument("--backend", metavar="NAME", help="solver backend (cvode, rk23)")
+    parser.add_argument("--n-elements", type=int, metavar="N", help="number of elements N")
+    parser.add_argument("--t-end", type=float, metavar="T", help="end time [s]")
+    parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
+
+
+# --------------------------------------------------------------------------- run
+
+def _load(args):
+    """The checked scenario, with the command line's overrides; raises ScenarioError."""
+    from .scenario_file import Override, load_scenario, parse_scenario
+
+    overrides = {}
+    for option, key in (("backend", "solver.backend"), ("n_elements", "discretization.n_elements"),
+                        ("t_end", "solver.t_end")):
+        if getattr(args, option) is not None:
+            overrides[key] = Override(getattr(args, option), "--" + option.replace("_", "-"))
+    if args.example and args.scenario:
+        raise ParameterError("give either a scenario file or `--example`, not both")
+    if args.example:
+        text = f'name = "{args.example}"\narm = "paper"\nscenario = "{args.example}"\n'
+        return parse_scenario(text, source=f"<example {args.example}>", overrides=overrides)
+    if not args.scenario:
+        raise ParameterError("give a scenario file (rodmol run FILE.toml) or `--example NAME`")
+    return load_scenario(args.scenario, overrides=overrides)
+
+
+def _run(args):
+    spec = _load(args)
+    out = args.out or spec.output.directory or Path("out") / spec.name
+    try:  # before the run, so a directory that cannot be made does not waste it
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ParameterError(f"cannot create the output directory {str(out)!r}: {exc.strerror}") from None
+    say = (lambda *a, **k: None) if args.quiet else print
+    model = spec.model
+    say(f"rodmol: {spec.name}: N = {model.n_elements} elements, t_end = {spec.t_end:g} s, "
+        f"backend {spec.solver['backend']} -> {out}")
+    if spec.solver["initial"] == "equilibrium":
+        say("rodmol: finding the initial equilibrium ...")
+
+    interrupts = _Interrupts()
+    previous = signal.signal(signal.SIGINT, interrupts)
+    try:
+        progress = None if args.quiet else Progress(spec.t_end)
+        started = time.perf_counter()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # the summary gives the message
+            result = spec.simulate(progress=progress)
+        wall = time.perf_counter() - started
+        if progress:
+            progress.close()
+        interrupts.raising = False  # from here, Ctrl-C stops writing between frames
+        result.meta.update(scenario=spec.source, name=spec.name)
+        say(f"rodmol: writing {len(result.t)} frames to {out} (Ctrl-C stops between frames) ...")
+        written = _write_outputs(result, spec.output, out, interrupts)
+        written["seconds"] = time.perf_counter() - started - wall
+    except KeyboardInterrupt:
+        print("\nrodmol: interrupted before the first frame; nothing written", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if not args.quiet:
+        print(summary(spec, result, wall, written))
+    elif not result.success:
+        print(f"rodmol: {spec.name}: {result.message}", file=sys.stderr)
+    if interrupts.count:
+        return EXIT_INTERRUPTED
+    return 0 if result.success else EXIT_FAILED
+
+
+class _Interrupts:
+    """SIGINT handler: raises KeyboardInterrupt (``raising``) or only counts."""
+
+    def __init__(self):
+        self.count, self.raising = 0, True
+
+    def __call__(self, signum, frame):
+        self.count += 1
+        if self.raising:
+            raise KeyboardInterrupt
+
+
+def _write_outputs(result, options, out, interrupts):
+    """Write result.npz, then the VTK frames; stop between frames on a new Ctrl-C."""
+    from .writers import SeriesWriter, frame_indices
+
+    before = interrupts.count
+    out.mkdir(parents=True, exist_ok=True)
+    written = {}
+    if options.npz:
+        result.save(out / "result.npz")
+        written["npz"] = out / "result.npz"
+    if options.vtk:
+        indices = frame_indices(len(result.t), options.every)
+        with SeriesWriter.for_result(result, out) as writer:
+            for k in indices:
+                if interrupts.count > before:
+                    break
+                writer.write(result, k)
+        written.update(pvd=writer.pvd("rod"), parts=writer.parts, frames=writer.frames,
+                       all_frames=len(indices))
+    return written
+
+
+def summary(spec, result, wall, written):
+    """A one-screen account of a run."""
+    st, t = result.stats, result.t
+    t_done = float(t[-1]) if len(t) else 0.0
+    state = "done" if result.success else f"STOPPED: {result.message}"
+    lines = [f"rodmol: {spec.name}: {state}",
+             f"  simulated   {t_done:g} of {spec.t_end:g} s, {len(t)} output frames "
+             f"(N = {spec.model.n_elements}, backend {st.get('backend', '?')})",
+             f"  solver      {st.get('steps', 0)} steps, {st.get('rhs_evals', 0)} RHS evaluations, "
+             f"{st.get('jac_evals', 0)} Jacobian evaluations"]
+    solver_wall = st.get("wall_time_s", wall)
+    factor = t_done / solver_wall if solver_wall > 0 else float("inf")
+    lines.append(f"  wall time   {wall:.2f} s run ({solver_wall:.2f} s integrating, {factor:.3g} x real "
+                 f"time) + {written.get('seconds', 0.0):.2f} s writing")
+    if len(t):
+        tip = result.tip[-1]
+        lines.append(f"  tip         ({tip[0]:.4f}, {tip[1]:.4f}, {tip[2]:.4f}) m, global, "
+                     f"at t = {t_done:g} s")
+    if "npz" in written:
+        lines.append(f"  result      {written['npz']}")
+    if "pvd" in written:
+        others = ", ".join(f"{p}.pvd" for p in written["parts"][1:])
+        partial = "" if written["frames"] == written["all_frames"] else f" of {written['all_frames']}"
+        lines.append(f"  ParaView    {written['pvd']}" + (f" (+ {others})" if others else "")
+                     + f", {written['frames']}{partial} frame" + ("" if written["all_frames"] == 1 else "s"))
+    if "npz" in written:
+        folder = written["npz"].parent
+        lines.append(f"  next        rodmol render {folder}   |   rodmol plot {folder}")
+    return "\n".join(lines)
+
+
+class Progress:
+    """``progress(t, t_end)`` callback: a bar on a terminal, plain lines otherwise."""
+
+    def __init__(self, t_end, stream=None):
+        self.stream = stream or sys.stdout
+        self.tty = self.stream.isatty()
+        self.t_end, self.start = t_end, time.perf_counter()
+        self.shown, self.next_fraction = -float("inf"), 0.1  # the first call always shows
+
+    def __call__(self, t, t_end):
+        now = time.perf_counter()
+        fraction = min(t / t_end, 1.0) if t_end > 0 else 1.0
+        wall = now - self.start
+        eta = wall * (1.0 - fraction) / fraction if fraction > 0.02 else float("nan")
+        text = (f"t = {t:8.3f} / {t_end:g} s  {100 * fraction:3.0f}%  wall {_clock(wall)}  "
+                f"ETA {_clock(eta)}")
+        if self.tty:
+            if now - self.shown >= 0.1 or fraction >= 1.0:
+                bar = "#" * int(30 * fraction)
+                self.stream.write(f"\r[{bar:<30}] {text}")
+                self.stream.flush()
+                self.shown = now
+        elif fraction >= self.next_fraction - 1e-12 or now - self.shown >= 10.0:
+            self.stream.write(text + "\n")
+            self.stream.flush()
+            self.shown = now
+            while self.next_fraction <= fraction + 1e-12:
+                self.next_fraction += 0.1
+
+    def close(self):
+        if self.tty:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+def _clock(seconds):
+    if seconds != seconds or seconds == float("inf"):
+        return "--:--"
+    minutes, sec = divmod(int(round(seconds)), 60)
+    hours, minutes = divmod(minutes, 60)
+    return f"{hours}:{minutes:02d}:{sec:02d}" if hours else f"{minutes:02d}:{sec:02d}"
+
+
+# --------------------------------------------------------------------------- render, plot
+
+def _result_in(directory):
+    from .result import load_result
+
+    path = Path(directory) / "result.npz"
+    if not path.is_file():
+        raise ParameterError(f"no result.npz in {str(directory)!r}; run `rodmol run ... --out DIR` first")
+    try:
+        return load_result(path)
+    except (OSError, KeyError, ValueError) as exc:
+        raise ParameterError(f"cannot read {str(path)!r} (another rodmol version?): {exc}") from None
+
+
+def _render(args):
+    try:
+        size = tuple(int(x) for x in args.size.lower().split("x"))
+        if len(size) != 2 or min(size) < 16:
+            raise ValueError
+    except ValueError:
+        raise ParameterError(f"`--size` must be WxH in pixels, e.g. 960x720, got {args.size!r}") from None
+    if args.frames < 0:
+        raise ParameterError(f"`--frames` must be >= 0, got {args.frames!r}")
+    result = _result_in(args.directory)
+    for path in render(result, args.directory, size, args.frames):
+        print(f"rodmol: wrote {path}")
+    return 0
+
+
+def render(result, directory, size=(960, 720), frames=60):
+    """Render ``last_frame.png`` and (``frames`` > 0) ``animation.gif`` into ``directory``.
+
+    Off-screen pyvista: the body as a tube of the true radius coloured by the
+    bending curvature, the cables as lines (red when pulled), the markers as dots.
+    """
+    import numpy as np
+    import pyvista as pv
+    from PIL import Image
+
+    from .writers import cables_mesh, frame_indices, markers_mesh, rod_mesh
+
+    pv.OFF_SCREEN = True
+    _quiet_vtk()
+    bending = np.linalg.norm(result.curvature[..., 1:], axis=-1)
+    r_max = float(np.max(result.radius))
+    low, high = result.positions.min(axis=(0, 1)) - r_max, result.positions.max(axis=(0, 1)) + r_max
+    plotter = pv.Plotter(off_screen=True, window_size=list(size))
+    plotter.set_background("white")
+
+    def draw(k):
+        rod = rod_mesh(result, k)
+        rod.point_data["bending curvature [1/m]"] = bending[k]
+        plotter.add_mesh(rod.tube(scalars="radius [m]", absolute=True, n_sides=32), name="body",
+                         scalars="bending curvature [1/m]", clim=[0.0, max(float(bending.max()), 1e-9)],
+                         cmap="viridis", smooth_shading=True, opacity=0.55,
+                         scalar_bar_args=dict(color="black"))
+        cables = cables_mesh(result, k)
+        if cables.n_cells:
+            pulled = cables.cell_data["tension [N]"] > 0
+            colours = np.where(pulled[:, None], [[0.85, 0.1, 0.1]], [[0.6, 0.6, 0.6]])
+            cables.cell_data["colour"] = (255 * colours).astype(np.uint8)
+            plotter.add_mesh(cables, name="cables", scalars="colour", rgb=True, line_width=3)
+        if len(result.meta.get("markers", [])):
+            plotter.add_mesh(markers_mesh(result, k), name="markers", color="black", point_size=10,
+                             render_points_as_spheres=True)
+        plotter.add_text(f"t = {result.t[k]:.2f} s", name="time", color="black", font_size=12)
+
+    draw(len(result.t) - 1)
+    centre, extent = (low + high) / 2, float(np.linalg.norm(high - low))
+    direction = np.array([0.25, 0.45, 1.0]) / np.linalg.norm([0.25, 0.45, 1.0])  # from front, above
+    plotter.camera_position = [tuple(centre + 2 * extent * direction), tuple(centre), (0.0, 1.0, 0.0)]
+    plotter.reset_camera(bounds=[low[0], high[0], low[1], high[1], low[2], high[2]])
+    plotter.camera.zoom(1.3)
+    written = [Path(directory) / "last_frame.png"]
+    plotter.screenshot(written[0])
+    if frames > 0 and len(result.t) > 1:
+        every = max(1, int(np.ceil(len(result.t) / frames)))
+        indices = frame_indices(len(result.t), every)
+        images = []
+        for k in indices:
+            draw(k)
+            plotter.render()
+            images.append(Image.fromarray(plotter.screenshot(return_img=True)))
+        step_ms = max(20, int(round(1000 * (result.t[-1] - result.t[0]) / max(len(indices) - 1, 1))))
+        written.append(Path(directory) / "animation.gif")
+        images[0].save(written[1], save_all=True, append_images=images[1:], duration=step_ms, loop=0)
+    plotter.close()
+    return written
+
+
+def _quiet_vtk():
+    """Hide VTK's console warnings (it first tries an X display, then falls back to EGL)."""
+    from vtkmodules.vtkCommonCore import vtkLogger
+
+    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)
+
+
+def _plot(args):
+    for path in plot(_result_in(args.directory), args.directory):
+        print(f"rodmol: wrote {path}")
+    return 0
+
+
+def plot(result, directory):
+    """Tip and marker paths, marker positions vs time and tensions vs time, as PNGs in
+    ``directory`` (like the paper's Figs. 7-8); returns their paths."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    directory, written = Path(directory), []
+    names = [m["name"] for m in result.meta.get("markers", [])]
+
+    fig, axes = plt.subplots(1, 2, figsize=(11, 5), constrained_layout=True)
+    for ax, (i, j) in zip(axes, ((0, 1), (0, 2))):
+        ax.plot(result.tip[:, i], result.tip[:, j], "k-", lw=1.5, label="tip")
+        for m, name in enumerate(names):
+            ax.plot(result.markers[:, m, i], result.markers[:, m, j], lw=1, label=f"marker {name}")
+        ax.plot(result.positions[-1, :, i], result.positions[-1, :, j], ":", color="grey", label="last frame")
+        ax.set(xlabel=f"{'xyz'[i]} [m]", ylabel=f"{'xyz'[j]} [m]")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.suptitle("Paths, global frame")
+    written.append(_save(fig, directory / "tip_path.png"))
+
+    fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True, constrained_layout=True)
+    for i, ax in enumerate(axes):
+        ax.plot(result.t, result.tip[:, i], "k-", lw=1.5, label="tip")
+        for m, name in enumerate(names):
+            ax.plot(result.t, result.markers[:, m, i], lw=1, label=name)
+        ax.set(ylabel=f"{'xyz'[i]} [m]")
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8, ncol=5)
+    axes[-1].set(xlabel="t [s]")
+    fig.suptitle("Marker positions, global frame")
+    written.append(_save(fig, directory / "markers.png"))
+
+    fig, ax = plt.subplots(figsize=(8, 3.5), constrained_layout=True)
+    cables = [c["name"] for c in result.meta.get("cables", [])]
+    pulled = [i for i in range(len(cables)) if np.any(result.tensions[:, i] > 0)]
+    for i in pulled:
+        ax.plot(result.t, result.tensions[:, i], label=cables[i])
+    ax.set(xlabel="t [s]", ylabel="tension [N]", title="Cable tensions" + ("" if pulled else " (all slack)"))
+    ax.grid(alpha=0.3)
+    if pulled:
+        ax.legend(fontsize=8)
+    written.append(_save(fig, directory / "tensions.png"))
+    return written
+
+
+def _save(fig, path):
+    import matplotlib.pyplot as plt
+
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+if __name__ == "__main__":
+    sys.exit(main())

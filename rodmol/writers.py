@@ -1,0 +1,284 @@
+"""VTK time series for ParaView: ``.pvd`` collections of ``.vtp`` PolyData frames.
+
+A series directory holds
+
+* ``rod.pvd``: the centreline as one polyline per frame, with the point arrays
+  listed in :data:`ROD_ARRAYS` (``radius [m]`` lets ParaView's Tube filter draw
+  the true tapered body);
+* ``cables.pvd``: each cable as a polyline at its true position ``u + R p``
+  from the base to its anchor, with ``tension [N]``;
+* ``markers.pvd``: the markers as points;
+* ``vtk/``: the frame files (``rod_000012.vtp``, ...).
+
+Each frame file is written completely before the ``.pvd`` that lists it is
+replaced (atomically), so an interrupted run leaves valid series of the frames
+done. Vectors carry the Result's frames: strains, velocities and stresses in
+local (material) components, positions and the frame vectors in global ones;
+``velocity (global) [m/s]`` is the velocity in global components, for glyphs.
+"""
+
+import os
+import re
+import time
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+from .errors import ParameterError
+
+#: Point arrays of the centreline: VTK name -> (Result attribute, frame).
+ROD_ARRAYS = {
+    "linear strain [-]": ("linear_strain", "local"),
+    "curvature [1/m]": ("curvature", "local"),
+    "velocity [m/s]": ("velocity", "local"),
+    "angular velocity [rad/s]": ("angular_velocity", "local"),
+    "internal force [N]": ("internal_force", "local"),
+    "internal moment [N m]": ("internal_moment", "local"),
+}
+PARTS = ("rod", "cables", "markers")
+SUBDIRECTORY = "vtk"
+
+
+def polydata(points, lines=(), vertices=False, point_data=None, cell_data=None, field_data=None):
+    """A pyvista PolyData built straight through VTK (several times faster than
+    pyvista's setters, which matters when writing thousands of frames).
+
+    ``lines`` is a list of point-index arrays, one polyline each; ``vertices``
+    makes one vertex cell per point. Arrays are float (n,) or (n, 3); field
+    data may also be lists of strings.
+    """
+    import pyvista as pv
+    from vtkmodules.util.numpy_support import numpy_to_vtk, numpy_to_vtkIdTypeArray
+    from vtkmodules.vtkCommonCore import vtkPoints, vtkStringArray
+    from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
+
+    def cells(groups):
+        sizes = [len(g) for g in groups]
+        offsets = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+        ids = np.concatenate(groups).astype(np.int64) if groups else np.zeros(0, np.int64)
+        array = vtkCellArray()
+        array.SetData(numpy_to_vtkIdTypeArray(offsets, deep=True), numpy_to_vtkIdTypeArray(ids, deep=True))
+        return array
+
+    def add(target, name, values):
+        if len(values) and isinstance(values[0], str):
+            array = vtkStringArray()
+            for v in values:
+                array.InsertNextValue(v)
+        else:
+            array = numpy_to_vtk(np.ascontiguousarray(values, dtype=float), deep=True)
+        array.SetName(name)
+        target.AddArray(array)
+
+    mesh = vtkPolyData()
+    vtk_points = vtkPoints()
+    vtk_points.SetData(numpy_to_vtk(np.ascontiguousarray(points, dtype=float).reshape(-1, 3), deep=True))
+    mesh.SetPoints(vtk_points)
+    if len(lines):
+        mesh.SetLines(cells([np.asarray(line) for line in lines]))
+    if vertices:
+        mesh.SetVerts(cells([[i] for i in range(len(points))]))
+    for target, arrays in ((mesh.GetPointData(), point_data), (mesh.GetCellData(), cell_data),
+                           (mesh.GetFieldData(), field_data)):
+        for name, values in (arrays or {}).items():
+            add(target, name, values)
+    return pv.wrap(mesh)
+
+
+def rod_mesh(result, k):
+    """The centreline at frame ``k`` as a polyline (pyvista PolyData) with its point arrays."""
+    rotation = result.rotations[k]
+    data = {"s [m]": result.s, "radius [m]": result.radius}
+    data.update({name: getattr(result, attribute)[k] for name, (attribute, _) in ROD_ARRAYS.items()})
+    data["velocity (global) [m/s]"] = np.einsum("nij,nj->ni", rotation, result.velocity[k])
+    data.update({f"frame {axis} [-]": rotation[:, :, i] for i, axis in enumerate("xyz")})
+    return polydata(result.positions[k], lines=[np.arange(len(result.s))], point_data=data,
+                    field_data={"time [s]": [float(result.t[k])]})
+
+
+def cable_paths(result, k):
+    """Each cable's points at frame ``k``: a list of (s [m] (n,), points [m] (n, 3), global).
+
+    The nodes with s below the anchor, then the anchor itself, with ``u + R p``
+    interpolated linearly in s between the nodes around it.
+    """
+    s_nodes, u, rotation = result.s, result.positions[k], result.rotations[k]
+    paths = []
+    for cable in result.meta.get("cables", []):
+        p = np.array([0.0, *cable["offset"]])
+        anchor = min(float(cable["anchor"]), float(s_nodes[-1]))
+        on_path = s_nodes < anchor
+        s = np.append(s_nodes[on_path], anchor)
+        points = u + rotation @ p
+        at_anchor = [np.interp(anchor, s_nodes, points[:, i]) for i in range(3)]
+        paths.append((s, np.vstack([points[on_path], at_anchor])))
+    return paths
+
+
+def cables_mesh(result, k):
+    """The cables at frame ``k`` as polylines (one cell each) with ``tension [N]``."""
+    paths = cable_paths(result, k)
+    sizes = [len(s) for s, _ in paths]
+    starts = np.concatenate([[0], np.cumsum(sizes)])
+    tension = result.tensions[k].reshape(-1)
+    names = [c["name"] for c in result.meta.get("cables", [])]
+    point_data = cell_data = None
+    if paths:
+        point_data = {"tension [N]": np.repeat(tension, sizes),
+                      "s [m]": np.concatenate([s for s, _ in paths]),
+                      "cable index [-]": np.repeat(np.arange(len(paths)), sizes)}
+        cell_data = {"tension [N]": tension, "cable index [-]": np.arange(len(paths))}
+    field_data = {"time [s]": [float(result.t[k])]}
+    if names:
+        field_data["cable names"] = names
+    return polydata(np.vstack([pts for _, pts in paths]) if paths else np.zeros((0, 3)),
+                    lines=[np.arange(a, b) for a, b in zip(starts[:-1], starts[1:])],
+                    point_data=point_data, cell_data=cell_data, field_data=field_data)
+
+
+def markers_mesh(result, k):
+    """The markers at frame ``k`` as points, with ``s [m]`` and ``marker index [-]``."""
+    info = result.meta.get("markers", [])
+    point_data = {"s [m]": [float(m["s"]) for m in info], "marker index [-]": np.arange(len(info))}
+    field_data = {"time [s]": [float(result.t[k])]}
+    if info:
+        field_data["marker names"] = [m["name"] for m in info]
+    return polydata(np.asarray(result.markers[k], dtype=float).reshape(-1, 3), vertices=True,
+                    point_data=point_data if info else None, field_data=field_data)
+
+
+def save_vtp(mesh, path):
+    """Write a PolyData with VTK's XML writer (raw appended binary, uncompressed: fastest)."""
+    from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter
+
+    writer = vtkXMLPolyDataWriter()
+    writer.SetFileName(str(path))
+    writer.SetInputData(mesh)
+    writer.SetDataModeToAppended()
+    writer.EncodeAppendedDataOff()
+    writer.SetCompressorTypeToNone()
+    if not writer.Write():
+        raise OSError(f"VTK could not write {str(path)!r}")
+
+
+MESHES = {"rod": rod_mesh, "cables": cables_mesh, "markers": markers_mesh}
+
+
+def write_pvd(path, entries):
+    """Write a ParaView collection listing ``(time [s], file)`` entries, atomically."""
+    root = ET.Element("VTKFile", type="Collection", version="0.1", byte_order="LittleEndian")
+    collection = ET.SubElement(root, "Collection")
+    for t, file in entries:
+        ET.SubElement(collection, "DataSet", timestep=repr(float(t)), group="", part="0",
+                      file=str(file))
+    ET.indent(root)
+    tmp = Path(f"{path}.part")
+    ET.ElementTree(root).write(tmp, encoding="utf-8", xml_declaration=True)
+    os.replace(tmp, path)
+
+
+def read_pvd(path):
+    """``(time [s], absolute path)`` entries of a ``.pvd`` collection."""
+    root = ET.parse(path).getroot()
+    folder = Path(path).parent
+    return [(float(d.get("timestep")), folder / d.get("file")) for d in root.iter("DataSet")]
+
+
+class SeriesWriter:
+    """Writes frames of results into ParaView series, one frame at a time.
+
+    Parameters
+    ----------
+    directory : path
+        Created if needed. Series files of an earlier run there
+        (``rod.pvd``, ``vtk/rod_*.vtp``, ...) are replaced.
+    parts : sequence of str
+        Which series to write: any of ``"rod"``, ``"cables"``, ``"markers"``.
+    flush_interval : float
+        The collections are rewritten after a frame if this many seconds
+        [s, wall time] have passed since the last rewrite (0: after every
+        frame), and by :meth:`flush` / :meth:`close`. They only ever list
+        frames whose files are complete.
+
+    Every part starts as an empty collection; :meth:`write` adds one frame.
+    Use it as a context manager, or call :meth:`close` at the end.
+    """
+
+    def __init__(self, directory, parts=PARTS, flush_interval=0.5):
+        unknown = [p for p in parts if p not in MESHES]
+        if unknown:
+            raise ParameterError(f"unknown `parts` {unknown}; valid are {list(PARTS)}")
+        self.directory = Path(directory)
+        self.parts = tuple(parts)
+        (self.directory / SUBDIRECTORY).mkdir(parents=True, exist_ok=True)
+        self.entries = {part: [] for part in self.parts}
+        self.frames, self.flush_interval = 0, float(flush_interval)
+        stale = re.compile(rf"({'|'.join(PARTS)})_\d+\.vtp")
+        for file in (self.directory / SUBDIRECTORY).iterdir():
+            if stale.fullmatch(file.name):
+                file.unlink()
+        for part in PARTS:
+            pvd = self.pvd(part)
+            if part in self.parts:
+                write_pvd(pvd, [])
+            elif pvd.exists():
+                pvd.unlink()
+        self.flushed = time.monotonic()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    @classmethod
+    def for_result(cls, result, directory, **options):
+        """A writer with the parts a result has (no cables or markers: no such series)."""
+        parts = ["rod"] + (["cables"] if result.meta.get("cables") else []) \
+            + (["markers"] if result.meta.get("markers") else [])
+        return cls(directory, parts, **options)
+
+    def pvd(self, part="rod"):
+        """Path of the collection of ``part``."""
+        return self.directory / f"{part}.pvd"
+
+    def write(self, result, k):
+        """Write frame ``k`` of ``result`` (all parts), then list it in the collections."""
+        index, files = self.frames, {}
+        for part in self.parts:
+            relative = Path(SUBDIRECTORY) / f"{part}_{index:06d}.vtp"
+            save_vtp(MESHES[part](result, k), self.directory / relative)
+            files[part] = relative
+        for part in self.parts:
+            self.entries[part].append((float(result.t[k]), files[part].as_posix()))
+        self.frames += 1
+        if time.monotonic() - self.flushed >= self.flush_interval:
+            self.flush()
+
+    def flush(self):
+        """Rewrite the collections so they list every frame written so far."""
+        for part in self.parts:
+            write_pvd(self.pvd(part), self.entries[part])
+        self.flushed = time.monotonic()
+
+    close = flush
+
+
+def frame_indices(n_frames, every=1):
+    """Indices of every ``every``-th frame, always including the last."""
+    if n_frames == 0:
+        return []
+    return sorted(set(range(0, n_frames, int(every))) | {n_frames - 1})
+
+
+def write_series(result, directory, every=1):
+    """Write a finished :class:`rodmol.Result` as ParaView series in ``directory``.
+
+    Returns the path of ``rod.pvd``. ``every``: write every n-th output frame
+    (and the last).
+    """
+    with SeriesWriter.for_result(result, directory) as writer:
+        for k in frame_indices(len(result.t), every):
+            writer.write(result, k)
+    return writer.pvd("rod")

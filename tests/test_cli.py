@@ -1,0 +1,156 @@
+"""The command line end to end, in subprocesses: every shipped example, errors, Ctrl-C."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+import rodmol
+from rodmol.writers import read_pvd
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+SCENARIOS = sorted(EXAMPLES.glob("*.toml"))
+
+
+def rodmol_cli(*args, timeout=120):
+    return subprocess.run([sys.executable, "-m", "rodmol.cli", *map(str, args)], capture_output=True,
+                          text=True, timeout=timeout)
+
+
+def assert_valid_series(directory):
+    """Every .pvd lists only files that exist and load; returns the rod's times."""
+    pv = pytest.importorskip("pyvista")
+    times = None
+    for pvd in directory.glob("*.pvd"):
+        entries = read_pvd(pvd)
+        for _, path in entries:
+            assert path.is_file(), path
+            assert pv.read(path).n_points > 0, path
+        if pvd.name == "rod.pvd":
+            times = [t for t, _ in entries]
+    assert times is not None, "no rod.pvd"
+    return times
+
+
+def test_examples_are_shipped():
+    assert {p.stem for p in SCENARIOS} >= {"bending", "reaching", "fetching", "uniform_arm_air"}
+
+
+@pytest.mark.parametrize("scenario", SCENARIOS, ids=lambda p: p.stem)
+def test_run_each_example_coarse(scenario, tmp_path):
+    out = tmp_path / "out"
+    run = rodmol_cli("run", scenario, "--out", out, "--n-elements", 8, "--t-end", 0.3)
+    assert run.returncode == 0, run.stderr
+    result = rodmol.load_result(out / "result.npz")
+    assert result.success and result.t[-1] == pytest.approx(0.3) and len(result.s) == 9
+    assert assert_valid_series(out) == pytest.approx(list(result.t))
+    assert str(out / "rod.pvd") in run.stdout and "Jacobian evaluations" in run.stdout
+    assert "x real time" in run.stdout and "tip" in run.stdout
+
+
+def test_builtin_example_quiet(tmp_path):
+    out = tmp_path / "fetch"
+    run = rodmol_cli("example", "fetching", "--out", out, "--n-elements", 6, "--t-end", 0.05, "--quiet")
+    assert run.returncode == 0, run.stderr
+    assert run.stdout == ""
+    assert rodmol.load_result(out / "result.npz").meta["name"] == "fetching"
+
+
+def test_malformed_scenario_exit_2_names_key_and_line_writes_nothing(tmp_path):
+    text = (EXAMPLES / "bending.toml").read_text()
+    text = text.replace("nu = 0.5", "nuu = 0.5").replace("rho = 1080.0", 'rho = "heavy"')
+    bad = tmp_path / "bad.toml"
+    bad.write_text(text)
+    lines = text.splitlines()
+    nuu = next(i for i, line in enumerate(lines, 1) if line.startswith("nuu"))
+    rho = next(i for i, line in enumerate(lines, 1) if line.startswith("rho = \"heavy\""))
+    out = tmp_path / "never"
+    run = rodmol_cli("run", bad, "--out", out)
+    assert run.returncode == 2
+    assert f"bad.toml:{nuu}: [material] unknown key `nuu`; did you mean `nu`?" in run.stderr
+    assert f"bad.toml:{rho}: [material] `rho` must be a number, got 'heavy'" in run.stderr
+    assert not out.exists()
+
+
+def test_bad_command_line_value_exit_2(tmp_path):
+    run = rodmol_cli("run", EXAMPLES / "bending.toml", "--n-elements", 1, "--out", tmp_path / "x")
+    assert run.returncode == 2 and "command line --n-elements" in run.stderr
+    assert not (tmp_path / "x").exists()
+    assert rodmol_cli("render", tmp_path).returncode == 2
+
+
+def test_ctrl_c_keeps_a_valid_partial_run(tmp_path):
+    out = tmp_path / "stopped"
+    # The explicit backend on this grid takes minutes: the interrupt lands in the solver.
+    command = [sys.executable, "-u", "-m", "rodmol.cli", "run", "--example", "fetching",
+               "--backend", "rk23", "--n-elements", "60", "--out", str(out)]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        line = ""
+        while not line.startswith("t ="):  # the first progress line: output frames exist
+            line = process.stdout.readline()
+            assert line or process.poll() is None, process.stderr.read()
+        time.sleep(1.0)
+        process.send_signal(signal.SIGINT)
+        stdout, stderr = process.communicate(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert process.returncode == 130, stderr
+    assert "STOPPED" in stdout and "interrupted" in stdout
+    result = rodmol.load_result(out / "result.npz")
+    assert not result.success and "interrupted" in result.message
+    assert 2 <= len(result.t) < 801
+    assert assert_valid_series(out) == pytest.approx(list(result.t))
+
+
+@pytest.mark.skipif(os.environ.get("RODMOL_SKIP_RENDER") == "1", reason="RODMOL_SKIP_RENDER=1")
+def test_render_and_plot(tmp_path):
+    out = tmp_path / "r"
+    assert rodmol_cli("run", EXAMPLES / "uniform_arm_air.toml", "--out", out, "--n-elements", 6,
+                      "--t-end", 0.1, "--quiet").returncode == 0
+    render = rodmol_cli("render", out, "--frames", 3, "--size", "320x240")
+    assert render.returncode == 0, render.stderr
+    plot = rodmol_cli("plot", out)
+    assert plot.returncode == 0, plot.stderr
+    for name in ("last_frame.png", "animation.gif", "tip_path.png", "markers.png", "tensions.png"):
+        assert (out / name).stat().st_size > 1000, name
+
+
+def test_ctrl_c_while_writing_stops_between_frames(tmp_path, monkeypatch):
+    from rodmol import cli, writers
+    from rodmol.scenario_file import OutputOptions
+
+    result = rodmol.simulate(rodmol.scenarios.get("bending").model(6), 0.05, output_dt=0.01)
+    interrupts = cli._Interrupts()
+    interrupts.count, interrupts.raising = 1, False  # one Ctrl-C already stopped the solver
+    original = writers.SeriesWriter.write
+
+    def write(self, result, k):
+        original(self, result, k)
+        if self.frames == 2:
+            interrupts(signal.SIGINT, None)  # a second Ctrl-C while writing
+
+    monkeypatch.setattr(writers.SeriesWriter, "write", write)
+    written = cli._write_outputs(result, OutputOptions(), tmp_path, interrupts)
+    assert written["frames"] == 2 and written["all_frames"] == len(result.t) == 6
+    assert assert_valid_series(tmp_path) == pytest.approx(list(result.t[:2]))
+    assert len(rodmol.load_result(tmp_path / "result.npz").t) == 6
+
+
+def test_progress_plain_lines_when_not_a_terminal():
+    import io
+
+    from rodmol.cli import Progress
+
+    stream = io.StringIO()
+    progress = Progress(1.0, stream)
+    for t in (0.01, 0.02, 0.05, 0.1, 0.15, 0.5, 1.0):
+        progress(t, 1.0)
+    lines = stream.getvalue().splitlines()
+    assert len(lines) == 4 and all(line.startswith("t =") and "ETA" in line for line in lines)
+    assert "\r" not in stream.getvalue()
