@@ -1,0 +1,129 @@
+"""Pictures of a result: off-screen 3-D renders (pyvista) and time plots (matplotlib)."""
+
+from pathlib import Path
+
+
+def render(result, directory, size=(960, 720), frames=60):
+    """Render ``last_frame.png`` and (``frames`` > 0) ``animation.gif`` into ``directory``.
+
+    Off-screen pyvista: the body as a tube of the true radius coloured by the
+    bending curvature, the cables as lines (red when pulled), the markers as dots.
+    """
+    import numpy as np
+    import pyvista as pv
+    from PIL import Image
+
+    from .writers import cables_mesh, frame_indices, markers_mesh, rod_mesh
+
+    pv.OFF_SCREEN = True
+    _quiet_vtk()
+    bending = np.linalg.norm(result.curvature[..., 1:], axis=-1)
+    r_max = float(np.max(result.radius))
+    low, high = result.positions.min(axis=(0, 1)) - r_max, result.positions.max(axis=(0, 1)) + r_max
+    plotter = pv.Plotter(off_screen=True, window_size=list(size))
+    plotter.set_background("white")
+
+    def draw(k):
+        rod = rod_mesh(result, k)
+        rod.point_data["bending curvature [1/m]"] = bending[k]
+        plotter.add_mesh(rod.tube(scalars="radius [m]", absolute=True, n_sides=32), name="body",
+                         scalars="bending curvature [1/m]", clim=[0.0, max(float(bending.max()), 1e-9)],
+                         cmap="viridis", smooth_shading=True, opacity=0.55,
+                         scalar_bar_args=dict(color="black"))
+        cables = cables_mesh(result, k)
+        if cables.n_cells:
+            pulled = cables.cell_data["tension [N]"] > 0
+            colours = np.where(pulled[:, None], [[0.85, 0.1, 0.1]], [[0.6, 0.6, 0.6]])
+            cables.cell_data["colour"] = (255 * colours).astype(np.uint8)
+            plotter.add_mesh(cables, name="cables", scalars="colour", rgb=True, line_width=3)
+        if len(result.meta.get("markers", [])):
+            plotter.add_mesh(markers_mesh(result, k), name="markers", color="black", point_size=10,
+                             render_points_as_spheres=True)
+        plotter.add_text(f"t = {result.t[k]:.2f} s", name="time", color="black", font_size=12)
+
+    draw(len(result.t) - 1)
+    centre, extent = (low + high) / 2, float(np.linalg.norm(high - low))
+    direction = np.array([0.25, 0.45, 1.0]) / np.linalg.norm([0.25, 0.45, 1.0])  # from front, above
+    plotter.camera_position = [tuple(centre + 2 * extent * direction), tuple(centre), (0.0, 1.0, 0.0)]
+    plotter.reset_camera(bounds=[low[0], high[0], low[1], high[1], low[2], high[2]])
+    plotter.camera.zoom(1.3)
+    written = [Path(directory) / "last_frame.png"]
+    plotter.screenshot(written[0])
+    if frames > 0 and len(result.t) > 1:
+        every = max(1, int(np.ceil(len(result.t) / frames)))
+        indices = frame_indices(len(result.t), every)
+        images = []
+        for k in indices:
+            draw(k)
+            plotter.render()
+            images.append(Image.fromarray(plotter.screenshot(return_img=True)))
+        step_ms = max(20, int(round(1000 * (result.t[-1] - result.t[0]) / max(len(indices) - 1, 1))))
+        written.append(Path(directory) / "animation.gif")
+        images[0].save(written[1], save_all=True, append_images=images[1:], duration=step_ms, loop=0)
+    plotter.close()
+    return written
+
+
+def _quiet_vtk():
+    """Hide VTK's console warnings (it first tries an X display, then falls back to EGL)."""
+    from vtkmodules.vtkCommonCore import vtkLogger
+
+    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)
+
+
+def plot(result, directory):
+    """Tip and marker paths, marker positions vs time and tensions vs time, as PNGs in
+    ``directory`` (like the paper's Figs. 7-8); returns their paths."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    directory, written = Path(directory), []
+    names = [m["name"] for m in result.meta.get("markers", [])]
+
+    fig, axes = plt.subplots(1, 2, figsize=(11, 5), constrained_layout=True)
+    for ax, (i, j) in zip(axes, ((0, 1), (0, 2))):
+        ax.plot(result.tip[:, i], result.tip[:, j], "k-", lw=1.5, label="tip")
+        for m, name in enumerate(names):
+            ax.plot(result.markers[:, m, i], result.markers[:, m, j], lw=1, label=f"marker {name}")
+        ax.plot(result.positions[-1, :, i], result.positions[-1, :, j], ":", color="grey", label="last frame")
+        ax.set(xlabel=f"{'xyz'[i]} [m]", ylabel=f"{'xyz'[j]} [m]")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.suptitle("Paths, global frame")
+    written.append(_save(fig, directory / "tip_path.png"))
+
+    fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True, constrained_layout=True)
+    for i, ax in enumerate(axes):
+        ax.plot(result.t, result.tip[:, i], "k-", lw=1.5, label="tip")
+        for m, name in enumerate(names):
+            ax.plot(result.t, result.markers[:, m, i], lw=1, label=name)
+        ax.set(ylabel=f"{'xyz'[i]} [m]")
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=8, ncol=5)
+    axes[-1].set(xlabel="t [s]")
+    fig.suptitle("Marker positions, global frame")
+    written.append(_save(fig, directory / "markers.png"))
+
+    fig, ax = plt.subplots(figsize=(8, 3.5), constrained_layout=True)
+    cables = [c["name"] for c in result.meta.get("cables", [])]
+    pulled = [i for i in range(len(cables)) if np.any(result.tensions[:, i] > 0)]
+    for i in pulled:
+        ax.plot(result.t, result.tensions[:, i], label=cables[i])
+    ax.set(xlabel="t [s]", ylabel="tension [N]", title="Cable tensions" + ("" if pulled else " (all slack)"))
+    ax.grid(alpha=0.3)
+    if pulled:
+        ax.legend(fontsize=8)
+    written.append(_save(fig, directory / "tensions.png"))
+    return written
+
+
+def _save(fig, path):
+    import matplotlib.pyplot as plt
+
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path

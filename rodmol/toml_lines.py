@@ -1,0 +1,79 @@
+"""Line numbers of the tables and keys of a TOML text, for error messages (tomllib gives none)."""
+
+import re
+
+_BARE = r"[A-Za-z0-9_-]+|\"[^\"]*\"|'[^']*'"
+_KEY = rf"(?:{_BARE})(?:\s*\.\s*(?:{_BARE}))*"
+_ARRAY_HEADER = re.compile(rf"^\s*\[\[\s*({_KEY})\s*\]\]")
+_HEADER = re.compile(rf"^\s*\[\s*({_KEY})\s*\]")
+_ASSIGN = re.compile(rf"^\s*({_KEY})\s*=(.*)$")
+
+
+def _split_key(key):
+    return tuple(part.strip("\"'") for part in re.findall(_BARE, key))
+
+
+class KeyLines:
+    """Line numbers of the tables and keys of a TOML text (tomllib gives none).
+
+    Paths are tuples: ``("rod", "radius")``, ``("cable", 2, "anchor")`` for the
+    third ``[[cable]]``. Lines inside multi-line arrays and strings are skipped.
+    """
+
+    def __init__(self, text):
+        self.lines = {}
+        table, counts, depth, in_string = (), {}, 0, None
+        for number, line in enumerate(text.splitlines(), start=1):
+            if depth or in_string:
+                depth, in_string = _scan(line, depth, in_string)
+                continue
+            if match := _ARRAY_HEADER.match(line):
+                name = _split_key(match.group(1))
+                counts[name] = counts.get(name, -1) + 1
+                table = name + (counts[name],)
+            elif match := _HEADER.match(line):
+                table = _split_key(match.group(1))
+            elif match := _ASSIGN.match(line):
+                self.lines.setdefault(table + _split_key(match.group(1)), number)
+                depth, in_string = _scan(match.group(2), 0, None)
+                continue
+            else:
+                continue
+            self.lines.setdefault(table, number)
+
+    def find(self, path):
+        """Line of ``path``, or of its closest enclosing table or key; None if unknown."""
+        path = tuple(path)
+        while path:
+            if path in self.lines:
+                return self.lines[path]
+            path = path[:-1]
+        return None
+
+
+def _scan(fragment, depth, in_string):
+    """Follow brackets and strings through a value fragment; return (depth, open string)."""
+    i = 0
+    while i < len(fragment):
+        if in_string:
+            end = fragment.find(in_string, i)
+            if end < 0:
+                return depth, in_string
+            i, in_string = end + 3, None
+            continue
+        c = fragment[i]
+        if c == "#":
+            break
+        if fragment.startswith('"""', i) or fragment.startswith("'''", i):
+            in_string, i = fragment[i:i + 3], i + 3
+            continue
+        if c in "\"'":
+            i += 1
+            while i < len(fragment) and fragment[i] != c:
+                i += 2 if (c == '"' and fragment[i] == "\\") else 1
+        elif c in "[{":
+            depth += 1
+        elif c in "]}":
+            depth = max(depth - 1, 0)
+        i += 1
+    return depth, in_string
