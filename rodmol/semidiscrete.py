@@ -2,14 +2,25 @@
 
 Forward differences (toward the tip) for v and w in the compatibility laws,
 backward differences (toward the base) for the stresses in the balance laws.
-This is the plain numpy reference implementation, vectorised over nodes.
+The plain numpy implementation here, vectorised over nodes, is the reference
+(``balance``/``stresses`` also serve post-processing with a leading time
+axis); by default ``SemiDiscrete.__call__`` runs the same equations compiled
+by numba (:mod:`rodmol.kernels`), which is what the time integrators call.
 """
+
+import warnings
+from bisect import bisect_right
 
 import numpy as np
 
-from . import loads, rotations
+from . import kernels, loads, rotations
+from .cables import ConstantTension, PiecewiseLinearTension
+from .errors import ParameterError
 from .layout import FIELDS, HEADER, StateLayout
 from .model import Q_STAR
+
+#: Implementations of ``SemiDiscrete.__call__``.
+KERNELS = ("numba", "numpy")
 
 #: Rate [1/s] at which the quaternion norm is pulled back to 1; the exact
 #: dynamics keep |Q| = 1, so this only damps integration drift.
@@ -41,12 +52,32 @@ class StateView:
 
 
 class SemiDiscrete:
-    """Right-hand side of the method-of-lines system of a :class:`rodmol.Model`."""
+    """Right-hand side of the method-of-lines system of a :class:`rodmol.Model`.
 
-    def __init__(self, model):
+    Parameters
+    ----------
+    model : Model
+    kernel : "numba" or "numpy"
+        Implementation of :meth:`__call__`: the compiled loops of
+        :mod:`rodmol.kernels` (default; falls back to numpy with a warning
+        if numba is not installed) or the vectorised numpy reference.
+    """
+
+    def __init__(self, model, kernel="numba"):
+        if kernel not in KERNELS:
+            raise ParameterError(f"unknown `kernel` {kernel!r}; valid: {list(KERNELS)}")
+        if kernel == "numba" and not kernels.AVAILABLE:
+            warnings.warn("numba is not installed: using the (slower) numpy right-hand side",
+                          RuntimeWarning, stacklevel=2)
+            kernel = "numpy"
         self.model = model
         self.layout = StateLayout(model.n_elements)
         self.size = self.layout.size
+        self.kernel = kernel
+        self._feedback = model.feedback  # a property that loops over the cables: read it once
+        self._classify_cables()
+        if kernel == "numba":
+            self._setup_compiled()
 
     def stresses(self, q, k, q_t, k_t, tensions):
         """Total internal stress at the strain nodes: Kelvin-Voigt plus cable actuation.
@@ -101,12 +132,115 @@ class SemiDiscrete:
         return q_t, k_t, force, torque
 
     def tensions(self, t, y):
-        m = self.model
-        state = StateView(self.layout, t, y) if m.feedback else None
-        return m.tensions(t, state)
+        """Tensions of all cables at (t, y), shape (n_cables,) [N]."""
+        if self._feedback:
+            return self.model.tensions(t, StateView(self.layout, t, y))
+        full = self._constant_tensions.copy()
+        for i, times, values in self._tables:
+            full[i] = _interp(t, times, values)
+        for i, cable in self._others:
+            full[i] = cable.tension_at(t)
+        return full
+
+    def _classify_cables(self):
+        """Sort the cables by how their tension is evaluated, once.
+
+        The right-hand side needs the tensions at every call, and going
+        through ``Model.tensions`` (one ``Cable.tension_at`` per cable, a
+        ``np.interp`` per table) costs more than the compiled kernel itself.
+        Constant tensions are read once (slack cables are dropped from the
+        kernel), tables are interpolated with ``bisect`` (same formula as
+        ``np.interp``), and only other callables are called each time,
+        through ``Cable.tension_at``, which checks their values. Feedback
+        tensions read the state, so then every cable goes the general way.
+        """
+        cables = self.model.cables
+        self._constant_tensions = np.zeros(len(cables))
+        self._tables, self._others, active = [], [], []
+        for i, c in enumerate(cables):
+            kind = c.tension
+            if isinstance(kind, ConstantTension):
+                self._constant_tensions[i] = kind.value
+                if kind.value == 0.0:
+                    continue
+            elif isinstance(kind, PiecewiseLinearTension):
+                self._tables.append((i, list(kind.times), list(kind.values)))
+            else:
+                self._others.append((i, c))
+            active.append(i)
+        # Cables the kernel sees: all of them with feedback, else the non-slack ones.
+        self._active = np.arange(len(cables)) if self._feedback else np.array(active, dtype=int)
 
     def __call__(self, t, y, out=None):
         """dy/dt at (t, y); writes into ``out`` if given (CVODE's ``yp``)."""
+        if self.kernel == "numba":
+            return self._compiled(t, y, out)
+        return self._reference(t, y, out)
+
+    def rates(self, t, states):
+        """dy/dt at each of the frames ``states`` (n_t, size) at times ``t`` (n_t,).
+
+        With the numba kernel this costs a few microseconds per frame, so
+        post-processing can take the strain rates (fields q, k of the rates)
+        from here instead of re-evaluating :meth:`balance` on whole series.
+        """
+        states = np.asarray(states, dtype=float)
+        out = np.empty_like(states)
+        for i, (ti, yi) in enumerate(zip(np.asarray(t, dtype=float), states)):
+            self(float(ti), yi, out[i])
+        return out
+
+    def _setup_compiled(self):
+        """Pack the model for the compiled kernel, once (parameter arrays,
+        cable geometry of the cables the kernel sees, input buffers)."""
+        m = self.model
+        self._params, self._consts, offsets, weights = kernels.pack_model(
+            m, QUATERNION_RESTORING_RATE, loads.DRAG_SMOOTHING_SPEED)
+        self._work = np.empty((m.n_elements, 6))
+        self.base_velocities = np.zeros(6)
+        self._fixed_base = m.base.fixed
+        self._offsets = np.ascontiguousarray(offsets[self._active])
+        self._weights = np.ascontiguousarray(weights[self._active])
+        self.tension_values = np.ascontiguousarray(self._constant_tensions[self._active])
+        # Positions in tension_values of the cables evaluated per call.
+        where = {int(i): j for j, i in enumerate(self._active)}
+        self._kernel_tables = [(where[i], times, values) for i, times, values in self._tables]
+        self._kernel_others = [(where[i], c) for i, c in self._others]
+
+    def update_inputs(self, t, y=None):
+        """Evaluate the time-dependent inputs of the compiled kernel at t, in place.
+
+        Fills ``self.tension_values`` (the cables the kernel sees) and
+        ``self.base_velocities`` (v0, w0). ``y`` (storage layout) is only
+        read by feedback tensions.
+        """
+        tensions = self.tension_values
+        if self._feedback:
+            tensions[:] = self.model.tensions(t, StateView(self.layout, t, y))
+        else:
+            for j, times, values in self._kernel_tables:
+                tensions[j] = _interp(t, times, values)
+            for j, cable in self._kernel_others:
+                tensions[j] = cable.tension_at(t)
+        if not self._fixed_base:
+            v0, w0 = self.model.base.velocities(t)
+            self.base_velocities[:3], self.base_velocities[3:] = v0, w0
+
+    def kernel_arguments(self):
+        """Arguments of :func:`rodmol.kernels.rhs` after (y, out): the packed
+        model, the input arrays refreshed by :meth:`update_inputs`, scratch."""
+        return (self._params, self._consts, self._offsets, self._weights, self.tension_values,
+                self.base_velocities, self._work)
+
+    def _compiled(self, t, y, out=None):
+        if out is None:
+            out = np.empty(self.size)
+        self.update_inputs(t, y)
+        kernels.rhs(y, out, self._params, self._consts, self._offsets, self._weights,
+                    self.tension_values, self.base_velocities, self._work)
+        return out
+
+    def _reference(self, t, y, out=None):
         m, lay = self.model, self.layout
         out = np.empty(self.size) if out is None else out
         b = lay.blocks(y)
@@ -125,6 +259,17 @@ class SemiDiscrete:
         out[:3] = rotations.matrices(quat0) @ v0
         out[3:HEADER] = _quaternion_rate(quat0, w0)
         return out
+
+
+def _interp(t, times, values):
+    """np.interp(t, times, values) for a scalar t and knot lists (held outside the knots)."""
+    j = bisect_right(times, t)
+    if j == 0:
+        return values[0]
+    if j == len(times):
+        return values[-1]
+    t0, f0 = times[j - 1], values[j - 1]
+    return (values[j] - f0) / (times[j] - t0) * (t - t0) + f0
 
 
 def _prepend(row, rows):

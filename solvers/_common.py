@@ -1,0 +1,205 @@
+"""Shared helpers of the solver studies: command line, machine header, timing,
+output files (CSV + Markdown + PNG under ``solvers/results/``).
+
+Import this module before numpy: it pins OpenBLAS/MKL/OpenMP to one thread.
+Their worker threads spin for a while after each call (e.g. in the static
+equilibrium's banded solve), and on a 2-core machine they take the core the
+solver is timed on.
+"""
+
+import argparse
+import csv
+import datetime
+import os
+import platform
+import sys
+import time
+
+for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import matplotlib  # noqa: E402
+import matplotlib.ticker  # noqa: E402
+
+matplotlib.use("Agg")  # no display on the CI machine
+import matplotlib.pyplot as plt  # noqa: E402,F401  (re-exported for the scripts)
+import numpy as np  # noqa: E402
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.dirname(HERE))  # run from a checkout without installing
+
+import rodmol  # noqa: E402
+from rodmol.backends import cvode, rk23  # noqa: E402,F401
+from rodmol.semidiscrete import SemiDiscrete  # noqa: E402,F401
+from rodmol.simulate import default_atol  # noqa: E402,F401
+
+RESULTS = os.path.join(HERE, "results")
+
+
+def parse_args(description, argv=None):
+    """--quick (small sizes), --smoke (seconds, for the tests), --out DIR."""
+    parser = argparse.ArgumentParser(description=description)
+    mode = parser.add_mutually_exclusive_group()
+    mode.add_argument("--quick", action="store_true", help="smaller sizes, about a minute")
+    mode.add_argument("--smoke", action="store_true", help="tiny sizes, a few seconds (tests)")
+    parser.add_argument("--out", default=None,
+                        help="output directory (default solvers/results, or solvers/results/smoke)")
+    parser.add_argument("--reps", type=int, default=None, help="timed repetitions (median)")
+    args = parser.parse_args(argv)
+    args.mode = "smoke" if args.smoke else "quick" if args.quick else "full"
+    if args.out is None:
+        args.out = os.path.join(RESULTS, "smoke") if args.smoke else RESULTS
+    os.makedirs(args.out, exist_ok=True)
+    if args.reps is None:
+        args.reps = 1 if args.smoke else 3
+    return args
+
+
+def pick(args, full, quick, smoke):
+    """The value of a setting for the run mode."""
+    return {"full": full, "quick": quick, "smoke": smoke}[args.mode]
+
+
+def machine():
+    """CPU, cores and package versions, for the header of every output."""
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo") as f:
+            names = [line.split(":", 1)[1].strip() for line in f if line.startswith("model name")]
+        cpu = names[0] if names else cpu
+    except OSError:
+        pass
+    versions = {"python": platform.python_version(), "rodmol": rodmol.__version__}
+    for name in ("numpy", "scipy", "sksundae", "numba", "matplotlib"):
+        try:
+            versions[name] = __import__(name).__version__
+        except ImportError:
+            versions[name] = "not installed"
+    return dict(cpu=cpu, cores=os.cpu_count(), platform=platform.platform(),
+                date=datetime.datetime.now().isoformat(timespec="seconds"), versions=versions,
+                threads="OPENBLAS/MKL/OMP_NUM_THREADS=" + os.environ.get("OPENBLAS_NUM_THREADS", "?"))
+
+
+def header_lines(args, script):
+    m = machine()
+    return [f"script: solvers/{script} (mode: {args.mode})",
+            f"machine: {m['cpu']}, {m['cores']} cores, {m['platform']}",
+            "packages: " + ", ".join(f"{k} {v}" for k, v in m["versions"].items()),
+            f"{m['threads']}; date {m['date']}"]
+
+
+def write_csv(path, rows, header):
+    """rows: list of dicts (same keys); header lines go first as '# ...' comments."""
+    with open(path, "w", newline="") as f:
+        for line in header:
+            f.write(f"# {line}\n")
+        if rows:
+            writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+            writer.writeheader()
+            writer.writerows(rows)
+    return path
+
+
+def markdown_table(rows, columns=None, formats=None):
+    """A Markdown table of dict rows; ``formats`` maps a column to a format spec."""
+    if not rows:
+        return "(no rows)\n"
+    columns = columns or list(rows[0])
+    formats = formats or {}
+
+    def cell(row, c):
+        v = row.get(c, "")
+        if isinstance(v, float):
+            return format(v, formats.get(c, ".4g"))
+        return str(v)
+
+    lines = ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    lines += ["| " + " | ".join(cell(r, c) for c in columns) + " |" for r in rows]
+    return "\n".join(lines) + "\n"
+
+
+def write_markdown(path, title, header, sections):
+    """sections: list of (heading, text) pairs, text already Markdown."""
+    with open(path, "w") as f:
+        f.write(f"# {title}\n\n")
+        for line in header:
+            f.write(f"- {line}\n")
+        for heading, text in sections:
+            f.write(f"\n## {heading}\n\n{text}\n")
+    return path
+
+
+def n_axis(ax, sizes):
+    """Label a log N axis with the sizes themselves (no overlapping minor labels)."""
+    ax.set_xticks(list(sizes))
+    ax.set_xticklabels([str(int(n)) for n in sizes])
+    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+
+
+def save_figure(fig, path):
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def initial_state(model, t=0.0):
+    """The static equilibrium (the paper's start). From N ~ 800 on, the
+    equilibrium's default residual tolerance (1e-10 of the load scale) is
+    below its round-off floor, so retry at 1e-9."""
+    try:
+        return rodmol.equilibrium(model, t)
+    except rodmol.EquilibriumError:
+        return rodmol.equilibrium(model, t, tol=1e-9)
+
+
+def outputs(t_end, dt=0.01):
+    """Output times 0, dt, ..., t_end (as rodmol.simulate makes them)."""
+    n = int(np.floor(t_end / dt + 1e-9))
+    return np.unique(np.append(np.arange(n + 1) * dt, t_end))
+
+
+def tip(raw):
+    """(n_t, 3) time-integrated tip position u(L) of a raw solution [m]."""
+    return np.asarray(raw.y)[:, -19:-16]
+
+
+def run(backend, system, y0, t_out, rtol, **options):
+    """One integration; atol from rodmol's default_atol unless given."""
+    atol = options.pop("atol", None)
+    if atol is None:
+        atol = default_atol(system.model, rtol)
+    return backend(system, y0, t_out, rtol=rtol, atol=atol, **options)
+
+
+def timed(backend, system, y0, t_out, rtol, reps, **options):
+    """Median wall time [s] of ``reps`` runs (solver only, as in its stats) and the last run."""
+    walls, raw = [], None
+    for _ in range(max(1, reps)):
+        raw = run(backend, system, y0, t_out, rtol, **dict(options))
+        walls.append(raw.stats["wall_time_s"])
+    return float(np.median(walls)), raw
+
+
+def warm_up(system, y0, **options):
+    """Compile (or load) the kernels a configuration uses, outside the timings."""
+    t_out = np.array([0.0, 1e-3, 2e-3])
+    run(cvode, system, y0, t_out, 1e-6, **options)
+
+
+class Stopwatch:
+    def __enter__(self):
+        self.start = time.perf_counter()
+        return self
+
+    def __exit__(self, *exc):
+        self.seconds = time.perf_counter() - self.start
+
+
+def explicit_limits(model):
+    """The paper's explicit stability limits [s]: ds / sqrt(E / rho) and ds^2 / (3 mu / rho)."""
+    mat = model.rod.material
+    ds = model.ds
+    wave = ds / np.sqrt(mat.E / mat.rho)
+    viscous = ds**2 / (3.0 * mat.mu / mat.rho) if mat.mu > 0 else np.inf
+    return wave, viscous

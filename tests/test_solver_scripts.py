@@ -1,0 +1,33 @@
+"""The solver studies under solvers/ run end to end (tiny --smoke sizes) and
+write their CSV, Markdown and PNG outputs. Timings are not checked here."""
+
+import os
+import subprocess
+import sys
+
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCRIPTS = {
+    "scaling.py": ["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"],
+    "temporal.py": ["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv",
+                    "temporal_options.csv"],
+    "work_precision.py": ["work_precision.csv", "work_precision.md", "work_precision.png"],
+    "convergence.py": ["convergence.csv", "convergence.md", "convergence.png"],
+    "profile_rhs.py": ["profile_rhs.csv", "profile_rhs_calls.csv", "profile_rhs_ladder.csv", "profile_rhs.md",
+                       "profile_rhs.png"],
+}
+
+
+@pytest.mark.parametrize("script", sorted(SCRIPTS))
+def test_script_smoke_run(script, tmp_path):
+    proc = subprocess.run([sys.executable, os.path.join(ROOT, "solvers", script), "--smoke",
+                           "--out", str(tmp_path)], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-4000:]
+    for name in SCRIPTS[script]:
+        path = tmp_path / name
+        assert path.is_file() and path.stat().st_size > 0, name
+    markdown = next(name for name in SCRIPTS[script] if name.endswith(".md"))
+    with open(tmp_path / markdown) as f:
+        text = f.read()
+    assert "machine:" in text and "numba" in text  # the header names the machine and versions
