@@ -21,6 +21,9 @@ DEFAULT_RTOL = 1e-6
 LINEAR_SOLVERS = ("gmres", "band", "lapackband", "sparse", "dense")
 #: How the direct linear solvers get the Jacobian (see :func:`cvode`).
 JACOBIANS = ("compiled", "sundials")
+#: Failed right-hand-side evaluations after which CVODE gives up: it has
+#: then crept up to where the inputs fail and can go no further.
+MAX_RHS_FAILURES = 50
 #: From this many elements on, linsolver="auto" picks the preconditioned GMRES.
 GMRES_MIN_ELEMENTS = 50
 
@@ -143,9 +146,18 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, linsolver="auto", max
     out = _Outputs(t_out, y0, progress)
     evals = [0]  # counted here: CVODE's own counter leaves out the Jacobian's evaluations
 
+    failures = []  # (t, exception) raised by the right-hand side
+
     def rhs(t, y, yp):
         evals[0] += 1
-        system(t, y, yp)
+        try:
+            system(t, y, yp)
+        except Exception as exc:
+            # scikit-sundae would abort on an exception, throwing away a step that
+            # merely reached past the trouble: NaN rates make CVODE reject the
+            # trial step and retry shorter ones, so the run gets as close as it can.
+            failures.append((t, exc))
+            yp[:] = np.nan
 
     def stats():
         info = dict(steps=len(sizes), rhs_evals=evals[0], linear_solver=linsolver,
@@ -169,9 +181,14 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, linsolver="auto", max
             solver.init_step(float(t_out[0]), np.asarray(y0, dtype=float))
         while not out.done:
             r = solver.step(t_end, method="onestep", tstop=t_end)
-            if not r.success:
-                return out.solution(False, f"CVODE failed at t = {r.t:.6g} s: {r.message}",
-                                    **stats())
+            if not r.success or len(failures) > MAX_RHS_FAILURES:
+                reason = r.message
+                if failures:
+                    t_bad, exc = failures[-1]
+                    reason = f"{type(exc).__name__}: {exc} (at t = {t_bad:.6g} s)"
+                reached = out.t_out[out.next_index - 1]
+                return out.solution(False, f"CVODE failed after t = {reached:.6g} s (last output; "
+                                    f"the solver got to {r.t:.6g} s): {reason}", **stats())
             # After output times were interpolated inside the last step, CVODE's
             # next one-step call hands that step back again: count real steps only.
             if r.t > t_last:

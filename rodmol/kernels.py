@@ -33,6 +33,8 @@ Packing of the sampled model (built once by :func:`pack_model`):
   caller at every call (they are the only time-dependent inputs).
 """
 
+import contextlib
+
 import numpy as np
 
 try:  # numba is optional: the numpy reference path works without it
@@ -400,7 +402,11 @@ class CompiledJacobian:
 
     def evaluate(self, t, y, fy):
         """Evaluate the Jacobian blocks at (t, y), ``fy`` = f(t, y)."""
-        self.system.update_inputs(t, y)
+        # If the inputs fail here, the right-hand side has already met the failure
+        # and answered with NaN rates, so CVODE will retry a shorter step; the
+        # Jacobian is only an approximation and may use the last good inputs.
+        with contextlib.suppress(Exception):
+            self.system.update_inputs(t, y)
         jacobian_blocks(y, fy, self._scale, *self._args, self._ybuf, self._fbuf,
                         self._jb, self._jh)
 

@@ -100,7 +100,7 @@ def from_states(system, t, y, success, message, stats):
     w0 = np.array([b[1] for b in base]).reshape(n_t, 3)
     tensions = np.array([system.tensions(ti, yi) for ti, yi in zip(t, y)]).reshape(n_t, -1)
 
-    q_t, k_t, _, _ = system.balance(q, k, quat, v, w, v0, w0, tensions, model.gravity)
+    q_t, k_t = system.strain_rates(q, k, v, w, v0, w0)
     n_el, m_el, _, _ = system.stresses(q, k, q_t, k_t, tensions)
 
     # Tip node: the body carries minus the stress of the cables anchored at the tip.

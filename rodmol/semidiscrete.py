@@ -96,6 +96,18 @@ class SemiDiscrete:
                 m_tot += m_a
         return n_el, m_el, n_tot, m_tot
 
+    def strain_rates(self, q, k, v, w, v0, w0):
+        """Compatibility laws (eq. 2) with forward differences of v and w.
+
+        Returns (q_t, k_t) at the strain nodes, (..., N, 3), local frame.
+        """
+        ds = self.model.ds
+        v_str = _prepend(v0, v[..., :-1, :])  # velocities at strain nodes 0..N-1
+        w_str = _prepend(w0, w[..., :-1, :])
+        q_t = (v - v_str) / ds + loads.cross(k, v_str) - loads.cross(w_str, q)
+        k_t = (w - w_str) / ds + loads.cross(k, w_str)
+        return q_t, k_t
+
     def balance(self, q, k, quat, v, w, v0, w0, tensions, gravity):
         """Strain rates and the net force/torque densities at the velocity nodes.
 
@@ -106,10 +118,7 @@ class SemiDiscrete:
         """
         m = self.model
         ds = m.ds
-        v_str = _prepend(v0, v[..., :-1, :])  # velocities at strain nodes 0..N-1
-        w_str = _prepend(w0, w[..., :-1, :])
-        q_t = (v - v_str) / ds + loads.cross(k, v_str) - loads.cross(w_str, q)
-        k_t = (w - w_str) / ds + loads.cross(k, w_str)
+        q_t, k_t = self.strain_rates(q, k, v, w, v0, w0)
         _, _, n_tot, m_tot = self.stresses(q, k, q_t, k_t, tensions)
 
         # Values at velocity nodes 1..N; at the tip the total stress vanishes.

@@ -90,10 +90,7 @@ def simulate(model, t_end, *, initial="equilibrium", backend="cvode", rtol=DEFAU
     if atol is None:
         atol = default_atol(model, rtol)
     else:
-        atol = np.asarray(atol, dtype=float)
-        if atol.shape not in ((), (system.size,)) or not np.all(np.isfinite(atol)) or np.any(atol <= 0):
-            raise ParameterError(f"`atol` must be > 0, scalar or of length {system.size}, got {atol!r}")
-        atol = np.broadcast_to(atol, (system.size,)).copy()
+        atol = _state_sized("atol", atol, system.size, positive=True)
 
     n_out = int(np.floor(t_end / output_dt + 1e-9))
     t_out = np.unique(np.append(np.arange(n_out + 1) * output_dt, t_end))
@@ -112,7 +109,25 @@ def _initial_state(model, initial, size):
         if initial == "straight":
             return straight_state(model)
         raise ParameterError(f"unknown `initial` {initial!r}; use 'equilibrium', 'straight' or a state")
-    y0 = np.asarray(initial, dtype=float)
-    if y0.shape != (size,) or not np.all(np.isfinite(y0)):
-        raise ParameterError(f"`initial` state must be {size} finite numbers, got shape {y0.shape}")
-    return y0.copy()
+    return _state_sized("initial", initial, size)
+
+
+def _state_sized(name, value, size, positive=False):
+    """A finite float array of length ``size`` (a scalar is broadcast if ``positive``);
+    the error names the first bad entry, which numpy's summarised repr would hide."""
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(f"`{name}` must be numbers, got {value!r}") from None
+    if positive and arr.ndim == 0:
+        if not (np.isfinite(arr) and arr > 0):
+            raise ParameterError(f"`{name}` must be finite and > 0, got {float(arr)!r}")
+        arr = np.full(size, float(arr))
+    if arr.shape != (size,):
+        raise ParameterError(f"`{name}` must have length {size} (the state size), got shape {arr.shape}")
+    bad = ~np.isfinite(arr) | ((arr <= 0) if positive else False)
+    if np.any(bad):
+        i = int(np.flatnonzero(bad)[0])
+        need = "finite and > 0" if positive else "finite"
+        raise ParameterError(f"`{name}` entries must be {need}, got {float(arr[i])!r} at entry {i}")
+    return arr.copy()
