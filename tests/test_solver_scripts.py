@@ -14,6 +14,7 @@ SCRIPTS = {
                     "temporal_options.csv"],
     "work_precision.py": ["work_precision.csv", "work_precision.md", "work_precision.png"],
     "convergence.py": ["convergence.csv", "convergence.md", "convergence.png"],
+    "release.py": ["release.csv", "release.md"],
     "profile_rhs.py": ["profile_rhs.csv", "profile_rhs_calls.csv", "profile_rhs_ladder.csv", "profile_rhs.md",
                        "profile_rhs.png"],
 }
