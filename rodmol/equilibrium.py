@@ -17,7 +17,10 @@ from .model import Q_STAR, Model
 from .semidiscrete import SemiDiscrete
 
 _BLOCK = 10  # q (3), k (3), Q (4)
-_HALF_BAND = 2 * _BLOCK - 1
+# Half-bandwidths of the residual's Jacobian: the balance at node b+1 (rows 0-5
+# of block b) reads q, k of block b+1 (columns 0-5 of the next block); the
+# compatibility of Q_{b+1} (rows 6-9) reads Q_b (columns 6-9 of the block before).
+_LOWER, _UPPER = 9 - (6 - _BLOCK), (_BLOCK + 5) - 0
 
 
 def equilibrium(model, t=0.0, *, tol=1e-10, max_iter=40):
@@ -71,7 +74,7 @@ def equilibrium(model, t=0.0, *, tol=1e-10, max_iter=40):
         zb = z.reshape(n, _BLOCK)
         q, k, quat = zb[:, :3], zb[:, 3:6], zb[:, 6:]
         _, _, force, torque = system.balance(q, k, quat, zeros, zeros, zeros[0], zeros[0],
-                                             lam * tensions, lam * model.gravity)
+                                             lam * tensions, lam * model.gravity, (zeros, zeros))
         prev = np.vstack([quat0, quat[:-1]])
         compat = quat - rotations.multiply(prev, rotations.from_rotation_vector(model.ds * k))
         return np.hstack([force / f_scale, torque / scale, compat]).ravel()
@@ -99,7 +102,7 @@ def _newton(fun, z, tol, max_iter):
         if np.max(np.abs(f)) < tol:
             return z
         try:
-            dz = solve_banded((_HALF_BAND, _HALF_BAND), _banded_jacobian(fun, z, f), -f)
+            dz = solve_banded((_LOWER, _UPPER), _banded_jacobian(fun, z, f), -f)
         except (np.linalg.LinAlgError, ValueError):
             return None
         alpha = 1.0
@@ -119,7 +122,7 @@ def _newton(fun, z, tol, max_iter):
 def _banded_jacobian(fun, z, f0):
     """Finite-difference Jacobian in ``solve_banded`` storage, one group of
     columns per evaluation (columns further apart than the band never share rows)."""
-    lo = up = _HALF_BAND
+    lo, up = _LOWER, _UPPER
     width = lo + up + 1
     size = z.size
     ab = np.zeros((width, size))

@@ -108,17 +108,18 @@ class SemiDiscrete:
         k_t = (w - w_str) / ds + loads.cross(k, w_str)
         return q_t, k_t
 
-    def balance(self, q, k, quat, v, w, v0, w0, tensions, gravity):
+    def balance(self, q, k, quat, v, w, v0, w0, tensions, gravity, rates=None):
         """Strain rates and the net force/torque densities at the velocity nodes.
 
         Returns (q_t, k_t, force, torque), each (N, 3), local frame; the
         accelerations are force / mass and torque / inertia. Every argument
         may carry a leading time axis: fields (n_t, N, 3), base velocities
-        (n_t, 3), tensions (n_t, n_cables).
+        (n_t, 3), tensions (n_t, n_cables). ``rates`` = (q_t, k_t) skips
+        the compatibility laws when the strain rates are known (zero at rest).
         """
         m = self.model
         ds = m.ds
-        q_t, k_t = self.strain_rates(q, k, v, w, v0, w0)
+        q_t, k_t = self.strain_rates(q, k, v, w, v0, w0) if rates is None else rates
         _, _, n_tot, m_tot = self.stresses(q, k, q_t, k_t, tensions)
 
         # Values at velocity nodes 1..N; at the tip the total stress vanishes.
