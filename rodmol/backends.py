@@ -15,7 +15,7 @@ from scipy import sparse
 from scipy.integrate import RK23
 
 from .errors import ParameterError
-from .kernels import BlockPreconditioner, CompiledJacobian
+from .jacobian import BlockPreconditioner, CompiledJacobian
 
 DEFAULT_RTOL = 1e-6
 LINEAR_SOLVERS = ("gmres", "band", "lapackband", "sparse", "dense")
@@ -71,7 +71,7 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, linsolver="auto", max
     ``linsolver`` is how the Newton systems (I - gamma J) x = r are solved:
 
     * ``"gmres"``: GMRES preconditioned by an exact O(N) solve of the
-      structured Newton matrix (:class:`rodmol.kernels.BlockPreconditioner`),
+      structured Newton matrix (:class:`rodmol.jacobian.BlockPreconditioner`),
       so it converges in one or two iterations; needs the numba kernel;
     * ``"band"``: SUNDIALS' band LU of the full system (half-bandwidths 24);
     * ``"lapackband"``, ``"sparse"`` (SuperLU_MT on the structural pattern),
@@ -87,7 +87,7 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, linsolver="auto", max
     * ``"sundials"``: SUNDIALS' own finite differences for the band and dense
       solvers (one Python call of the right-hand side per column group, 49
       for the band), scikit-sundae's coloured differences for ``"sparse"``;
-    * ``"compiled"``: :class:`rodmol.kernels.CompiledJacobian`, finite
+    * ``"compiled"``: :class:`rodmol.jacobian.CompiledJacobian`, finite
       differences inside numba with a colouring of the true structure (34
       kernel evaluations whatever N, no Python calls), handed over as
       ``jacfn`` (needs the numba kernel);

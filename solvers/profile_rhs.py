@@ -22,7 +22,7 @@ import time
 import _common as C
 from _common import np, plt, rodmol
 
-from rodmol import kernels
+from rodmol import jacobian, kernels
 
 SCRIPT = "profile_rhs.py"
 
@@ -44,10 +44,10 @@ def per_call(fn, reps):
 # cProfile entries (file suffix, function name) -> group
 GROUPS = [
     (("kernels.py", "rhs"), "kernel: right-hand side"),
-    (("kernels.py", "jacobian_blocks"), "kernel: Jacobian"),
-    (("kernels.py", "fill_band"), "kernel: Jacobian"),
-    (("kernels.py", "block_setup"), "kernel: preconditioner setup"),
-    (("kernels.py", "block_solve"), "kernel: preconditioner solve"),
+    (("jacobian.py", "jacobian_blocks"), "kernel: Jacobian"),
+    (("jacobian.py", "fill_band"), "kernel: Jacobian"),
+    (("jacobian.py", "block_setup"), "kernel: preconditioner setup"),
+    (("jacobian.py", "block_solve"), "kernel: preconditioner solve"),
     (("_solver.py", "step"), "CVODE (C) + scikit-sundae wrappers"),
 ]
 
@@ -84,7 +84,7 @@ def main(argv=None):
     fast.update_inputs(0.3, y)
     karg = fast.kernel_arguments()
     atol = C.default_atol(model, 1e-6)
-    pre = kernels.BlockPreconditioner(fast, atol / 1e-6)
+    pre = jacobian.BlockPreconditioner(fast, atol / 1e-6)
     fy = fast(0.3, y)
     pre.setup(0.3, y, fy, False, [0], 1e-3)
     z = np.empty_like(y)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import rodmol
-from rodmol import kernels
+from rodmol import jacobian, kernels
 from rodmol.arm import paper_rod
 from rodmol.backends import cvode, rk23
 from rodmol.errors import ParameterError
@@ -134,12 +134,12 @@ def test_compiled_jacobian_matches_finite_differences(name):
     scale = default_atol(model, 1.0)
     expected = _fd_jacobian(ref, 0.4, y, scale)
     for matrix in ("band", "dense", "sparse"):
-        got = kernels.CompiledJacobian(system, scale, matrix).dense(0.4, y)
+        got = jacobian.CompiledJacobian(system, scale, matrix).dense(0.4, y)
         # One-sided differences (the solver's) against central ones.
         assert np.max(np.abs(got - expected)) <= 1e-5 * np.max(np.abs(expected)), matrix
     # The sparse structure is layout.pattern(), and nothing lies outside it.
     pattern = system.layout.pattern()
-    sparsity = kernels.CompiledJacobian(system, scale, "sparse").sparsity.toarray() != 0
+    sparsity = jacobian.CompiledJacobian(system, scale, "sparse").sparsity.toarray() != 0
     np.testing.assert_array_equal(sparsity, pattern)
     assert np.all(expected[~pattern] == 0.0)
 
@@ -149,7 +149,7 @@ def test_block_preconditioner_solves_the_newton_matrix(gamma):
     model = MODELS["water, three cables held"]
     system = SemiDiscrete(model)
     y = _random_state(model, np.random.default_rng(11), scale=0.3)
-    pre = kernels.BlockPreconditioner(system, default_atol(model, 1.0))
+    pre = jacobian.BlockPreconditioner(system, default_atol(model, 1.0))
     jnew = [0]
     pre.setup(0.7, y, system(0.7, y), False, jnew, gamma)
     assert jnew == [1] and pre.jac_evals == 1
