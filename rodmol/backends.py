@@ -73,7 +73,7 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, linsolver="auto", max
     * ``"gmres"``: GMRES preconditioned by an exact O(N) solve of the
       structured Newton matrix (:class:`rodmol.jacobian.BlockPreconditioner`),
       so it converges in one or two iterations; needs the numba kernel;
-    * ``"band"``: SUNDIALS' band LU of the full system (half-bandwidths 24);
+    * ``"band"``: SUNDIALS' band LU of the full system (half-bandwidths 21);
     * ``"lapackband"``, ``"sparse"`` (SuperLU_MT on the structural pattern),
       ``"dense"`` (small systems only);
     * ``"auto"``: "gmres" with the numba kernel from ``GMRES_MIN_ELEMENTS``
@@ -85,7 +85,7 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, linsolver="auto", max
     ``jacobian`` chooses how the direct solvers get J:
 
     * ``"sundials"``: SUNDIALS' own finite differences for the band and dense
-      solvers (one Python call of the right-hand side per column group, 49
+      solvers (one Python call of the right-hand side per column group, 43
       for the band), scikit-sundae's coloured differences for ``"sparse"``;
     * ``"compiled"``: :class:`rodmol.jacobian.CompiledJacobian`, finite
       differences inside numba with a colouring of the true structure (34

@@ -32,7 +32,7 @@ def jacobian_blocks(y, f0, scale, params, consts, offsets, weights, tensions, ba
     perturbed together when they touch disjoint rows (a colouring of the
     structure: nothing depends on u; Q reaches only its own element; q, k
     reach elements b - 1, b; v, w reach b - 1, b, b + 1), so the whole
-    Jacobian costs 4 + 2*6 + 3*6 = 34 evaluations, whatever N, against 49
+    Jacobian costs 4 + 2*6 + 3*6 = 34 evaluations, whatever N, against 43
     for a band colouring. The increments follow SUNDIALS: sqrt(eps)
     max(|y_j|, scale_j). Feedback tensions are held fixed (their coupling is
     global). Entries the structure never reaches (u columns, Q beyond its
@@ -220,7 +220,7 @@ def _sparse_structure(n, size):
 # local solves; substituting them leaves a block-tridiagonal system in the
 # Z = (v, w) unknowns alone, with 6x6 blocks, solved by block elimination
 # (block Thomas); U follows last. Against the band LU of the full 19-per-
-# element system (half-bandwidths 24), this is ~10x fewer operations per
+# element system (half-bandwidths 21), this is ~10x fewer operations per
 # solve and ~4x less memory (which stays in cache), so it is what CVODE's
 # Newton iterations use, through scikit-sundae's GMRES with this solve as
 # an exact preconditioner (scikit-sundae accepts no custom direct solver).
