@@ -8,11 +8,13 @@ A tension input is any of
 * a path to a CSV file with two columns, time [s] and tension [N]
   (an optional header line; ``#`` starts a comment), as logged by a rig;
 * a callable ``T(t)``;
-* a callable ``T(t, state)`` (feedback): ``state`` is a :class:`rodmol.StateView`.
-  Its dependence on the state is *not* part of the banded Jacobian the implicit
-  solver builds (the coupling is global), so strong feedback gains converge
-  more slowly; the result stays correct because CVODE only needs an
-  approximate Jacobian.
+* a callable ``T(t, state)`` (feedback): ``state`` is a :class:`rodmol.StateView`
+  (``None`` while the initial equilibrium is solved). Its dependence on the
+  state is global, so it is not in the banded Jacobian; CVODE's default
+  linear solver for such models is therefore GMRES, whose Jacobian-vector
+  products are differences of the full right-hand side and do carry it
+  (with ``linsolver="band"`` a strong gain costs many small steps, though
+  the result stays correct).
 """
 
 import csv

@@ -13,7 +13,7 @@ from bisect import bisect_right
 
 import numpy as np
 
-from . import kernels, loads, rotations
+from . import centreline, kernels, loads, rotations
 from .cables import ConstantTension, PiecewiseLinearTension
 from .errors import ParameterError
 from .layout import FIELDS, HEADER, StateLayout
@@ -30,25 +30,27 @@ QUATERNION_RESTORING_RATE = 1.0
 class StateView:
     """Read-only view of a state vector, handed to feedback tensions.
 
-    Attributes are computed on first access: ``t`` [s], ``positions`` (N+1, 3)
-    [m] global, ``rotations`` (N+1, 3, 3), ``q``, ``k``, ``v``, ``w`` (N, 3)
-    local, ``tip`` (3,) [m].
+    Attributes are computed on access: ``t`` [s], ``positions`` (N+1, 3) [m]
+    global (rebuilt from the strains, as ``Result.positions``), ``tip`` (3,)
+    [m], ``rotations`` (N+1, 3, 3), ``q``, ``k``, ``v``, ``w`` (N, 3) local.
     """
 
-    def __init__(self, layout, t, y):
-        self.t, self._layout, self._y = t, layout, y
+    def __init__(self, layout, t, y, ds):
+        self.t, self._layout, self._y, self._ds = t, layout, y, ds
 
     def __getattr__(self, name):
         if name in ("q", "k", "v", "w"):
             return self._layout.field(self._y, name)
-        if name == "positions":
-            return np.vstack([self._y[:3], self._layout.field(self._y, "u")])
         if name == "rotations":
-            quat = np.vstack([self._y[3:7], self._layout.field(self._y, "Q")])
-            return rotations.matrices(quat)
+            return rotations.matrices(self._quaternions())
+        if name == "positions":
+            return centreline.positions(self._y[:3], self._quaternions(), self.q, self.k, self._ds)
         if name == "tip":
-            return self._layout.field(self._y, "u")[-1]
+            return self.positions[-1]
         raise AttributeError(name)
+
+    def _quaternions(self):
+        return np.vstack([self._y[3:7], self._layout.field(self._y, "Q")])
 
 
 class SemiDiscrete:
@@ -144,7 +146,7 @@ class SemiDiscrete:
     def tensions(self, t, y):
         """Tensions of all cables at (t, y), shape (n_cables,) [N]."""
         if self._feedback:
-            return self.model.tensions(t, StateView(self.layout, t, y))
+            return self.model.tensions(t, StateView(self.layout, t, y, self.model.ds))
         full = self._constant_tensions.copy()
         for i, times, values in self._tables:
             full[i] = _interp(t, times, values)
@@ -226,7 +228,7 @@ class SemiDiscrete:
         """
         tensions = self.tension_values
         if self._feedback:
-            tensions[:] = self.model.tensions(t, StateView(self.layout, t, y))
+            tensions[:] = self.model.tensions(t, StateView(self.layout, t, y, self.model.ds))
         else:
             for j, times, values in self._kernel_tables:
                 tensions[j] = _interp(t, times, values)
