@@ -56,12 +56,27 @@ class Result:
         ``backend``.
     """
 
-    def __init__(self, arrays, success=True, message="", stats=None, meta=None):
-        for name in ARRAYS:
-            setattr(self, name, np.asarray(arrays[name]))
+    def __init__(self, arrays, success=True, message="", stats=None, meta=None, deferred=None):
+        for name, value in arrays.items():
+            setattr(self, name, np.asarray(value))
+        # Arrays derived from the states are computed on first access:
+        # name -> function returning a dict of arrays (a group computed together).
+        self._deferred = dict(deferred or {})
+        missing = set(ARRAYS) - set(arrays) - set(self._deferred)
+        if missing:
+            raise ValueError(f"Result lacks the arrays {sorted(missing)}")
         self.success, self.message = bool(success), str(message)
         self.stats = dict(stats or {})
         self.meta = dict(meta or {})
+
+    def __getattr__(self, name):
+        deferred = self.__dict__.get("_deferred", {})
+        if name not in deferred:
+            raise AttributeError(f"'Result' object has no attribute {name!r}")
+        for key, value in deferred[name]().items():
+            setattr(self, key, value)
+            deferred.pop(key, None)
+        return self.__dict__[name]
 
     def __repr__(self):
         return (f"Result(n_t={len(self.t)}, t_end={self.t[-1] if len(self.t) else None} s, "
@@ -89,8 +104,21 @@ def load_result(path):
     return Result(arrays, info["success"], info["message"], info["stats"], info.get("meta"))
 
 
+#: The arrays each deferred group of :func:`from_states` computes.
+_GROUPS = {
+    "mechanics": ("linear_strain", "curvature", "velocity", "angular_velocity", "internal_force",
+                  "internal_moment"),
+    "pose": ("positions", "rotations", "integrated_positions", "markers"),
+}
+
+
 def from_states(system, t, y, success, message, stats):
-    """Build a :class:`Result` from raw states ``y`` (n_t, size) of ``system``."""
+    """Build a :class:`Result` from raw states ``y`` (n_t, size) of ``system``.
+
+    Times, tensions and the quaternion drift are filled at once; the strains,
+    stresses and poses of every frame are computed on first access (most runs
+    need only a few of them, and they cost about half the integration).
+    """
     model = system.model
     n_t, n = len(t), model.n_elements
     blocks = y[:, HEADER:].reshape(n_t, n, -1)
@@ -100,40 +128,47 @@ def from_states(system, t, y, success, message, stats):
     w0 = np.array([b[1] for b in base]).reshape(n_t, 3)
     tensions = np.array([system.tensions(ti, yi) for ti, yi in zip(t, y)]).reshape(n_t, -1)
 
-    q_t, k_t = system.strain_rates(q, k, v, w, v0, w0)
-    n_el, m_el, _, _ = system.stresses(q, k, q_t, k_t, tensions)
 
-    # Tip node: the body carries minus the stress of the cables anchored at the tip.
-    tip_cables = model.cable_weights[:, -1] == 1.0 if model.cables else np.zeros(0, bool)
-    n_tip, m_tip = np.zeros((n_t, 3)), np.zeros((n_t, 3))
-    if np.any(tip_cables):
-        _, _, n_tot, m_tot = system.stresses(q[:, -1:], k[:, -1:], 0 * q[:, -1:], 0 * k[:, -1:],
-                                             tensions * tip_cables)
-        n_tip, m_tip = -n_tot[:, 0], -m_tot[:, 0]
-    kl_tip, kth_tip = model.rod.stiffness(model.rod.length)
-    q_tip = Q_STAR + n_tip / kl_tip
-    k_tip = m_tip / kth_tip
+    def mechanics():
+        """Strains, velocities and stresses at all nodes (node N: the tip)."""
+        q_t, k_t = system.strain_rates(q, k, v, w, v0, w0)
+        n_el, m_el, _, _ = system.stresses(q, k, q_t, k_t, tensions)
+        # Tip node: the body carries minus the stress of the cables anchored at the tip.
+        tip_cables = model.cable_weights[:, -1] == 1.0 if model.cables else np.zeros(0, bool)
+        n_tip, m_tip = np.zeros((n_t, 3)), np.zeros((n_t, 3))
+        if np.any(tip_cables):
+            _, _, n_tot, m_tot = system.stresses(q[:, -1:], k[:, -1:], 0 * q[:, -1:], 0 * k[:, -1:],
+                                                 tensions * tip_cables)
+            n_tip, m_tip = -n_tot[:, 0], -m_tot[:, 0]
+        kl_tip, kth_tip = model.rod.stiffness(model.rod.length)
+        return dict(
+            linear_strain=np.concatenate([q, (Q_STAR + n_tip / kl_tip)[:, None]], axis=1),
+            curvature=np.concatenate([k, (m_tip / kth_tip)[:, None]], axis=1),
+            velocity=np.concatenate([v0[:, None], v], axis=1),
+            angular_velocity=np.concatenate([w0[:, None], w], axis=1),
+            internal_force=np.concatenate([n_el, n_tip[:, None]], axis=1),
+            internal_moment=np.concatenate([m_el, m_tip[:, None]], axis=1),
+        )
+
+    def pose():
+        """Positions rebuilt from the strains, rotations, markers, integrated positions."""
+        positions = centreline.positions(y[:, :3], quat_all, q, k, model.ds)
+        rots = rotations.matrices(quat_all)
+        return dict(
+            positions=positions, rotations=rots,
+            integrated_positions=np.concatenate([y[:, None, :3], blocks[..., FIELDS["u"]]], axis=1),
+            markers=markers.track(model.markers, model.marker_offsets, model.s_nodes, positions, rots),
+        )
 
     quat_all = np.concatenate([y[:, None, 3:7], quat], axis=1)
-    positions = centreline.positions(y[:, :3], quat_all, q, k, model.ds)
-    rots = rotations.matrices(quat_all)
     arrays = dict(
-        t=t, s=model.s_nodes, radius=model.rod.radius_at(model.s_nodes),
-        positions=positions, rotations=rots,
-        integrated_positions=np.concatenate([y[:, None, :3], blocks[..., FIELDS["u"]]], axis=1),
-        markers=markers.track(model.markers, model.marker_offsets, model.s_nodes, positions, rots),
-        linear_strain=np.concatenate([q, q_tip[:, None]], axis=1),
-        curvature=np.concatenate([k, k_tip[:, None]], axis=1),
-        velocity=np.concatenate([v0[:, None], v], axis=1),
-        angular_velocity=np.concatenate([w0[:, None], w], axis=1),
-        internal_force=np.concatenate([n_el, n_tip[:, None]], axis=1),
-        internal_moment=np.concatenate([m_el, m_tip[:, None]], axis=1),
-        tensions=tensions,
+        t=t, s=model.s_nodes, radius=model.rod.radius_at(model.s_nodes), tensions=tensions,
         quaternion_norm_error=np.max(np.abs(np.linalg.norm(quat_all, axis=-1) - 1.0), axis=-1),
     )
+    deferred = {name: group for group in (mechanics, pose) for name in _GROUPS[group.__name__]}
     meta = dict(n_elements=n, length=model.rod.length,
                 cables=[dict(name=c.name, offset=list(c.offset), anchor=c.anchor)
                         for c in model.cables],
                 markers=[dict(name=mk.name, s=mk.s, offset=list(model.marker_offsets[i, 1:]))
                          for i, mk in enumerate(model.markers)])
-    return Result(arrays, success, message, stats, meta)
+    return Result(arrays, success, message, stats, meta, deferred)
