@@ -21,6 +21,7 @@ import csv
 import inspect
 import math
 import os
+from bisect import bisect_right
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -56,8 +57,21 @@ class PiecewiseLinearTension(Tension):
     values: np.ndarray
     source: str = "knots"
 
+    def __post_init__(self):
+        # Plain lists and bisect: called at every right-hand side evaluation with
+        # a scalar t, where np.interp's array overhead would dominate.
+        object.__setattr__(self, "_t", [float(x) for x in self.times])
+        object.__setattr__(self, "_v", [float(x) for x in self.values])
+
     def __call__(self, t, state=None):
-        return float(np.interp(t, self.times, self.values))
+        times, values = self._t, self._v
+        j = bisect_right(times, t)
+        if j == 0:
+            return values[0]
+        if j == len(times):
+            return values[-1]
+        t0, v0 = times[j - 1], values[j - 1]
+        return v0 + (values[j] - v0) * (t - t0) / (times[j] - t0)
 
 
 @dataclass(frozen=True)

@@ -9,12 +9,11 @@ by numba (:mod:`rodmol.kernels`), which is what the time integrators call.
 """
 
 import warnings
-from bisect import bisect_right
 
 import numpy as np
 
 from . import centreline, kernels, loads, rotations
-from .cables import ConstantTension, PiecewiseLinearTension
+from .cables import ConstantTension
 from .errors import ParameterError
 from .layout import FIELDS, HEADER, StateLayout
 from .model import Q_STAR
@@ -148,8 +147,6 @@ class SemiDiscrete:
         if self._feedback:
             return self.model.tensions(t, StateView(self.layout, t, y, self.model.ds))
         full = self._constant_tensions.copy()
-        for i, times, values in self._tables:
-            full[i] = _interp(t, times, values)
         for i, cable in self._others:
             full[i] = cable.tension_at(t)
         return full
@@ -157,26 +154,19 @@ class SemiDiscrete:
     def _classify_cables(self):
         """Sort the cables by how their tension is evaluated, once.
 
-        The right-hand side needs the tensions at every call, and going
-        through ``Model.tensions`` (one ``Cable.tension_at`` per cable, a
-        ``np.interp`` per table) costs more than the compiled kernel itself.
-        Constant tensions are read once (slack cables are dropped from the
-        kernel), tables are interpolated with ``bisect`` (same formula as
-        ``np.interp``), and only other callables are called each time,
-        through ``Cable.tension_at``, which checks their values. Feedback
+        The right-hand side needs the tensions at every call: constant
+        tensions are read once here (slack cables are dropped from the kernel)
+        and only the time-dependent ones are called each time. Feedback
         tensions read the state, so then every cable goes the general way.
         """
         cables = self.model.cables
         self._constant_tensions = np.zeros(len(cables))
-        self._tables, self._others, active = [], [], []
+        self._others, active = [], []
         for i, c in enumerate(cables):
-            kind = c.tension
-            if isinstance(kind, ConstantTension):
-                self._constant_tensions[i] = kind.value
-                if kind.value == 0.0:
+            if isinstance(c.tension, ConstantTension):
+                self._constant_tensions[i] = c.tension.value
+                if c.tension.value == 0.0:
                     continue
-            elif isinstance(kind, PiecewiseLinearTension):
-                self._tables.append((i, list(kind.times), list(kind.values)))
             else:
                 self._others.append((i, c))
             active.append(i)
@@ -216,7 +206,6 @@ class SemiDiscrete:
         self.tension_values = np.ascontiguousarray(self._constant_tensions[self._active])
         # Positions in tension_values of the cables evaluated per call.
         where = {int(i): j for j, i in enumerate(self._active)}
-        self._kernel_tables = [(where[i], times, values) for i, times, values in self._tables]
         self._kernel_others = [(where[i], c) for i, c in self._others]
 
     def update_inputs(self, t, y=None):
@@ -230,8 +219,6 @@ class SemiDiscrete:
         if self._feedback:
             tensions[:] = self.model.tensions(t, StateView(self.layout, t, y, self.model.ds))
         else:
-            for j, times, values in self._kernel_tables:
-                tensions[j] = _interp(t, times, values)
             for j, cable in self._kernel_others:
                 tensions[j] = cable.tension_at(t)
         if not self._fixed_base:
@@ -271,17 +258,6 @@ class SemiDiscrete:
         out[:3] = rotations.matrices(quat0) @ v0
         out[3:HEADER] = _quaternion_rate(quat0, w0)
         return out
-
-
-def _interp(t, times, values):
-    """np.interp(t, times, values) for a scalar t and knot lists (held outside the knots)."""
-    j = bisect_right(times, t)
-    if j == 0:
-        return values[0]
-    if j == len(times):
-        return values[-1]
-    t0, f0 = times[j - 1], values[j - 1]
-    return (values[j] - f0) / (times[j] - t0) * (t - t0) + f0
 
 
 def _prepend(row, rows):
