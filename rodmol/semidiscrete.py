@@ -182,9 +182,7 @@ class SemiDiscrete:
     def rates(self, t, states):
         """dy/dt at each of the frames ``states`` (n_t, size) at times ``t`` (n_t,).
 
-        With the numba kernel this costs a few microseconds per frame, so
-        post-processing can take the strain rates (fields q, k of the rates)
-        from here instead of re-evaluating :meth:`balance` on whole series.
+        With the numba kernel this costs a few microseconds per frame.
         """
         states = np.asarray(states, dtype=float)
         out = np.empty_like(states)
