@@ -1,20 +1,12 @@
-"""Compiled (numba) right-hand side, Jacobian and Newton solver of the semi-discrete system.
+"""Compiled (numba) right-hand side of the semi-discrete system.
 
 :class:`rodmol.semidiscrete.SemiDiscrete` keeps the vectorised numpy code as
 the reference (``balance``/``stresses``, also used for post-processing with a
 leading time axis); :func:`rhs` computes the same ``dy/dt`` in two loops over
 the nodes, with no temporary arrays, which is what an implicit solver calling
 it thousands of times needs. ``tests/test_kernels.py`` checks that both agree
-to round-off. On top of it:
-
-* :func:`jacobian_blocks` / :class:`CompiledJacobian`: the Jacobian by
-  finite differences inside numba, coloured by the structure of the scheme
-  (34 evaluations whatever N), as element blocks or as a scikit-sundae
-  ``jacfn`` for its band, dense and sparse solvers;
-* :func:`block_setup`, :func:`block_solve` / :class:`BlockPreconditioner`:
-  an exact O(N) solve of CVODE's Newton matrix I - gamma J that exploits the
-  block structure, used as the preconditioner of CVODE's GMRES (the default
-  linear solver from 50 elements on, see ``rodmol.backends.cvode``).
+to round-off. The compiled Jacobian and the block preconditioner of CVODE's
+Newton systems built on it are in :mod:`rodmol.jacobian`.
 
 numba is an optional-but-default dependency: without it, :data:`AVAILABLE` is
 False, ``SemiDiscrete`` falls back to the numpy path with a warning and CVODE

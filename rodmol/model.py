@@ -139,11 +139,9 @@ class Model:
 
     def load_scale(self, t=0.0):
         """A force scale [N] of the applied loads: net weight plus cable tensions."""
-        weight = abs(self.rod.material.rho - self.medium.rho) * np.linalg.norm(self.gravity)
-        x, w = np.polynomial.legendre.leggauss(64)
-        s = 0.5 * self.rod.length * (x + 1.0)
-        total = 0.5 * self.rod.length * np.sum(w * weight * self.rod.area(s))
-        return total + float(np.sum(self.tensions(t))) if self.cables else total
+        net_density = abs(self.rod.material.rho - self.medium.rho)
+        weight = net_density * np.linalg.norm(self.gravity) * self.rod.volume()
+        return weight + float(np.sum(self.tensions(t))) if self.cables else weight
 
 
 def _medium(medium, medium_density):

@@ -94,8 +94,12 @@ class Rod:
         vth = mu * self.second_moments(s) * np.array([1.0, 3.0, 3.0])
         return vl, vth
 
-    def mass(self):
-        """Total mass [kg], by Gauss-Legendre quadrature of rho A(s)."""
+    def volume(self):
+        """Volume [m^3], by Gauss-Legendre quadrature of A(s)."""
         x, w = np.polynomial.legendre.leggauss(64)
         s = 0.5 * self.length * (x + 1.0)
-        return 0.5 * self.length * np.sum(w * self.material.rho * self.area(s))
+        return 0.5 * self.length * np.sum(w * self.area(s))
+
+    def mass(self):
+        """Mass [kg]."""
+        return self.material.rho * self.volume()

@@ -29,9 +29,8 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))  # run from a checkout without installing
 
 import rodmol  # noqa: E402
-from rodmol import centreline  # noqa: E402
 from rodmol.backends import cvode, rk23  # noqa: E402,F401
-from rodmol.layout import FIELDS  # noqa: E402
+from rodmol.result import from_states  # noqa: E402
 from rodmol.semidiscrete import SemiDiscrete  # noqa: E402,F401
 from rodmol.simulate import default_atol  # noqa: E402,F401
 
@@ -165,13 +164,9 @@ def tip(raw, model=None):
     """(n_t, 3) tip position [m] of a raw solution: rebuilt from the strains if
     ``model`` is given (as ``Result.tip``; use it to compare grids), else the
     time-integrated u(L), which is cheaper and fine on one grid."""
-    y = np.asarray(raw.y)
     if model is None:
-        return y[:, -19:-16]
-    blocks = y[:, 7:].reshape(len(y), model.n_elements, -1)
-    quat = np.concatenate([y[:, None, 3:7], blocks[..., FIELDS["Q"]]], axis=1)
-    q, k = blocks[..., FIELDS["q"]], blocks[..., FIELDS["k"]]
-    return centreline.positions(y[:, :3], quat, q, k, model.ds)[:, -1]
+        return np.asarray(raw.y)[:, -19:-16]
+    return from_states(SemiDiscrete(model), raw.t, np.asarray(raw.y), True, "", {}).tip
 
 
 def run(backend, system, y0, t_out, rtol, **options):
