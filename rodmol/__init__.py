@@ -2,32 +2,39 @@
 
 Implements and extends Renda et al., "Dynamic Model of a Multibending Soft
 Robot Arm Driven by Cables", IEEE T-RO 30(5), 2014. SI units throughout.
+
+The package follows the data flow. The user's nouns are flat at the top:
+parameters, rod, cables, base motion, loads, markers, model, simulate,
+result, analysis. The machinery sits in folders: ``discretise/`` (state
+layout, the compiled physics and the semi-discrete scheme, its Jacobian),
+``solve/`` (static equilibrium and the time-integration backends) and
+``io/`` (scenario files, ParaView series, pictures, command line).
 """
 
 from . import scenarios
 from .analysis import energy, marker_errors
 from .arm import paper_arm
-from .backends import BACKENDS
-from .base import Base
+from .base_motion import Base, BaseMotion
 from .cables import Cable, read_tension_csv
-from .equilibrium import equilibrium
+from .discretise.layout import StateLayout
+from .discretise.system import SemiDiscrete, StateView
 from .errors import EquilibriumError, IntegrationError, ParameterError, RodmolError
-from .layout import StateLayout
+from .io.scenario_file import ScenarioError, load_scenario
+from .io.writers import write_series
 from .markers import Marker
 from .model import Model
 from .parameters import MEDIA, Material, Medium
 from .result import Result, load_result
 from .rod import Rod
-from .scenario_file import ScenarioError, load_scenario
-from .semidiscrete import SemiDiscrete, StateView
 from .simulate import default_atol, simulate, straight_state
-from .writers import write_series
+from .solve.backends import BACKENDS
+from .solve.equilibrium import equilibrium
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "BACKENDS", "Base", "Cable", "EquilibriumError", "IntegrationError", "MEDIA", "Marker",
-    "Material", "Medium", "Model", "ParameterError", "Result", "Rod", "RodmolError",
+    "BACKENDS", "Base", "BaseMotion", "Cable", "EquilibriumError", "IntegrationError", "MEDIA",
+    "Marker", "Material", "Medium", "Model", "ParameterError", "Result", "Rod", "RodmolError",
     "ScenarioError", "SemiDiscrete", "StateLayout", "StateView", "default_atol", "energy",
     "equilibrium", "load_result", "load_scenario", "marker_errors", "paper_arm",
     "read_tension_csv", "scenarios", "simulate", "straight_state", "write_series",

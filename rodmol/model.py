@@ -10,7 +10,7 @@ prescribed velocities, the tip (node N) a vanishing total stress.
 import numpy as np
 
 from . import _checks
-from .base import Base
+from .base_motion import BaseMotion
 from .cables import Cable
 from .errors import ParameterError
 from .markers import Marker, marker_offsets
@@ -61,9 +61,9 @@ class Model:
         for i, c in enumerate(self.cables):
             if not isinstance(c, Cable):
                 raise ParameterError(f"`cables[{i}]` must be a rodmol.Cable, got {c!r}")
-        self.base = Base() if base is None else base
-        if not isinstance(self.base, Base):
-            raise ParameterError(f"`base` must be a rodmol.Base or None, got {base!r}")
+        self.base = BaseMotion() if base is None else base
+        if not isinstance(self.base, BaseMotion):
+            raise ParameterError(f"`base` must be a rodmol.BaseMotion or None, got {base!r}")
         self.drag, self.added_mass = bool(drag), bool(added_mass)
         self.viscosity, self.munk_moment = bool(viscosity), bool(munk_moment)
         self._check_cables()

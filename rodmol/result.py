@@ -5,8 +5,10 @@ import os
 
 import numpy as np
 
-from . import centreline, markers, rotations
-from .layout import FIELDS, HEADER
+from .discretise import centreline, rotations
+
+from . import markers
+from .discretise.layout import FIELDS, HEADER
 from .model import Q_STAR
 
 #: Arrays of a Result, with their units (also the keys of the .npz file).

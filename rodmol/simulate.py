@@ -4,14 +4,16 @@ import warnings
 
 import numpy as np
 
-from . import _checks, rotations
-from .backends import DEFAULT_RTOL, get_backend
-from .equilibrium import equilibrium
+from . import _checks
+
+from .discretise import rotations
+from .solve.backends import DEFAULT_RTOL, get_backend
+from .solve.equilibrium import equilibrium
 from .errors import ParameterError
-from .layout import FIELDS
+from .discretise.layout import FIELDS
 from .model import Model
 from .result import from_states
-from .semidiscrete import SemiDiscrete
+from .discretise.system import SemiDiscrete
 
 
 def default_atol(model, rtol):

@@ -22,7 +22,8 @@ import time
 import _common as C
 from _common import np, plt, rodmol
 
-from rodmol import jacobian, kernels
+from rodmol.discretise import jacobian
+from rodmol.discretise import upwind as kernels
 
 SCRIPT = "profile_rhs.py"
 

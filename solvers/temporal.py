@@ -19,7 +19,7 @@ import os
 import _common as C
 from _common import np, plt, rodmol
 
-from rodmol.layout import FIELDS
+from rodmol.discretise.layout import FIELDS
 
 SCRIPT = "temporal.py"
 

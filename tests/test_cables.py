@@ -562,7 +562,7 @@ def test_base_at_constant_velocity_translates_rod_rigidly():
     v = np.array([0.0, 0.01, 0.0])
     rod = rodmol.Rod(0.3, 0.01, SILICONE)
     model = rodmol.Model(rod, 12, gravity=NO_GRAVITY,
-                         base=rodmol.Base(velocity=lambda t: (0.0, 0.01, 0.0)))
+                         base=rodmol.BaseMotion(velocity=lambda t: (0.0, 0.01, 0.0)))
     y0 = rodmol.straight_state(model)
     rodmol.StateLayout(12).field(y0, "v")[:] = v
     result = rodmol.simulate(model, 2.0, initial=y0, output_dt=0.1)
@@ -582,7 +582,7 @@ def test_base_velocity_is_in_the_base_frame():
     along global +y, and so does the whole rod (which points along +y)."""
     turn = ((0.0, -1.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0))
     rod = rodmol.Rod(0.3, 0.01, SILICONE)
-    model = rodmol.Model(rod, 8, gravity=NO_GRAVITY, base=rodmol.Base(
+    model = rodmol.Model(rod, 8, gravity=NO_GRAVITY, base=rodmol.BaseMotion(
         velocity=lambda t: (0.02, 0.0, 0.0), position=(0.1, 0.0, 0.0), rotation=turn))
     y0 = rodmol.straight_state(model)
     rodmol.StateLayout(8).field(y0, "v")[:] = (0.02, 0.0, 0.0)

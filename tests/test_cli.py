@@ -10,14 +10,14 @@ from pathlib import Path
 import pytest
 
 import rodmol
-from rodmol.writers import read_pvd
+from rodmol.io.writers import read_pvd
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 SCENARIOS = sorted(EXAMPLES.glob("*.toml"))
 
 
 def rodmol_cli(*args, timeout=120):
-    return subprocess.run([sys.executable, "-m", "rodmol.cli", *map(str, args)], capture_output=True,
+    return subprocess.run([sys.executable, "-m", "rodmol.io.cli", *map(str, args)], capture_output=True,
                           text=True, timeout=timeout)
 
 
@@ -86,7 +86,7 @@ def test_bad_command_line_value_exit_2(tmp_path):
 def test_ctrl_c_keeps_a_valid_partial_run(tmp_path):
     out = tmp_path / "stopped"
     # The explicit backend on this grid takes minutes: the interrupt lands in the solver.
-    command = [sys.executable, "-u", "-m", "rodmol.cli", "run", "--example", "fetching",
+    command = [sys.executable, "-u", "-m", "rodmol.io.cli", "run", "--example", "fetching",
                "--backend", "rk23", "--n-elements", "60", "--out", str(out)]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
@@ -122,8 +122,8 @@ def test_render_and_plot(tmp_path):
 
 
 def test_ctrl_c_while_writing_stops_between_frames(tmp_path, monkeypatch):
-    from rodmol import cli, writers
-    from rodmol.scenario_file import OutputOptions
+    from rodmol.io import cli, writers
+    from rodmol.io.scenario_file import OutputOptions
 
     result = rodmol.simulate(rodmol.scenarios.get("bending").model(6), 0.05, output_dt=0.01)
     interrupts = cli._Interrupts()
@@ -145,7 +145,7 @@ def test_ctrl_c_while_writing_stops_between_frames(tmp_path, monkeypatch):
 def test_progress_plain_lines_when_not_a_terminal():
     import io
 
-    from rodmol.cli import Progress
+    from rodmol.io.cli import Progress
 
     stream = io.StringIO()
     progress = Progress(1.0, stream)

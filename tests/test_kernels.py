@@ -6,16 +6,17 @@ import numpy as np
 import pytest
 
 import rodmol
-from rodmol import jacobian, kernels
+from rodmol.discretise import jacobian
+from rodmol.discretise import upwind as kernels
 from rodmol.arm import paper_rod
-from rodmol.backends import cvode, rk23
+from rodmol.solve.backends import cvode, rk23
 from rodmol.errors import ParameterError
-from rodmol.semidiscrete import SemiDiscrete
+from rodmol.discretise.system import SemiDiscrete
 from rodmol.simulate import default_atol
 
 pytestmark = pytest.mark.skipif(not kernels.AVAILABLE, reason="numba is not installed")
 
-WAVY_BASE = rodmol.Base(velocity=lambda t: np.array([0.02 * np.sin(3 * t), 0.05 * np.cos(2 * t), -0.01]),
+WAVY_BASE = rodmol.BaseMotion(velocity=lambda t: np.array([0.02 * np.sin(3 * t), 0.05 * np.cos(2 * t), -0.01]),
                         angular_velocity=lambda t: np.array([0.3 * np.cos(t), -0.2, 0.1 * t]))
 
 

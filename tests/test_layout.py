@@ -43,7 +43,7 @@ def models(n):
         rodmol.Cable((0.0, -0.002), 0.5 * L, 0.7, name="on a node"),
         rodmol.Cable((-0.001, 0.0015), L, 0.4, name="to the tip"),
     ]
-    base = rodmol.Base(velocity=lambda t: np.array([0.01, 0.02, -0.01]),
+    base = rodmol.BaseMotion(velocity=lambda t: np.array([0.01, 0.02, -0.01]),
                        angular_velocity=lambda t: np.array([0.1, -0.2, 0.3]))
     return {
         "paper loads": rodmol.Model(rod, n, medium="water", cables=cables),

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import rodmol
-from rodmol.writers import write_series
+from rodmol.io.writers import write_series
 
 PVPYTHON, XVFB = shutil.which("pvpython"), shutil.which("xvfb-run")
 pytestmark = pytest.mark.skipif(

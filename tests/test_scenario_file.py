@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import rodmol
-from rodmol.scenario_file import Override, ScenarioError, load_scenario, parse_scenario
+from rodmol.io.scenario_file import Override, ScenarioError, load_scenario, parse_scenario
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import rodmol
-from rodmol.writers import SeriesWriter, frame_indices, read_pvd, write_series
+from rodmol.io.writers import SeriesWriter, frame_indices, read_pvd, write_series
 
 pv = pytest.importorskip("pyvista")
 

@@ -11,7 +11,7 @@ _ZERO = np.zeros(3)
 
 
 @dataclass(frozen=True)
-class Base:
+class BaseMotion:
     """Prescribed base velocities, in the base's local frame.
 
     Parameters
@@ -25,7 +25,7 @@ class Base:
         (local to global). Default: the origin and the identity.
 
     The base pose is integrated with the rest of the state. The default,
-    ``Base()``, is a fixed clamp at the origin.
+    ``BaseMotion()``, is a fixed clamp at the origin.
     """
 
     velocity: Callable | None = None
@@ -84,3 +84,7 @@ def _vector(value, name, t):
     if arr.shape != (3,) or not np.all(np.isfinite(arr)):
         raise ParameterError(f"base `{name}`({t!r}) must return three finite numbers, got {value!r}")
     return arr
+
+
+#: Former name of :class:`BaseMotion`, kept so existing scripts still run.
+Base = BaseMotion

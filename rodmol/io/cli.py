@@ -16,7 +16,7 @@ import time
 import warnings
 from pathlib import Path
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 EXIT_FAILED, EXIT_USAGE, EXIT_INTERRUPTED = 1, 2, 130
 EXAMPLES = ("bending", "reaching", "fetching")
@@ -248,7 +248,7 @@ def _clock(seconds):
 # --------------------------------------------------------------------------- render, plot
 
 def _result_in(directory):
-    from .result import load_result
+    from ..result import load_result
 
     path = Path(directory) / "result.npz"
     if not path.is_file():

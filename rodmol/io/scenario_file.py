@@ -22,16 +22,16 @@ try:
 except ModuleNotFoundError:  # Python 3.10
     import tomli as tomllib
 
-from . import scenarios
-from .arm import CABLE_OFFSETS, paper_arm
-from .backends import BACKENDS, DEFAULT_RTOL
-from .base import Base
-from .cables import Cable, as_tension, read_tension_csv
-from .errors import ParameterError
-from .markers import Marker
-from .model import Model
-from .parameters import MEDIA, Material, Medium
-from .rod import Rod
+from .. import scenarios
+from ..arm import CABLE_OFFSETS, paper_arm
+from ..solve.backends import BACKENDS, DEFAULT_RTOL
+from ..base_motion import BaseMotion
+from ..cables import Cable, as_tension, read_tension_csv
+from ..errors import ParameterError
+from ..markers import Marker
+from ..model import Model
+from ..parameters import MEDIA, Material, Medium
+from ..rod import Rod
 from .toml_lines import KeyLines
 
 
@@ -86,7 +86,7 @@ class RunSpec:
 
     def simulate(self, progress=None):
         """Run it: :func:`rodmol.simulate` with this scenario's settings."""
-        from .simulate import simulate
+        from ..simulate import simulate
 
         return simulate(self.model, self.t_end, progress=progress, **self.solver)
 
@@ -590,7 +590,7 @@ def _base(data, ctx):
         return _FAILED
     if _failed(fixed, position, rotation, velocity, angular):
         return _FAILED
-    return ctx.construct(path, table, lambda: Base(
+    return ctx.construct(path, table, lambda: BaseMotion(
         None if velocity is None else _constant(np.array(velocity)),
         None if angular is None else _constant(np.array(angular)), position, rotation))
 

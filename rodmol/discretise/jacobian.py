@@ -9,7 +9,7 @@ import contextlib
 
 import numpy as np
 
-from .kernels import (
+from .upwind import (
     N_PASSIVE,
     P_QUAT,
     _jit,

@@ -14,8 +14,8 @@ import numpy as np
 from scipy import sparse
 from scipy.integrate import RK23
 
-from .errors import ParameterError
-from .jacobian import BlockPreconditioner, CompiledJacobian
+from ..errors import ParameterError
+from ..discretise.jacobian import BlockPreconditioner, CompiledJacobian
 
 DEFAULT_RTOL = 1e-6
 LINEAR_SOLVERS = ("gmres", "band", "lapackband", "sparse", "dense")

@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 #: Point arrays of the centreline: VTK name -> (Result attribute, frame).
 ROD_ARRAYS = {

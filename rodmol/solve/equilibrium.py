@@ -11,10 +11,10 @@ grows linearly with the number of elements.
 import numpy as np
 from scipy.linalg import solve_banded
 
-from . import centreline, rotations
-from .errors import EquilibriumError
-from .model import Q_STAR, Model
-from .semidiscrete import SemiDiscrete
+from ..discretise import centreline, rotations
+from ..errors import EquilibriumError
+from ..model import Q_STAR, Model
+from ..discretise.system import SemiDiscrete
 
 _BLOCK = 10  # q (3), k (3), Q (4)
 # Half-bandwidths of the residual's Jacobian: the balance at node b+1 (rows 0-5

@@ -12,11 +12,11 @@ import warnings
 
 import numpy as np
 
-from . import centreline, kernels, loads, rotations
-from .cables import ConstantTension
-from .errors import ParameterError
+from . import centreline, upwind, body_loads, rotations
+from ..cables import ConstantTension
+from ..errors import ParameterError
 from .layout import FIELDS, HEADER, StateLayout
-from .model import Q_STAR
+from ..model import Q_STAR
 
 #: Implementations of ``SemiDiscrete.__call__``.
 KERNELS = ("numba", "numpy")
@@ -67,7 +67,7 @@ class SemiDiscrete:
     def __init__(self, model, kernel="numba"):
         if kernel not in KERNELS:
             raise ParameterError(f"unknown `kernel` {kernel!r}; valid: {list(KERNELS)}")
-        if kernel == "numba" and not kernels.AVAILABLE:
+        if kernel == "numba" and not upwind.AVAILABLE:
             warnings.warn("numba is not installed: using the (slower) numpy right-hand side",
                           RuntimeWarning, stacklevel=2)
             kernel = "numpy"
@@ -92,7 +92,7 @@ class SemiDiscrete:
         for p, tension, weight in zip(m.cable_offsets, np.moveaxis(tensions, -1, 0),
                                       m.cable_weights):
             if np.any(tension):
-                n_a, m_a = loads.cable_stress(q, k, p, tension, weight)
+                n_a, m_a = body_loads.cable_stress(q, k, p, tension, weight)
                 n_tot += n_a
                 m_tot += m_a
         return n_el, m_el, n_tot, m_tot
@@ -105,8 +105,8 @@ class SemiDiscrete:
         ds = self.model.ds
         v_str = _prepend(v0, v[..., :-1, :])  # velocities at strain nodes 0..N-1
         w_str = _prepend(w0, w[..., :-1, :])
-        q_t = (v - v_str) / ds + loads.cross(k, v_str) - loads.cross(w_str, q)
-        k_t = (w - w_str) / ds + loads.cross(k, w_str)
+        q_t = (v - v_str) / ds + body_loads.cross(k, v_str) - body_loads.cross(w_str, q)
+        k_t = (w - w_str) / ds + body_loads.cross(k, w_str)
         return q_t, k_t
 
     def balance(self, q, k, quat, v, w, v0, w0, tensions, gravity, rates=None):
@@ -130,16 +130,16 @@ class SemiDiscrete:
         k_next = _append(k[..., 1:, :], zero)
         q_next = _append(q[..., 1:, :], Q_STAR)
 
-        force = (n_next - n_tot) / ds + loads.cross(k_next, n_next)
-        force += loads.gyroscopic_force(w, m.mass, v)
+        force = (n_next - n_tot) / ds + body_loads.cross(k_next, n_next)
+        force += body_loads.gyroscopic_force(w, m.mass, v)
         if np.any(gravity) and np.any(m.net_mass):
-            force += loads.gravity_buoyancy(rotations.matrices(quat), m.net_mass, gravity)
+            force += body_loads.gravity_buoyancy(rotations.matrices(quat), m.net_mass, gravity)
         if m.drag:
-            force += loads.drag(v, m.drag_coefficient)
-        torque = ((m_next - m_tot) / ds + loads.cross(k_next, m_next)
-                  + loads.cross(q_next, n_next) + loads.gyroscopic_torque(w, m.inertia))
+            force += body_loads.drag(v, m.drag_coefficient)
+        torque = ((m_next - m_tot) / ds + body_loads.cross(k_next, m_next)
+                  + body_loads.cross(q_next, n_next) + body_loads.gyroscopic_torque(w, m.inertia))
         if m.munk_moment:
-            torque += loads.munk_torque(v, m.added)
+            torque += body_loads.munk_torque(v, m.added)
         return q_t, k_t, force, torque
 
     def tensions(self, t, y):
@@ -194,8 +194,8 @@ class SemiDiscrete:
         """Pack the model for the compiled kernel, once (parameter arrays,
         cable geometry of the cables the kernel sees, input buffers)."""
         m = self.model
-        self._params, self._consts, offsets, weights = kernels.pack_model(
-            m, QUATERNION_RESTORING_RATE, loads.DRAG_SMOOTHING_SPEED)
+        self._params, self._consts, offsets, weights = upwind.pack_model(
+            m, QUATERNION_RESTORING_RATE, body_loads.DRAG_SMOOTHING_SPEED)
         self._work = np.empty((m.n_elements, 6))
         self.base_velocities = np.zeros(6)
         self._fixed_base = m.base.fixed
@@ -224,7 +224,7 @@ class SemiDiscrete:
             self.base_velocities[:3], self.base_velocities[3:] = v0, w0
 
     def kernel_arguments(self):
-        """Arguments of :func:`rodmol.kernels.rhs` after (y, out): the packed
+        """Arguments of :func:`rodmol.upwind.rhs` after (y, out): the packed
         model, the input arrays refreshed by :meth:`update_inputs`, scratch."""
         return (self._params, self._consts, self._offsets, self._weights, self.tension_values,
                 self.base_velocities, self._work)
@@ -233,7 +233,7 @@ class SemiDiscrete:
         if out is None:
             out = np.empty(self.size)
         self.update_inputs(t, y)
-        kernels.rhs(y, out, self._params, self._consts, self._offsets, self._weights,
+        upwind.rhs(y, out, self._params, self._consts, self._offsets, self._weights,
                     self.tension_values, self.base_velocities, self._work)
         return out
 
