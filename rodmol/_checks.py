@@ -9,6 +9,8 @@ from .errors import ParameterError
 
 def finite(name, value):
     """Return ``value`` as a float, or raise if it is not a finite number."""
+    if isinstance(value, (bool, np.bool_)):
+        raise ParameterError(f"`{name}` must be a number, got {value!r}")
     try:
         x = float(value)
     except (TypeError, ValueError):

@@ -8,7 +8,7 @@ A tension input is any of
 * a path to a CSV file with two columns, time [s] and tension [N]
   (an optional header line; ``#`` starts a comment), as logged by a rig;
 * a callable ``T(t)``;
-* a callable ``T(t, state)`` (feedback): ``state`` is a :class:`rodmol.StateView`
+* a callable ``T(t, state)`` with two required arguments (feedback): ``state`` is a :class:`rodmol.StateView`
   (``None`` while the initial equilibrium is solved). Its dependence on the
   state is global, so it is not in the banded Jacobian; CVODE's default
   linear solver for such models is therefore GMRES, whose Jacobian-vector
@@ -17,11 +17,8 @@ A tension input is any of
   the result stays correct).
 """
 
-import csv
 import inspect
-import math
 import os
-from bisect import bisect_right
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -30,84 +27,39 @@ import numpy as np
 
 from . import _checks
 from .errors import ParameterError
+from .inputs import Knots, TimeInput, as_time_input, read_table
 
 
 class Tension:
-    """Base class of tension inputs; ``feedback`` tells if it reads the state."""
+    """A cable's tension input: ``tension(t, state=None)`` [N].
+
+    ``feedback`` tells if it reads the state; ``constant`` holds the value of
+    a constant tension (None otherwise), so the right-hand side reads it once.
+    """
 
     feedback = False
 
+    def __init__(self, signal: TimeInput):
+        self.signal = signal
+        self.constant = signal.value(0.0) if signal.constant else None
+
     def __call__(self, t, state=None):
-        raise NotImplementedError
+        return self.signal.value(t)
+
+    def __repr__(self):
+        return f"Tension({self.signal!r})"
 
 
 @dataclass(frozen=True)
-class ConstantTension(Tension):
-    value: float
+class FeedbackTension(Tension):
+    """A feedback law ``T(t, state)``; ``state`` is a :class:`rodmol.StateView`."""
 
-    def __call__(self, t, state=None):
-        return self.value
-
-
-@dataclass(frozen=True)
-class PiecewiseLinearTension(Tension):
-    """Linear interpolation between knots, held constant outside them."""
-
-    times: np.ndarray
-    values: np.ndarray
-    source: str = "knots"
-
-    def __post_init__(self):
-        # Plain lists and bisect: called at every right-hand side evaluation with
-        # a scalar t, where np.interp's array overhead would dominate.
-        object.__setattr__(self, "_t", [float(x) for x in self.times])
-        object.__setattr__(self, "_v", [float(x) for x in self.values])
-
-    def __call__(self, t, state=None):
-        times, values = self._t, self._v
-        j = bisect_right(times, t)
-        if j == 0:
-            return values[0]
-        if j == len(times):
-            return values[-1]
-        t0, v0 = times[j - 1], values[j - 1]
-        return v0 + (values[j] - v0) * (t - t0) / (times[j] - t0)
-
-
-@dataclass(frozen=True)
-class CallableTension(Tension):
     function: Callable
-    feedback: bool = False
+    feedback = True
+    constant = None
 
     def __call__(self, t, state=None):
-        return float(self.function(t, state) if self.feedback else self.function(t))
-
-
-def _knots(name, knots, source="knots"):
-    try:
-        arr = np.asarray(knots, dtype=float)
-    except (TypeError, ValueError):
-        raise ParameterError(f"`{name}` knots must be (t, T) pairs, got {knots!r}") from None
-    if arr.ndim != 2 or arr.shape[1] != 2 or len(arr) < 1:
-        raise ParameterError(f"`{name}` knots must be a list of (t, T) pairs, got {knots!r}")
-    if not np.all(np.isfinite(arr)):
-        raise ParameterError(f"`{name}` knots must be finite, got {knots!r}")
-    if np.any(np.diff(arr[:, 0]) <= 0.0):
-        i = int(np.flatnonzero(np.diff(arr[:, 0]) <= 0.0)[0]) + 1
-        raise ParameterError(f"`{name}` knot times must increase; knot {i} has t = {float(arr[i, 0])!r}")
-    if np.any(arr[:, 1] < 0.0):
-        i = int(np.flatnonzero(arr[:, 1] < 0.0)[0])
-        raise ParameterError(f"`{name}` must be >= 0 N; knot {i} has T = {float(arr[i, 1])!r}")
-    return PiecewiseLinearTension(arr[:, 0].copy(), arr[:, 1].copy(), source)
-
-
-def _number(cell):
-    """The finite float in ``cell``, or None."""
-    try:
-        x = float(cell)
-    except ValueError:
-        return None
-    return x if math.isfinite(x) else None
+        return float(self.function(t, state))
 
 
 def read_tension_csv(path):
@@ -115,39 +67,8 @@ def read_tension_csv(path):
 
     Errors name the file and the line.
     """
-    path = os.fspath(path)
-    rows, header_seen = [], False
-    try:
-        handle = open(path, newline="")  # noqa: SIM115 (closed by the with below)
-    except OSError as exc:
-        raise ParameterError(f"cannot read tension table {path!r}: {exc.strerror}") from None
-    with handle:
-        for lineno, row in enumerate(csv.reader(handle), start=1):
-            cells = [c.strip() for c in row]
-            if not any(cells) or cells[0].startswith("#"):
-                continue
-            values = [_number(c) for c in cells[:2]]
-            if not rows and not header_seen and any(v is None for v in values):
-                header_seen = True  # the first row that is not all numbers is a header
-                continue
-            if len(cells) < 1 or not cells[0]:
-                raise ParameterError(f"{path}:{lineno}: missing time in {row!r}")
-            if len(cells) < 2 or not cells[1]:
-                raise ParameterError(f"{path}:{lineno}: missing tension in {row!r}")
-            if any(v is None for v in values):
-                raise ParameterError(f"{path}:{lineno}: not a number in {row!r}")
-            t, tension = values
-            if rows and t <= rows[-1][1]:
-                raise ParameterError(
-                    f"{path}:{lineno}: time {t!r} s does not increase (previous {rows[-1][1]!r} s)"
-                )
-            if tension < 0.0:
-                raise ParameterError(f"{path}:{lineno}: negative tension {tension!r} N")
-            rows.append((lineno, t, tension))
-    if not rows:
-        raise ParameterError(f"{path}: no (time, tension) rows found")
-    arr = np.array([r[1:] for r in rows])
-    return PiecewiseLinearTension(arr[:, 0], arr[:, 1], source=path)
+    times, values = read_table(path, 1, "tension", "N", minimum=0.0)
+    return Tension(Knots(times, values, source=os.fspath(path)))
 
 
 def as_tension(value, name="tension"):
@@ -156,15 +77,19 @@ def as_tension(value, name="tension"):
         return value
     if isinstance(value, (str, os.PathLike)):
         return read_tension_csv(value)
-    if callable(value):
-        try:
-            n_args = len(inspect.signature(value).parameters)
-        except (TypeError, ValueError):
-            n_args = 1
-        return CallableTension(value, feedback=n_args >= 2)
-    if np.ndim(value) == 0:
-        return ConstantTension(_checks.non_negative(name, value, " N"))
-    return _knots(name, value)
+    if callable(value) and _required_arguments(value) >= 2:
+        return FeedbackTension(value)
+    return Tension(as_time_input(name, value, 1, "N", minimum=0.0))
+
+
+def _required_arguments(function):
+    """Positional parameters without defaults (``lambda t, gain=1.0: ...`` has one)."""
+    try:
+        parameters = inspect.signature(function).parameters.values()
+    except (TypeError, ValueError):
+        return 1
+    kinds = (inspect.Parameter.POSITIONAL_ONLY, inspect.Parameter.POSITIONAL_OR_KEYWORD)
+    return sum(1 for p in parameters if p.kind in kinds and p.default is inspect.Parameter.empty)
 
 
 @dataclass(frozen=True)

@@ -10,8 +10,10 @@ prescribed velocities, the tip (node N) a vanishing total stress.
 import numpy as np
 
 from . import _checks
+from . import loads as load_types
 from .base_motion import BaseMotion
 from .cables import Cable
+from .discretise import external
 from .errors import ParameterError
 from .markers import Marker, marker_offsets
 from .parameters import Medium
@@ -19,6 +21,10 @@ from .rod import Rod
 
 #: Strain of the straight reference configuration, q* = (1, 0, 0).
 Q_STAR = np.array([1.0, 0.0, 0.0])
+Q_STAR.flags.writeable = False
+#: The sampled arrays of a Model (read-only once built).
+SAMPLED = ("s_nodes", "kl", "kth", "vl", "vth", "added", "mass", "inertia", "net_mass",
+           "drag_coefficient", "cable_offsets", "cable_weights")
 
 
 class Model:
@@ -37,8 +43,11 @@ class Model:
     medium_density : float
         Shortcut for a fluid that only gives buoyancy [kg/m^3].
     cables : sequence of Cable
-    base : Base or None
+    base : BaseMotion or None
         Base motion; None is a fixed clamp at the origin.
+    loads : sequence of loads
+        External loads (:mod:`rodmol.loads`): point and distributed forces
+        and moments, contact with planes, spheres and capsules.
     drag, added_mass, viscosity : bool
         Switches to drop a load (the paper's worsened models, Table V):
         ``viscosity=False`` sets mu = 0.
@@ -46,11 +55,17 @@ class Model:
         Add the Munk moment of the added-mass model (off in the paper).
     markers : sequence of Marker
         Surface points whose trajectories the result carries.
+
+    The sampled sectional arrays (``kl``, ``kth``, ``vl``, ``vth``, ``mass``,
+    ``inertia``, ``net_mass``, ``drag_coefficient``, ``added``,
+    ``cable_offsets``, ``cable_weights``, ``s_nodes``) are read-only: the
+    compiled system copies them once, so they must not change afterwards.
+    Build a new Model to change a parameter.
     """
 
     def __init__(self, rod, n_elements, *, gravity=(0.0, -9.81, 0.0), medium=None,
                  medium_density=0.0, cables=(), base=None, drag=True, added_mass=True,
-                 viscosity=True, munk_moment=False, markers=()):
+                 viscosity=True, munk_moment=False, markers=(), loads=()):
         if not isinstance(rod, Rod):
             raise ParameterError(f"`rod` must be a rodmol.Rod, got {rod!r}")
         self.rod = rod
@@ -67,6 +82,15 @@ class Model:
         self.drag, self.added_mass = bool(drag), bool(added_mass)
         self.viscosity, self.munk_moment = bool(viscosity), bool(munk_moment)
         self._check_cables()
+        self.loads = tuple(loads)
+        for i, load in enumerate(self.loads):
+            if not isinstance(load, load_types.LOAD_TYPES):
+                names = ", ".join(t.__name__ for t in load_types.LOAD_TYPES)
+                raise ParameterError(f"`loads[{i}]` must be one of rodmol's loads ({names}), got {load!r}")
+        names = [c.name for c in self.cables]
+        duplicate = next((n for n in names if names.count(n) > 1), None)
+        if duplicate is not None:
+            raise ParameterError(f"two cables are named {duplicate!r}: cable names must be unique")
         self.markers = tuple(markers)
         for i, mk in enumerate(self.markers):
             if not isinstance(mk, Marker):
@@ -132,16 +156,29 @@ class Model:
         self.cable_offsets = np.array([c.offset3 for c in self.cables]).reshape(-1, 3)
         anchors = np.array([c.anchor for c in self.cables]).reshape(-1, 1)
         self.cable_weights = np.clip((anchors - s_str[None, :]) / ds, 0.0, 1.0)
+        self.grid_loads = load_types.on_grid(self.loads, self.s_nodes, rod.radius_at(self.s_nodes))
+        for name in SAMPLED:
+            getattr(self, name).flags.writeable = False
 
     def tensions(self, t, state=None):
         """Cable tensions [N] at time t, shape (n_cables,)."""
         return np.array([c.tension_at(t, state) for c in self.cables])
 
     def load_scale(self, t=0.0):
-        """A force scale [N] of the applied loads: net weight plus cable tensions."""
+        """A force scale [N] of the applied loads at time t: net weight, cable
+        tensions, external forces and external moments divided by L."""
         net_density = abs(self.rod.material.rho - self.medium.rho)
-        weight = net_density * np.linalg.norm(self.gravity) * self.rod.volume()
-        return weight + float(np.sum(self.tensions(t))) if self.cables else weight
+        scale = net_density * np.linalg.norm(self.gravity) * self.rod.volume()
+        if self.cables:
+            scale += float(np.sum(self.tensions(t)))
+        g = self.grid_loads
+        values = g.initial.copy()
+        for rows, at in g.values:
+            values[rows] = at(t)
+        size = np.linalg.norm(values, axis=1) * g.weight * self.ds
+        forces = np.isin(g.kind, (external.FOLLOWER_FORCE, external.DEAD_FORCE))
+        moments = np.isin(g.kind, (external.FOLLOWER_MOMENT, external.DEAD_MOMENT))
+        return scale + float(np.sum(size[forces]) + np.sum(size[moments]) / self.rod.length)
 
 
 def _medium(medium, medium_density):

@@ -1,6 +1,6 @@
 """Material and medium parameters (SI units), validated on construction."""
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from . import _checks
 from .errors import ParameterError
@@ -14,33 +14,43 @@ class Material:
     ----------
     E : float
         Young's modulus [Pa].
-    nu : float
-        Poisson ratio, in (-1, 0.5]; the shear modulus is ``E / (2 (1 + nu))``.
+    nu : float, optional
+        Poisson ratio, in (-1, 0.5]; gives the shear modulus ``E / (2 (1 + nu))``.
     mu : float
-        Shear viscosity [Pa s] of the Kelvin-Voigt law; 0 gives a linear
-        elastic rod.
+        Shear viscosity [Pa s] of the Kelvin-Voigt law; 0 (default) gives a
+        linear elastic rod.
     rho : float
         Density [kg/m^3].
+    G : float, optional, keyword-only
+        Shear modulus [Pa], instead of ``nu`` (for example a Timoshenko beam
+        with G = E / 100). Give exactly one of ``nu`` and ``G``; ``nu`` is
+        then reported as E / (2 G) - 1.
     """
 
     E: float
-    nu: float
-    mu: float
-    rho: float
+    nu: float | None = None
+    mu: float = 0.0
+    rho: float | None = None
+    G: float | None = field(default=None, kw_only=True)
 
     def __post_init__(self):
         object.__setattr__(self, "E", _checks.positive("E", self.E, " Pa"))
-        nu = _checks.finite("nu", self.nu)
-        if not -1.0 < nu <= 0.5:
-            raise ParameterError(f"`nu` must lie in (-1, 0.5], got {self.nu!r}")
-        object.__setattr__(self, "nu", nu)
-        object.__setattr__(self, "mu", _checks.non_negative("mu", self.mu, " Pa s"))
+        if self.rho is None:
+            raise ParameterError("`rho` (density [kg/m^3]) is required")
         object.__setattr__(self, "rho", _checks.positive("rho", self.rho, " kg/m^3"))
-
-    @property
-    def G(self):
-        """Shear modulus [Pa]."""
-        return self.E / (2.0 * (1.0 + self.nu))
+        object.__setattr__(self, "mu", _checks.non_negative("mu", self.mu, " Pa s"))
+        if (self.nu is None) == (self.G is None):
+            raise ParameterError("give exactly one of `nu` (Poisson ratio) and `G` (shear modulus "
+                                 f"[Pa]), got nu={self.nu!r}, G={self.G!r}")
+        if self.G is None:
+            nu = _checks.finite("nu", self.nu)
+            if not -1.0 < nu <= 0.5:
+                raise ParameterError(f"`nu` must lie in (-1, 0.5], got {self.nu!r}")
+            object.__setattr__(self, "nu", nu)
+            object.__setattr__(self, "G", self.E / (2.0 * (1.0 + nu)))
+        else:
+            object.__setattr__(self, "G", _checks.positive("G", self.G, " Pa"))
+            object.__setattr__(self, "nu", self.E / (2.0 * self.G) - 1.0)
 
 
 @dataclass(frozen=True)

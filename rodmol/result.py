@@ -5,10 +5,9 @@ import os
 
 import numpy as np
 
-from .discretise import centreline, rotations
+from .discretise import centreline, physics, rotations
 
 from . import markers
-from .discretise.layout import FIELDS, HEADER
 from .model import Q_STAR
 
 #: Arrays of a Result, with their units (also the keys of the .npz file).
@@ -25,6 +24,8 @@ ARRAYS = {
     "angular_velocity": "rad/s, local",
     "internal_force": "N, local",
     "internal_moment": "N m, local",
+    "external_force": "N/m, global",
+    "external_moment": "N m/m, global",
     "tensions": "N",
     "quaternion_norm_error": "-",
     "markers": "m, global",
@@ -49,6 +50,9 @@ class Result:
     velocity, angular_velocity : (n_t, N+1, 3) v [m/s] and w [rad/s], local.
     internal_force, internal_moment : (n_t, N+1, 3) Kelvin-Voigt stress N [N]
         and M [N m] in the body, local (without the cables' own tension).
+    external_force, external_moment : (n_t, N+1, 3) external load densities
+        [N/m, N m/m] at the nodes, global frame (point loads appear as their
+        share over the element length ds; node 0, the clamp, carries none).
     tensions : (n_t, n_cables) cable tensions [N].
     quaternion_norm_error : (n_t,) max over nodes of ||Q| - 1|.
     markers : (n_t, n_markers, 3) marker positions [m], global; their names
@@ -109,7 +113,7 @@ def load_result(path):
 #: The arrays each deferred group of :func:`from_states` computes.
 _GROUPS = {
     "mechanics": ("linear_strain", "curvature", "velocity", "angular_velocity", "internal_force",
-                  "internal_moment"),
+                  "internal_moment", "external_force", "external_moment"),
     "pose": ("positions", "rotations", "integrated_positions", "markers"),
 }
 
@@ -118,59 +122,65 @@ def from_states(system, t, y, success, message, stats):
     """Build a :class:`Result` from raw states ``y`` (n_t, size) of ``system``.
 
     Times, tensions and the quaternion drift are filled at once; the strains,
-    stresses and poses of every frame are computed on first access (most runs
-    need only a few of them, and they cost about half the integration).
+    stresses, loads and poses of every frame are computed on first access
+    (most runs need only a few of them, and they cost about half the
+    integration), by the same compiled kernel as the integration.
     """
-    model = system.model
-    n_t, n = len(t), model.n_elements
-    blocks = y[:, HEADER:].reshape(n_t, n, -1)
-    quat, q, k, v, w = (blocks[..., FIELDS[f]] for f in ("Q", "q", "k", "v", "w"))
+    model, layout = system.model, system.layout
+    n_t = len(t)
+    q, k, v, w = (layout.field(y, f) for f in ("q", "k", "v", "w"))
+    quat_all = layout.quaternions(y)
     base = [model.base.velocities(ti) for ti in t]
     v0 = np.array([b[0] for b in base]).reshape(n_t, 3)
     w0 = np.array([b[1] for b in base]).reshape(n_t, 3)
     tensions = np.array([system.tensions(ti, yi) for ti, yi in zip(t, y)]).reshape(n_t, -1)
 
-
     def mechanics():
-        """Strains, velocities and stresses at all nodes (node N: the tip)."""
-        q_t, k_t = system.strain_rates(q, k, v, w, v0, w0)
-        n_el, m_el, _, _ = system.stresses(q, k, q_t, k_t, tensions)
+        """Strains, velocities, stresses and external loads at all nodes."""
+        stress, loads = system.frames(t, y)
         # Tip node: the body carries minus the stress of the cables anchored at the tip.
-        tip_cables = model.cable_weights[:, -1] == 1.0 if model.cables else np.zeros(0, bool)
         n_tip, m_tip = np.zeros((n_t, 3)), np.zeros((n_t, 3))
-        if np.any(tip_cables):
-            _, _, n_tot, m_tot = system.stresses(q[:, -1:], k[:, -1:], 0 * q[:, -1:], 0 * k[:, -1:],
-                                                 tensions * tip_cables)
-            n_tip, m_tip = -n_tot[:, 0], -m_tot[:, 0]
+        for c, cable in enumerate(model.cables):
+            if model.cable_weights[c, -1] != 1.0:
+                continue
+            p = tuple(model.cable_offsets[c])
+            for i in range(n_t):
+                n_a, m_a = physics.cable_stress(tuple(q[i, -1]), tuple(k[i, -1]), p, tensions[i, c])
+                n_tip[i] -= n_a
+                m_tip[i] -= m_a
         kl_tip, kth_tip = model.rod.stiffness(model.rod.length)
+        rots = rotations.matrices(quat_all[:, 1:])
+        zero = np.zeros((n_t, 1, 3))
         return dict(
             linear_strain=np.concatenate([q, (Q_STAR + n_tip / kl_tip)[:, None]], axis=1),
             curvature=np.concatenate([k, (m_tip / kth_tip)[:, None]], axis=1),
             velocity=np.concatenate([v0[:, None], v], axis=1),
             angular_velocity=np.concatenate([w0[:, None], w], axis=1),
-            internal_force=np.concatenate([n_el, n_tip[:, None]], axis=1),
-            internal_moment=np.concatenate([m_el, m_tip[:, None]], axis=1),
+            internal_force=np.concatenate([stress[..., :3], n_tip[:, None]], axis=1),
+            internal_moment=np.concatenate([stress[..., 3:], m_tip[:, None]], axis=1),
+            external_force=np.concatenate([zero, np.einsum("tnij,tnj->tni", rots, loads[..., :3])], axis=1),
+            external_moment=np.concatenate([zero, np.einsum("tnij,tnj->tni", rots, loads[..., 3:])], axis=1),
         )
 
     def pose():
         """Positions rebuilt from the strains, rotations, markers, integrated positions."""
-        positions = centreline.positions(y[:, :3], quat_all, q, k, model.ds)
+        positions = centreline.positions(layout.base_position(y), quat_all, q, k, model.ds)
         rots = rotations.matrices(quat_all)
         return dict(
             positions=positions, rotations=rots,
-            integrated_positions=np.concatenate([y[:, None, :3], blocks[..., FIELDS["u"]]], axis=1),
+            integrated_positions=layout.integrated_positions(y),
             markers=markers.track(model.markers, model.marker_offsets, model.s_nodes, positions, rots),
         )
 
-    quat_all = np.concatenate([y[:, None, 3:7], quat], axis=1)
     arrays = dict(
         t=t, s=model.s_nodes, radius=model.rod.radius_at(model.s_nodes), tensions=tensions,
         quaternion_norm_error=np.max(np.abs(np.linalg.norm(quat_all, axis=-1) - 1.0), axis=-1),
     )
     deferred = {name: group for group in (mechanics, pose) for name in _GROUPS[group.__name__]}
-    meta = dict(n_elements=n, length=model.rod.length,
+    meta = dict(n_elements=model.n_elements, length=model.rod.length,
                 cables=[dict(name=c.name, offset=list(c.offset), anchor=c.anchor)
                         for c in model.cables],
                 markers=[dict(name=mk.name, s=mk.s, offset=list(model.marker_offsets[i, 1:]))
-                         for i, mk in enumerate(model.markers)])
+                         for i, mk in enumerate(model.markers)],
+                loads=[repr(load) for load in model.loads])
     return Result(arrays, success, message, stats, meta, deferred)

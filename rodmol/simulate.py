@@ -10,42 +10,30 @@ from .discretise import rotations
 from .solve.backends import DEFAULT_RTOL, get_backend
 from .solve.equilibrium import equilibrium
 from .errors import ParameterError
-from .discretise.layout import FIELDS
+from .discretise.layout import StateLayout
 from .model import Model
 from .result import from_states
 from .discretise.system import SemiDiscrete
 
 
 def default_atol(model, rtol):
-    """Per-variable absolute tolerances: ``rtol`` times a scale of each field.
-
-    Scales: positions L, quaternions 1, strains q 1, curvatures 1/L,
-    velocities L/(1 s), angular velocities 1 rad/s.
+    """Per-variable absolute tolerances: ``rtol`` times a scale of each field
+    (see ``StateLayout.scales``: positions L, quaternions 1, strains q 1,
+    curvatures 1/L, velocities L/(1 s), angular velocities 1 rad/s).
 
     (A looser angular-velocity scale, e.g. (L/s)/r_min, takes 15-20% fewer
     steps on the paper's tests, but lets energy creep up in inviscid
     oscillations; see ``docs/performance.md``.)
     """
-    L = model.rod.length
-    scale = {"u": L, "Q": 1.0, "q": 1.0, "k": 1.0 / L, "v": L, "w": 1.0}
-    block = np.empty(19)
-    for name, sl in FIELDS.items():
-        block[sl] = scale[name]
-    head = np.array([L] * 3 + [1.0] * 4)
-    return rtol * np.concatenate([head, np.tile(block, model.n_elements)])
+    return rtol * StateLayout(model.n_elements).scales(model.rod.length)
 
 
 def straight_state(model):
     """The undeformed rod at rest along the base's x axis."""
-    system = SemiDiscrete(model)
-    n = model.n_elements
-    r0 = np.asarray(model.base.rotation, dtype=float)
-    u0 = np.asarray(model.base.position, dtype=float)
-    quat0 = rotations.from_matrix(r0)
-    u = u0 + model.s_nodes[1:, None] * r0[:, 0]
-    zeros = np.zeros((n, 3))
-    q = np.tile([1.0, 0.0, 0.0], (n, 1))
-    return system.layout.pack(u0, quat0, u, np.tile(quat0, (n, 1)), q, zeros, zeros, zeros)
+    base = model.base
+    return StateLayout(model.n_elements).straight(
+        model.s_nodes, np.asarray(base.position, dtype=float), np.asarray(base.rotation, dtype=float),
+        rotations.from_matrix(base.rotation))
 
 
 def simulate(model, t_end, *, initial="equilibrium", backend="cvode", rtol=DEFAULT_RTOL,
@@ -87,12 +75,12 @@ def simulate(model, t_end, *, initial="equilibrium", backend="cvode", rtol=DEFAU
     output_dt = _checks.positive("output_dt", output_dt, " s")
     rtol = _checks.positive("rtol", rtol)
     run = get_backend(backend)
-    system = SemiDiscrete(model)
-    y0 = _initial_state(model, initial, system.size)
+    system = SemiDiscrete(model)  # the one system of this run
+    y0 = _initial_state(system, initial)
     if atol is None:
         atol = default_atol(model, rtol)
     else:
-        atol = _state_sized("atol", atol, system.size, positive=True)
+        atol = _state_sized("atol", atol, system.size, positive=True, layout=system.layout)
 
     n_out = int(np.floor(t_end / output_dt + 1e-9))
     t_out = np.unique(np.append(np.arange(n_out + 1) * output_dt, t_end))
@@ -104,17 +92,17 @@ def simulate(model, t_end, *, initial="equilibrium", backend="cvode", rtol=DEFAU
     return result
 
 
-def _initial_state(model, initial, size):
+def _initial_state(system, initial):
     if isinstance(initial, str):
         if initial == "equilibrium":
-            return equilibrium(model, 0.0)
+            return equilibrium(system.model, 0.0, system=system)
         if initial == "straight":
-            return straight_state(model)
+            return straight_state(system.model)
         raise ParameterError(f"unknown `initial` {initial!r}; use 'equilibrium', 'straight' or a state")
-    return _state_sized("initial", initial, size)
+    return _state_sized("initial", initial, system.size, layout=system.layout)
 
 
-def _state_sized(name, value, size, positive=False):
+def _state_sized(name, value, size, positive=False, layout=None):
     """A finite float array of length ``size`` (a scalar is broadcast if ``positive``);
     the error names the first bad entry, which numpy's summarised repr would hide."""
     try:
@@ -131,5 +119,6 @@ def _state_sized(name, value, size, positive=False):
     if np.any(bad):
         i = int(np.flatnonzero(bad)[0])
         need = "finite and > 0" if positive else "finite"
-        raise ParameterError(f"`{name}` entries must be {need}, got {float(arr[i])!r} at entry {i}")
+        where = f" ({layout.entry_name(i)})" if layout is not None else ""
+        raise ParameterError(f"`{name}` entries must be {need}, got {float(arr[i])!r} at entry {i}{where}")
     return arr.copy()

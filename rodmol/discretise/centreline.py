@@ -4,12 +4,24 @@ The upwind scheme does not keep the time-integrated positions (u_t = R v)
 consistent with the strains (u' = R q): their gap grows by O(ds) per unit
 time under sustained motion. Positions are therefore rebuilt from the base
 position, the orientations and the strains, which is exact at rest and
-bounded by O(ds) at all times.
+bounded by O(ds) at all times. The static equilibrium imposes the same chords,
+so at rest both positions agree.
 """
 
 import numpy as np
 
 from . import rotations
+
+
+def chords(quat, q, k, ds):
+    """Element chords (..., N, 3) [m], global: element j runs from node j to
+    node j+1 with constant strains q_j, k_j, and its chord is taken as
+    ds R(mid) q_j with R(mid) = R_j exp(ds k_j / 2).
+
+    ``quat`` (..., N, 4) are the orientations of nodes 0..N-1.
+    """
+    mid = rotations.multiply(quat, rotations.from_rotation_vector(0.5 * ds * k))
+    return ds * np.einsum("...ij,...j->...i", rotations.matrices(mid), q)
 
 
 def positions(u0, quat, q, k, ds):
@@ -21,11 +33,7 @@ def positions(u0, quat, q, k, ds):
     quat : (..., N+1, 4) orientations of nodes 0..N (node 0 is the base).
     q, k : (..., N, 3) strains of strain nodes 0..N-1, local.
     ds : float, element length [m].
-
-    Element j runs from node j to node j+1 with constant strains q_j, k_j;
-    its chord is approximated by ds R(mid) q_j with R(mid) = R_j exp(ds k_j / 2).
     """
-    mid = rotations.multiply(quat[..., :-1, :], rotations.from_rotation_vector(0.5 * ds * k))
-    steps = ds * np.einsum("...ij,...j->...i", rotations.matrices(mid), q)
+    steps = chords(quat[..., :-1, :], q, k, ds)
     u0 = np.asarray(u0, dtype=float)[..., None, :]
     return np.concatenate([u0, u0 + np.cumsum(steps, axis=-2)], axis=-2)

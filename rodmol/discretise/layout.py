@@ -1,87 +1,211 @@
-"""Packing of the semi-discrete state vector, node by node, and its Jacobian pattern.
+"""Packing of the semi-discrete state vector, node by node, and every structure
+derived from it: offsets, accessors, the straight state, absolute-tolerance
+scales, the Jacobian pattern, its bandwidths and its colouring.
 
-The vector starts with the base pose (u0, Q0: 7 values), then one block of 19
+The state starts with the base pose (u0, Q0: 7 values), then one block of 19
 values per element b = 0..N-1 holding the pose and velocities of velocity node
 b + 1 and the strains of strain node b::
 
     [u (3), Q (4), q (3), k (3), v (3), w (3)]
 
-Strains and velocities are coupled only to the neighbouring blocks, so the
-Jacobian is banded; keeping (q, k, v, w) contiguous with v, w last makes the
-half-bandwidths as small as this blocking allows.
+Couplings are declared, never drawn by hand: a *dependency table* maps each
+row field to ``{block offset: column fields}`` (the scheme's table lives with
+the scheme, each load kind declares its own), and :meth:`BlockLayout.pattern`,
+:meth:`~BlockLayout.bandwidths` and :meth:`~BlockLayout.colouring` are computed
+from it. Keeping (q, k, v, w) contiguous with v, w last keeps the half-
+bandwidths as small as this blocking allows.
 """
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-HEADER = 7
-FIELDS = {"u": slice(0, 3), "Q": slice(3, 7), "q": slice(7, 10), "k": slice(10, 13),
-          "v": slice(13, 16), "w": slice(16, 19)}
-BLOCK = 19
+#: Fields of an element block and their widths, in storage order.
+STATE_FIELDS = {"u": 3, "Q": 4, "q": 3, "k": 3, "v": 3, "w": 3}
+#: Fields of the base header: base position and quaternion.
+HEADER_FIELDS = {"u": 3, "Q": 4}
 
-# Which fields of which block (offset -1, 0, +1) each field's rate depends on.
-_DEPENDS = {
-    "u": {0: ("Q", "v")},
-    "Q": {0: ("Q", "w")},
-    "q": {-1: ("v", "w"), 0: ("q", "k", "v")},
-    "k": {-1: ("w",), 0: ("k", "w")},
-    # The next block's w reaches the force only through the moment, and the
-    # torque sees the previous block only through k_t (its w).
-    "v": {-1: ("v", "w"), 0: ("Q", "q", "k", "v", "w"), 1: ("q", "k", "v")},
-    "w": {-1: ("w",), 0: ("q", "k", "v", "w"), 1: ("q", "k", "v", "w")},
-}
+
+def _slices(fields):
+    out, start = {}, 0
+    for name, width in fields.items():
+        out[name] = slice(start, start + width)
+        start += width
+    return out
+
+
+FIELDS = _slices(STATE_FIELDS)
+BLOCK = sum(STATE_FIELDS.values())
+HEADER = sum(HEADER_FIELDS.values())
+# Integer offsets of each field inside a block, for the compiled kernels (numba
+# freezes module-level ints into the machine code).
+U, QUAT, Q, K, V, W = (FIELDS[f].start for f in ("u", "Q", "q", "k", "v", "w"))
+
+
+def merge(*tables):
+    """Union of dependency tables ``{row: {offset: (cols...)}}``."""
+    out = {}
+    for table in tables:
+        for row, deps in table.items():
+            for offset, cols in deps.items():
+                have = out.setdefault(row, {}).setdefault(offset, ())
+                out[row][offset] = have + tuple(c for c in cols if c not in have)
+    return out
 
 
 @dataclass(frozen=True)
-class StateLayout:
-    """Owns the packing of the state vector for N elements."""
+class BlockLayout:
+    """A vector of ``header`` values followed by ``n_blocks`` blocks of ``fields``."""
 
-    n_elements: int
+    n_blocks: int
+    fields: dict = field(default_factory=lambda: dict(STATE_FIELDS))
+    header: int = 0
+
+    @property
+    def block(self):
+        return sum(self.fields.values())
 
     @property
     def size(self):
-        return HEADER + BLOCK * self.n_elements
+        return self.header + self.block * self.n_blocks
+
+    def slices(self):
+        return _slices(self.fields)
 
     def blocks(self, y):
-        """(N, 19) view of the element blocks of y."""
-        return y[HEADER:].reshape(self.n_elements, BLOCK)
+        """(..., n_blocks, block) view of the blocks of y (y may have leading axes)."""
+        y = np.asarray(y)
+        return y[..., self.header:].reshape(y.shape[:-1] + (self.n_blocks, self.block))
 
     def field(self, y, name):
-        """(N, 3 or 4) view of one field of y (see ``FIELDS``)."""
-        return self.blocks(y)[:, FIELDS[name]]
+        """(..., n_blocks, width) view of one field of y."""
+        return self.blocks(y)[..., self.slices()[name]]
 
-    def pack(self, u0, quat0, u, quat, q, k, v, w):
-        y = np.empty(self.size)
-        y[:3], y[3:7] = u0, quat0
-        b = self.blocks(y)
-        for name, value in zip(["u", "Q", "q", "k", "v", "w"], (u, quat, q, k, v, w)):
-            b[:, FIELDS[name]] = value
-        return y
+    def pattern(self, depends, header_depends=None):
+        """Structural Jacobian pattern (bool, size x size) of a dependency table.
 
-    def pattern(self):
-        """Structural Jacobian pattern (bool, size x size), from ``_DEPENDS``.
-
-        It covers every coupling of the right-hand side except cable tensions
-        that feed back on the state, which are global.
+        ``header_depends`` is a (header, header) bool array of the header's
+        own coupling (headers couple to nothing else).
         """
-        n = self.n_elements
+        n, block, sl = self.n_blocks, self.block, self.slices()
         pat = np.zeros((self.size, self.size), dtype=bool)
-        pat[:HEADER, :HEADER] = True  # base pose integrates the prescribed base velocities
-        for row_field, deps in _DEPENDS.items():
-            rows = np.arange(BLOCK)[FIELDS[row_field]]
+        if header_depends is not None:
+            pat[:self.header, :self.header] = header_depends
+        local = np.arange(block)
+        for row_field, deps in depends.items():
+            rows = local[sl[row_field]]
             for offset, cols in deps.items():
-                cidx = np.concatenate([np.arange(BLOCK)[FIELDS[c]] for c in cols])
+                cidx = np.concatenate([local[sl[c]] for c in cols]) if cols else local[:0]
                 for b in range(n):
                     if 0 <= b + offset < n:
-                        r = HEADER + b * BLOCK + rows
-                        c = HEADER + (b + offset) * BLOCK + cidx
+                        r = self.header + b * block + rows
+                        c = self.header + (b + offset) * block + cidx
                         pat[np.ix_(r, c)] = True
         return pat
 
-    def bandwidths(self):
-        """(lower, upper) half-bandwidths of :meth:`pattern`, from the layout alone."""
-        # The pattern is block-periodic, so three blocks tell the whole story.
-        small = StateLayout(min(self.n_elements, 3))
-        rows, cols = np.nonzero(small.pattern())
+    def bandwidths(self, depends):
+        """(lower, upper) half-bandwidths of :meth:`pattern` (headers excluded)."""
+        # The pattern is block-periodic: three blocks tell the whole story.
+        small = BlockLayout(min(self.n_blocks, 3), self.fields, 0)
+        rows, cols = np.nonzero(small.pattern(depends))
         return int(np.max(rows - cols)), int(np.max(cols - rows))
+
+    def column_reach(self, depends):
+        """For each entry j of a block, the (lowest, highest) offset of the
+        blocks whose rows depend on it, or None if no row does."""
+        sl = self.slices()
+        reach = [None] * self.block
+        for deps in depends.values():
+            for offset, cols in deps.items():
+                for c in cols:
+                    for j in range(sl[c].start, sl[c].stop):
+                        lo, hi = reach[j] or (-offset, -offset)
+                        reach[j] = (min(lo, -offset), max(hi, -offset))
+        return reach
+
+    def colouring(self, depends):
+        """Column groups for finite differences, as an int array (n_groups, 4):
+        (entry j, residue r, period p, lowest row offset). A group perturbs
+        entry j of every block b with b % p == r: the row blocks b + lo ..
+        b + lo + p - 1 they reach are then disjoint between members."""
+        groups = []
+        for j, reach in enumerate(self.column_reach(depends)):
+            if reach is None:
+                continue
+            lo, hi = reach
+            period = hi - lo + 1
+            groups += [(j, r, period, lo) for r in range(min(period, self.n_blocks))]
+        return np.array(groups, dtype=np.int64).reshape(-1, 4)
+
+
+class StateLayout(BlockLayout):
+    """Owns the packing of the rod's state vector for N elements."""
+
+    def __init__(self, n_elements):
+        super().__init__(n_elements, dict(STATE_FIELDS), HEADER)
+
+    @property
+    def n_elements(self):
+        return self.n_blocks
+
+    def base_position(self, y):
+        """(..., 3) base position u0 [m], global."""
+        return np.asarray(y)[..., 0:3]
+
+    def base_quaternion(self, y):
+        """(..., 4) base orientation Q0."""
+        return np.asarray(y)[..., 3:HEADER]
+
+    def quaternions(self, y):
+        """(..., N+1, 4) orientations of nodes 0..N (node 0: the base)."""
+        return np.concatenate([self.base_quaternion(y)[..., None, :], self.field(y, "Q")], axis=-2)
+
+    def integrated_positions(self, y):
+        """(..., N+1, 3) time-integrated positions of nodes 0..N [m], global."""
+        return np.concatenate([self.base_position(y)[..., None, :], self.field(y, "u")], axis=-2)
+
+    def tip_slice(self, name):
+        """Index range of field ``name`` of the tip node's block."""
+        sl = FIELDS[name]
+        start = HEADER + BLOCK * (self.n_blocks - 1)
+        return slice(start + sl.start, start + sl.stop)
+
+    def pack(self, u0, quat0, u, quat, q, k, v, w):
+        y = np.empty(self.size)
+        y[0:3], y[3:HEADER] = u0, quat0
+        b = self.blocks(y)
+        for name, value in zip(STATE_FIELDS, (u, quat, q, k, v, w)):
+            b[:, FIELDS[name]] = value
+        return y
+
+    def straight(self, s_nodes, position, rotation, quaternion):
+        """The undeformed rod at rest along the base's local x axis."""
+        n = self.n_blocks
+        u = np.asarray(position) + s_nodes[1:, None] * np.asarray(rotation)[:, 0]
+        zeros = np.zeros((n, 3))
+        q = np.tile([1.0, 0.0, 0.0], (n, 1))
+        return self.pack(position, quaternion, u, np.tile(quaternion, (n, 1)), q, zeros, zeros, zeros)
+
+    def scales(self, length):
+        """Typical magnitude of every entry (for absolute tolerances and
+        difference increments): positions L, quaternions 1, strains q 1,
+        curvatures 1/L, velocities L/(1 s), angular velocities 1 rad/s."""
+        per_field = {"u": length, "Q": 1.0, "q": 1.0, "k": 1.0 / length, "v": length, "w": 1.0}
+        block = np.concatenate([np.full(w, per_field[f]) for f, w in STATE_FIELDS.items()])
+        head = np.concatenate([np.full(w, per_field[f]) for f, w in HEADER_FIELDS.items()])
+        return np.concatenate([head, np.tile(block, self.n_blocks)])
+
+    def header_pattern(self):
+        """The base pose integrates prescribed base velocities: u0 and Q0
+        rates read Q0 only."""
+        pat = np.zeros((HEADER, HEADER), dtype=bool)
+        pat[:, 3:HEADER] = True
+        return pat
+
+    def entry_name(self, index):
+        """A readable name of state entry ``index`` (``"k[2] of element 7"``)."""
+        if index < HEADER:
+            return f"base {'u' if index < 3 else 'Q'}[{index if index < 3 else index - 3}]"
+        b, j = divmod(index - HEADER, BLOCK)
+        name = next(f for f, sl in FIELDS.items() if sl.start <= j < sl.stop)
+        return f"{name}[{j - FIELDS[name].start}] of element {b}"

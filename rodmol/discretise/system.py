@@ -1,29 +1,26 @@
-"""The semi-discrete right-hand side dy/dt = f(t, y) of eq. (12), paper's upwind scheme.
+"""The semi-discrete system dy/dt = f(t, y) of a model, as the solvers see it.
 
-Forward differences (toward the tip) for v and w in the compatibility laws,
-backward differences (toward the base) for the stresses in the balance laws.
-The plain numpy implementation here, vectorised over nodes, is the reference
-(``balance``/``stresses`` also serve post-processing with a leading time
-axis); by default ``SemiDiscrete.__call__`` runs the same equations compiled
-by numba (:mod:`rodmol.kernels`), which is what the time integrators call.
+:class:`SemiDiscrete` packs a :class:`rodmol.Model` once for the compiled
+scheme, evaluates the time-dependent inputs (tensions, base velocities, load
+values) at each call, and owns the structure the solvers need: the state
+layout, the Jacobian pattern and bandwidths derived from the scheme's and the
+loads' declared dependencies, and factories for the compiled Jacobian and the
+block preconditioner. Backends and the equilibrium solver use only this
+interface (``size``, ``__call__``, ``layout``, ``pattern``, ``bandwidths``,
+``jacobian``, ``preconditioner``, ``global_coupling``).
 """
-
-import warnings
 
 import numpy as np
 
-from . import centreline, upwind, body_loads, rotations
-from ..cables import ConstantTension
-from ..errors import ParameterError
-from .layout import FIELDS, HEADER, StateLayout
-from ..model import Q_STAR
-
-#: Implementations of ``SemiDiscrete.__call__``.
-KERNELS = ("numba", "numpy")
+from . import centreline, external, rotations, upwind
+from .layout import StateLayout, merge
 
 #: Rate [1/s] at which the quaternion norm is pulled back to 1; the exact
 #: dynamics keep |Q| = 1, so this only damps integration drift.
 QUATERNION_RESTORING_RATE = 1.0
+#: Smoothing speed [m/s] of |v| in the drag law, so the implicit solver's
+#: Newton iterations see a differentiable right-hand side near v = 0.
+DRAG_SMOOTHING_SPEED = 1e-6
 
 
 class StateView:
@@ -41,233 +38,176 @@ class StateView:
         if name in ("q", "k", "v", "w"):
             return self._layout.field(self._y, name)
         if name == "rotations":
-            return rotations.matrices(self._quaternions())
+            return rotations.matrices(self._layout.quaternions(self._y))
         if name == "positions":
-            return centreline.positions(self._y[:3], self._quaternions(), self.q, self.k, self._ds)
+            return centreline.positions(self._layout.base_position(self._y),
+                                        self._layout.quaternions(self._y), self.q, self.k, self._ds)
         if name == "tip":
             return self.positions[-1]
         raise AttributeError(name)
 
-    def _quaternions(self):
-        return np.vstack([self._y[3:7], self._layout.field(self._y, "Q")])
-
 
 class SemiDiscrete:
-    """Right-hand side of the method-of-lines system of a :class:`rodmol.Model`.
+    """The method-of-lines system of a :class:`rodmol.Model` (paper's upwind scheme).
 
     Parameters
     ----------
     model : Model
-    kernel : "numba" or "numpy"
-        Implementation of :meth:`__call__`: the compiled loops of
-        :mod:`rodmol.kernels` (default; falls back to numpy with a warning
-        if numba is not installed) or the vectorised numpy reference.
     """
 
-    def __init__(self, model, kernel="numba"):
-        if kernel not in KERNELS:
-            raise ParameterError(f"unknown `kernel` {kernel!r}; valid: {list(KERNELS)}")
-        if kernel == "numba" and not upwind.AVAILABLE:
-            warnings.warn("numba is not installed: using the (slower) numpy right-hand side",
-                          RuntimeWarning, stacklevel=2)
-            kernel = "numpy"
+    scheme = upwind
+
+    def __init__(self, model):
         self.model = model
         self.layout = StateLayout(model.n_elements)
         self.size = self.layout.size
-        self.kernel = kernel
-        self._feedback = model.feedback  # a property that loops over the cables: read it once
-        self._classify_cables()
-        if kernel == "numba":
-            self._setup_compiled()
+        self.global_coupling = model.feedback  # feedback tensions read the whole state
+        m = model
+        self._params = upwind.pack_params(m.kl, m.kth, m.vl, m.vth, m.mass, m.inertia, m.net_mass,
+                                          m.drag_coefficient, m.added)
+        self._consts = np.array([m.ds, QUATERNION_RESTORING_RATE, DRAG_SMOOTHING_SPEED**2,
+                                 1.0 if m.munk_moment else 0.0, *m.gravity])
+        self._work = np.zeros((m.n_elements, upwind.WORK_COLUMNS))
+        self.base_velocities = np.zeros(6)
+        self._fixed_base = m.base.fixed
+        self._setup_cables()
+        self._setup_loads()
+        self.depends = merge(self.scheme.DEPENDS, external.dependency_table(set(self._kinds)))
+        self._inputs_vary = bool(self.global_coupling or self._timed or self._timed_loads
+                                 or not self._fixed_base)
+        # The kernel's arguments: arrays whose contents update_inputs refreshes in place.
+        self._args = (self._params, self._consts, self._offsets, self._weights, self.tension_values,
+                      self.base_velocities, self._kinds, self._nodes, self._entry_weights,
+                      self._entry_params, self.entry_values, self._work)
 
-    def stresses(self, q, k, q_t, k_t, tensions):
-        """Total internal stress at the strain nodes: Kelvin-Voigt plus cable actuation.
+    # ------------------------------------------------------------------ inputs
 
-        Returns (N_el, M_el, N_tot, M_tot), each (N, 3), local frame [N, N m].
-        """
+    def _setup_cables(self):
+        """Sort the cables by how their tension is evaluated, once: constant
+        tensions are read here (slack ones are left out of the kernel), the
+        time-dependent ones at each call; feedback laws read the state, so
+        then every cable is evaluated at each call."""
         m = self.model
-        n_el = m.kl * (q - Q_STAR) + m.vl * q_t
-        m_el = m.kth * k + m.vth * k_t
-        n_tot, m_tot = n_el.copy(), m_el.copy()
-        for p, tension, weight in zip(m.cable_offsets, np.moveaxis(tensions, -1, 0),
-                                      m.cable_weights):
-            if np.any(tension):
-                n_a, m_a = body_loads.cable_stress(q, k, p, tension, weight)
-                n_tot += n_a
-                m_tot += m_a
-        return n_el, m_el, n_tot, m_tot
+        constant = [c.tension.constant for c in m.cables]
+        if self.global_coupling:
+            active = list(range(len(m.cables)))
+        else:
+            active = [i for i, value in enumerate(constant) if value != 0.0]
+        self._active = np.array(active, dtype=int)
+        self._offsets = np.ascontiguousarray(m.cable_offsets[self._active]).reshape(-1, 3)
+        self._weights = np.ascontiguousarray(m.cable_weights[self._active]).reshape(
+            len(active), m.n_elements)
+        self.tension_values = np.array([constant[i] or 0.0 for i in active])
+        self._timed = [(j, m.cables[i]) for j, i in enumerate(active) if constant[i] is None]
 
-    def strain_rates(self, q, k, v, w, v0, w0):
-        """Compatibility laws (eq. 2) with forward differences of v and w.
+    def _setup_loads(self):
+        entries = self.model.grid_loads
+        self._kinds = np.ascontiguousarray(entries.kind, dtype=np.int64)
+        self._nodes = np.ascontiguousarray(entries.node - 1, dtype=np.int64)  # element blocks
+        self._entry_weights = np.ascontiguousarray(entries.weight, dtype=float)
+        self._entry_params = np.ascontiguousarray(entries.params, dtype=float).reshape(-1, external.N_PARAMS)
+        self.entry_values = np.ascontiguousarray(entries.initial, dtype=float).reshape(-1, 3)
+        self._timed_loads = entries.values
 
-        Returns (q_t, k_t) at the strain nodes, (..., N, 3), local frame.
-        """
-        ds = self.model.ds
-        v_str = _prepend(v0, v[..., :-1, :])  # velocities at strain nodes 0..N-1
-        w_str = _prepend(w0, w[..., :-1, :])
-        q_t = (v - v_str) / ds + body_loads.cross(k, v_str) - body_loads.cross(w_str, q)
-        k_t = (w - w_str) / ds + body_loads.cross(k, w_str)
-        return q_t, k_t
-
-    def balance(self, q, k, quat, v, w, v0, w0, tensions, gravity, rates=None):
-        """Strain rates and the net force/torque densities at the velocity nodes.
-
-        Returns (q_t, k_t, force, torque), each (N, 3), local frame; the
-        accelerations are force / mass and torque / inertia. Every argument
-        may carry a leading time axis: fields (n_t, N, 3), base velocities
-        (n_t, 3), tensions (n_t, n_cables). ``rates`` = (q_t, k_t) skips
-        the compatibility laws when the strain rates are known (zero at rest).
-        """
+    def update_inputs(self, t, y=None):
+        """Evaluate the time-dependent inputs at t, in place: the tensions of
+        the cables the kernel sees, the base velocities (v0, w0) and the
+        values of time-dependent loads. ``y`` is read by feedback tensions."""
         m = self.model
-        ds = m.ds
-        q_t, k_t = self.strain_rates(q, k, v, w, v0, w0) if rates is None else rates
-        _, _, n_tot, m_tot = self.stresses(q, k, q_t, k_t, tensions)
+        if self.global_coupling:
+            state = StateView(self.layout, t, y, m.ds) if y is not None else None
+            self.tension_values[:] = m.tensions(t, state)
+        else:
+            for j, cable in self._timed:
+                self.tension_values[j] = cable.tension_at(t)
+        if not self._fixed_base:
+            v0, w0 = m.base.velocities(t)
+            self.base_velocities[:3], self.base_velocities[3:] = v0, w0
+        for rows, values in self._timed_loads:
+            self.entry_values[rows] = values(t)
 
-        # Values at velocity nodes 1..N; at the tip the total stress vanishes.
-        zero = np.zeros(3)
-        n_next = _append(n_tot[..., 1:, :], zero)
-        m_next = _append(m_tot[..., 1:, :], zero)
-        k_next = _append(k[..., 1:, :], zero)
-        q_next = _append(q[..., 1:, :], Q_STAR)
-
-        force = (n_next - n_tot) / ds + body_loads.cross(k_next, n_next)
-        force += body_loads.gyroscopic_force(w, m.mass, v)
-        if np.any(gravity) and np.any(m.net_mass):
-            force += body_loads.gravity_buoyancy(rotations.matrices(quat), m.net_mass, gravity)
-        if m.drag:
-            force += body_loads.drag(v, m.drag_coefficient)
-        torque = ((m_next - m_tot) / ds + body_loads.cross(k_next, m_next)
-                  + body_loads.cross(q_next, n_next) + body_loads.gyroscopic_torque(w, m.inertia))
-        if m.munk_moment:
-            torque += body_loads.munk_torque(v, m.added)
-        return q_t, k_t, force, torque
-
-    def tensions(self, t, y):
+    def tensions(self, t, y=None):
         """Tensions of all cables at (t, y), shape (n_cables,) [N]."""
-        if self._feedback:
-            return self.model.tensions(t, StateView(self.layout, t, y, self.model.ds))
-        full = self._constant_tensions.copy()
-        for i, cable in self._others:
-            full[i] = cable.tension_at(t)
-        return full
+        state = StateView(self.layout, t, y, self.model.ds) if self.global_coupling and y is not None else None
+        return self.model.tensions(t, state)
 
-    def _classify_cables(self):
-        """Sort the cables by how their tension is evaluated, once.
+    def kernel_arguments(self):
+        """Arguments of :func:`rodmol.discretise.upwind.rhs` after (y, out):
+        the packed model, the inputs :meth:`update_inputs` refreshes, scratch."""
+        return self._args
 
-        The right-hand side needs the tensions at every call: constant
-        tensions are read once here (slack cables are dropped from the kernel)
-        and only the time-dependent ones are called each time. Feedback
-        tensions read the state, so then every cable goes the general way.
-        """
-        cables = self.model.cables
-        self._constant_tensions = np.zeros(len(cables))
-        self._others, active = [], []
-        for i, c in enumerate(cables):
-            if isinstance(c.tension, ConstantTension):
-                self._constant_tensions[i] = c.tension.value
-                if c.tension.value == 0.0:
-                    continue
-            else:
-                self._others.append((i, c))
-            active.append(i)
-        # Cables the kernel sees: all of them with feedback, else the non-slack ones.
-        self._active = np.arange(len(cables)) if self._feedback else np.array(active, dtype=int)
+    # ------------------------------------------------------------------ evaluation
 
     def __call__(self, t, y, out=None):
         """dy/dt at (t, y); writes into ``out`` if given (CVODE's ``yp``)."""
-        if self.kernel == "numba":
-            return self._compiled(t, y, out)
-        return self._reference(t, y, out)
+        if out is None:
+            out = np.empty(self.size)
+        if self._inputs_vary:
+            self.update_inputs(t, y)
+        self.scheme.rhs(y, out, *self._args)
+        return out
+
+    def rest_rates(self, t, y, out, load_factor=1.0):
+        """dy/dt at (t, y) with every applied load (gravity, tensions, external
+        load values) scaled by ``load_factor``, for the equilibrium's
+        continuation. Feedback tensions are evaluated with ``state=None``."""
+        self.update_inputs(t, None)
+        args = self.kernel_arguments()
+        if load_factor != 1.0:
+            consts = self._consts.copy()
+            consts[4:7] *= load_factor
+            args = (args[0], consts, args[2], args[3], args[4] * load_factor, *args[5:10],
+                    args[10] * load_factor, args[11])
+        self.scheme.rhs(y, out, *args)
+        return out
 
     def rates(self, t, states):
-        """dy/dt at each of the frames ``states`` (n_t, size) at times ``t`` (n_t,).
-
-        With the numba kernel this costs a few microseconds per frame.
-        """
+        """dy/dt at each of the frames ``states`` (n_t, size) at times ``t`` (n_t,)."""
         states = np.asarray(states, dtype=float)
         out = np.empty_like(states)
         for i, (ti, yi) in enumerate(zip(np.asarray(t, dtype=float), states)):
             self(float(ti), yi, out[i])
         return out
 
-    def _setup_compiled(self):
-        """Pack the model for the compiled kernel, once (parameter arrays,
-        cable geometry of the cables the kernel sees, input buffers)."""
-        m = self.model
-        self._params, self._consts, offsets, weights = upwind.pack_model(
-            m, QUATERNION_RESTORING_RATE, body_loads.DRAG_SMOOTHING_SPEED)
-        self._work = np.empty((m.n_elements, 6))
-        self.base_velocities = np.zeros(6)
-        self._fixed_base = m.base.fixed
-        self._offsets = np.ascontiguousarray(offsets[self._active])
-        self._weights = np.ascontiguousarray(weights[self._active])
-        self.tension_values = np.ascontiguousarray(self._constant_tensions[self._active])
-        # Positions in tension_values of the cables evaluated per call.
-        where = {int(i): j for j, i in enumerate(self._active)}
-        self._kernel_others = [(where[i], c) for i, c in self._others]
+    def frames(self, t, states):
+        """Per-frame sectional stresses and external loads, from the same kernel.
 
-    def update_inputs(self, t, y=None):
-        """Evaluate the time-dependent inputs of the compiled kernel at t, in place.
-
-        Fills ``self.tension_values`` (the cables the kernel sees) and
-        ``self.base_velocities`` (v0, w0). ``y`` (storage layout) is only
-        read by feedback tensions.
+        Returns (stress (n_t, N, 6): Kelvin-Voigt N, M at the strain nodes
+        [N, N m]; loads (n_t, N, 6): external force and moment densities at the
+        velocity nodes 1..N [N/m, N m/m]), local frame.
         """
-        tensions = self.tension_values
-        if self._feedback:
-            tensions[:] = self.model.tensions(t, StateView(self.layout, t, y, self.model.ds))
-        else:
-            for j, cable in self._kernel_others:
-                tensions[j] = cable.tension_at(t)
-        if not self._fixed_base:
-            v0, w0 = self.model.base.velocities(t)
-            self.base_velocities[:3], self.base_velocities[3:] = v0, w0
+        states = np.asarray(states, dtype=float)
+        n_t, n = len(states), self.model.n_elements
+        stress, loads = np.empty((n_t, n, 6)), np.empty((n_t, n, 6))
+        out = np.empty(self.size)
+        for i, (ti, yi) in enumerate(zip(np.asarray(t, dtype=float), states)):
+            self(float(ti), yi, out)
+            stress[i], loads[i] = self._work[:, 0:6], self._work[:, 12:18]
+        return stress, loads
 
-    def kernel_arguments(self):
-        """Arguments of :func:`rodmol.upwind.rhs` after (y, out): the packed
-        model, the input arrays refreshed by :meth:`update_inputs`, scratch."""
-        return (self._params, self._consts, self._offsets, self._weights, self.tension_values,
-                self.base_velocities, self._work)
+    # ------------------------------------------------------------------ structure
 
-    def _compiled(self, t, y, out=None):
-        if out is None:
-            out = np.empty(self.size)
-        self.update_inputs(t, y)
-        upwind.rhs(y, out, self._params, self._consts, self._offsets, self._weights,
-                    self.tension_values, self.base_velocities, self._work)
-        return out
+    def pattern(self):
+        """Structural Jacobian pattern (bool, size x size). Feedback tensions
+        are global couplings and are not in it (see ``global_coupling``)."""
+        return self.layout.pattern(self.depends, self.layout.header_pattern())
 
-    def _reference(self, t, y, out=None):
-        m, lay = self.model, self.layout
-        out = np.empty(self.size) if out is None else out
-        b = lay.blocks(y)
-        quat, q, k, v, w = (b[:, FIELDS[f]] for f in ("Q", "q", "k", "v", "w"))
-        v0, w0 = m.base.velocities(t)
-        q_t, k_t, force, torque = self.balance(q, k, quat, v, w, v0, w0,
-                                               self.tensions(t, y), m.gravity)
-        ob = lay.blocks(out)
-        ob[:, FIELDS["q"]] = q_t
-        ob[:, FIELDS["k"]] = k_t
-        ob[:, FIELDS["v"]] = force / m.mass
-        ob[:, FIELDS["w"]] = torque / m.inertia
-        ob[:, FIELDS["u"]] = np.einsum("nij,nj->ni", rotations.matrices(quat), v)
-        ob[:, FIELDS["Q"]] = _quaternion_rate(quat, w)
-        quat0 = y[3:7]
-        out[:3] = rotations.matrices(quat0) @ v0
-        out[3:HEADER] = _quaternion_rate(quat0, w0)
-        return out
+    def bandwidths(self):
+        """(lower, upper) half-bandwidths of :meth:`pattern`."""
+        return self.layout.bandwidths(self.depends)
 
+    def atol_scale(self):
+        """Typical magnitude of each state entry (see ``StateLayout.scales``)."""
+        return self.layout.scales(self.model.rod.length)
 
-def _prepend(row, rows):
-    row = np.broadcast_to(np.expand_dims(row, -2), rows.shape[:-2] + (1, 3))
-    return np.concatenate([row, rows], axis=-2)
+    def jacobian(self, scale, matrix="band"):
+        """The compiled finite-difference Jacobian (scikit-sundae ``jacfn``)."""
+        from .jacobian import CompiledJacobian
 
+        return CompiledJacobian(self, scale, matrix)
 
-def _append(rows, row):
-    row = np.broadcast_to(np.expand_dims(row, -2), rows.shape[:-2] + (1, 3))
-    return np.concatenate([rows, row], axis=-2)
+    def preconditioner(self, scale):
+        """The exact block preconditioner of CVODE's Newton matrix."""
+        from .preconditioner import BlockPreconditioner
 
-
-def _quaternion_rate(quat, omega):
-    norm2 = np.sum(quat * quat, axis=-1, keepdims=True)
-    return rotations.rate(quat, omega) + QUATERNION_RESTORING_RATE * (1.0 - norm2) * quat
+        return BlockPreconditioner(self, scale)

@@ -1,51 +1,63 @@
 """Static equilibrium of the discrete rod: damped Newton with load continuation.
 
-Unknowns per element b: the strains q_b, k_b and the orientation Q_{b+1} of the
-next velocity node. Equations: the discrete force and torque balance of the
-dynamic right-hand side at rest (v = w = 0), and the pose compatibility
-Q_{b+1} = Q_b exp(ds k_b). The Jacobian is banded, built by grouped finite
-differences and factorised with ``scipy.linalg.solve_banded``, so the cost
-grows linearly with the number of elements.
+Unknowns per element b: the pose (u, Q) of velocity node b + 1 and the strains
+(q, k) of strain node b. Equations: the force and torque balance of the
+system's own right-hand side at rest (v = w = 0), so every load the dynamics
+sees acts here too, and the pose compatibility of the element, Q_{b+1} =
+Q_b exp(ds k_b) and u_{b+1} = u_b + the chord of ``centreline.chords`` (so
+the resting state's positions are the ones ``Result.positions`` rebuilds).
+The Jacobian is banded, with half-bandwidths derived from the system's
+dependency table, built by grouped finite differences and factorised with
+``scipy.linalg.solve_banded``: the cost grows linearly with N.
 """
 
 import numpy as np
 from scipy.linalg import solve_banded
 
 from ..discretise import centreline, rotations
-from ..errors import EquilibriumError
-from ..model import Q_STAR, Model
+from ..discretise.layout import BlockLayout
 from ..discretise.system import SemiDiscrete
+from ..errors import EquilibriumError, ParameterError
+from ..model import Model
 
-_BLOCK = 10  # q (3), k (3), Q (4)
-# Half-bandwidths of the residual's Jacobian: the balance at node b+1 (rows 0-5
-# of block b) reads q, k of block b+1 (columns 0-5 of the next block); the
-# compatibility of Q_{b+1} (rows 6-9) reads Q_b (columns 6-9 of the block before).
-_LOWER, _UPPER = 9 - (6 - _BLOCK), (_BLOCK + 5) - 0
+#: Unknowns per element, and the equation each row of a block carries:
+#: u -> position compatibility, Q -> orientation compatibility, q -> force
+#: balance, k -> torque balance.
+STATIC_FIELDS = {"u": 3, "Q": 4, "q": 3, "k": 3}
+_COMPATIBILITY = {"u": {-1: ("u", "Q"), 0: ("u", "q", "k")}, "Q": {-1: ("Q",), 0: ("Q", "k")}}
 
 
-def equilibrium(model, t=0.0, *, tol=1e-10, max_iter=40):
+def static_dependencies(depends):
+    """The equilibrium's dependency table, from the system's."""
+    def at_rest(row):
+        return {off: tuple(c for c in cols if c in STATIC_FIELDS) for off, cols in depends[row].items()}
+    return {**_COMPATIBILITY, "q": at_rest("v"), "k": at_rest("w")}
+
+
+def equilibrium(model, t=0.0, *, tol=1e-10, max_iter=40, system=None):
     """Static equilibrium of ``model`` under its loads at time ``t``.
 
-    Gravity, buoyancy and the cable tensions at ``t`` are applied; velocities
-    are zero. Newton's method is tried on the full load first and, if it
-    fails, on a continuation path that ramps the loads from zero.
+    Gravity, buoyancy, the cable tensions and the external loads at ``t`` are
+    applied (contact included); velocities are zero. Newton's method is tried
+    on the full load first and, if it fails, on a continuation path that
+    ramps the loads from zero.
 
     Parameters
     ----------
     model : Model
     t : float
-        Time [s] at which the cable tensions are evaluated.
+        Time [s] at which the time-dependent inputs are evaluated.
     tol : float
-        Required max-norm of the force and torque residuals, relative to
-        the load scale (net weight plus tensions, see ``Model.load_scale``);
-        raised to the round-off floor of the difference quotients on very
-        fine grids (about 2e-9 at N = 800 for the paper's arm).
+        Required max-norm of the force and torque residuals, relative to the
+        load scale (``Model.load_scale``); raised to the round-off floor of
+        the difference quotients on very fine grids.
+    system : SemiDiscrete, optional
+        The model's system, if one is built already (``simulate`` passes its own).
 
     Returns
     -------
     numpy.ndarray
-        A state vector (see ``rodmol.layout``) that is a rest state of the
-        dynamic right-hand side.
+        A state vector that is a rest state of the dynamic right-hand side.
 
     Raises
     ------
@@ -53,36 +65,48 @@ def equilibrium(model, t=0.0, *, tol=1e-10, max_iter=40):
         If no equilibrium is found (e.g. a buckling load).
     """
     if not isinstance(model, Model):
-        raise TypeError(f"`model` must be a rodmol.Model, got {model!r}")
-    system = SemiDiscrete(model)
-    n = model.n_elements
+        raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
+    system = SemiDiscrete(model) if system is None else system
+    layout, n, ds = system.layout, model.n_elements, model.ds
+    static = BlockLayout(n, dict(STATIC_FIELDS))
+    sl = static.slices()
+    base = model.base
+    quat0 = rotations.from_matrix(base.rotation)
+    u0 = np.asarray(base.position, dtype=float)
+    y = layout.straight(model.s_nodes, u0, np.asarray(base.rotation, dtype=float), quat0)
+    z = np.hstack([layout.field(y, f) for f in STATIC_FIELDS]).ravel()
     scale = model.load_scale(t)
-    # Feedback tensions get state=None here: there is no motion yet to feed back.
-    tensions = model.tensions(t, None)
-    quat0 = rotations.from_matrix(model.base.rotation)
-    z = np.tile(np.concatenate([Q_STAR, np.zeros(3), quat0]), n)
-    if scale == 0.0:
-        return _state(model, system, z, quat0)
+    if scale == 0.0 and not model.loads:
+        return y
 
+    scale = scale or 1.0  # contact alone: forces of the order of 1 N
     f_scale = scale / model.rod.length
     # Differencing stresses of size EA * strain over ds loses digits as N grows:
     # never ask for less than ten times that round-off floor.
-    tol = max(tol, 10 * np.finfo(float).eps * np.max(model.kl) / (model.ds * f_scale))
-    zeros = np.zeros((n, 3))
+    tol = max(tol, 10 * np.finfo(float).eps * np.max(model.kl) / (ds * f_scale))
+    mass, inertia = model.mass, model.inertia
+    rates = np.empty(layout.size)
 
     def residual(z, lam):
-        zb = z.reshape(n, _BLOCK)
-        q, k, quat = zb[:, :3], zb[:, 3:6], zb[:, 6:]
-        _, _, force, torque = system.balance(q, k, quat, zeros, zeros, zeros[0], zeros[0],
-                                             lam * tensions, lam * model.gravity, (zeros, zeros))
-        prev = np.vstack([quat0, quat[:-1]])
-        compat = quat - rotations.multiply(prev, rotations.from_rotation_vector(model.ds * k))
-        return np.hstack([force / f_scale, torque / scale, compat]).ravel()
+        zb = static.blocks(z)
+        for f in STATIC_FIELDS:
+            layout.field(y, f)[:] = zb[:, sl[f]]
+        system.rest_rates(t, y, rates, lam)
+        u, quat, q, k = (zb[:, sl[f]] for f in STATIC_FIELDS)
+        u_prev = np.vstack([u0, u[:-1]])
+        q_prev = np.vstack([quat0, quat[:-1]])
+        out = np.empty_like(zb)
+        out[:, sl["u"]] = (u - u_prev - centreline.chords(q_prev, q, k, ds)) / ds
+        out[:, sl["Q"]] = quat - rotations.multiply(q_prev, rotations.from_rotation_vector(ds * k))
+        out[:, sl["q"]] = layout.field(rates, "v") * mass / f_scale
+        out[:, sl["k"]] = layout.field(rates, "w") * inertia / scale
+        return out.ravel()
 
+    bands = static.bandwidths(static_dependencies(system.depends))
     lam, step = 0.0, 1.0
     while lam < 1.0:
         target = min(1.0, lam + step)
-        z_new = _newton(lambda x, lam=target: residual(x, lam), z, tol, max_iter)
+        z_new = _newton(lambda x, lam=target: residual(x, lam), z, tol, max_iter, bands)
         if z_new is not None:
             z, lam, step = z_new, target, min(1.0, 2.0 * step)
         else:
@@ -91,10 +115,15 @@ def equilibrium(model, t=0.0, *, tol=1e-10, max_iter=40):
                 raise EquilibriumError(
                     f"no static equilibrium found beyond {lam:.4g} of the loads at t = {t} s "
                     "(the rod may buckle under these loads)")
-    return _state(model, system, z, quat0)
+    zb = static.blocks(z)
+    quat = zb[:, sl["Q"]] / np.linalg.norm(zb[:, sl["Q"]], axis=1, keepdims=True)
+    q, k = zb[:, sl["q"]], zb[:, sl["k"]]
+    u = centreline.positions(u0, np.vstack([quat0, quat]), q, k, ds)[1:]
+    zeros = np.zeros((n, 3))
+    return layout.pack(u0, quat0, u, quat, q, k, zeros, zeros)
 
 
-def _newton(fun, z, tol, max_iter):
+def _newton(fun, z, tol, max_iter, bands):
     """Damped Newton on a banded system; None if it does not converge."""
     f = fun(z)
     norm = np.linalg.norm(f)
@@ -102,7 +131,7 @@ def _newton(fun, z, tol, max_iter):
         if np.max(np.abs(f)) < tol:
             return z
         try:
-            dz = solve_banded((_LOWER, _UPPER), _banded_jacobian(fun, z, f), -f)
+            dz = solve_banded(bands, _banded_jacobian(fun, z, f, bands), -f)
         except (np.linalg.LinAlgError, ValueError):
             return None
         alpha = 1.0
@@ -119,10 +148,10 @@ def _newton(fun, z, tol, max_iter):
     return z if np.max(np.abs(f)) < tol else None
 
 
-def _banded_jacobian(fun, z, f0):
+def _banded_jacobian(fun, z, f0, bands):
     """Finite-difference Jacobian in ``solve_banded`` storage, one group of
     columns per evaluation (columns further apart than the band never share rows)."""
-    lo, up = _LOWER, _UPPER
+    lo, up = bands
     width = lo + up + 1
     size = z.size
     ab = np.zeros((width, size))
@@ -137,15 +166,3 @@ def _banded_jacobian(fun, z, f0):
             ok = (rows >= 0) & (rows < size)
             ab[up + d, cols[ok]] = df[rows[ok]] / h[cols[ok]]
     return ab
-
-
-def _state(model, system, z, quat0):
-    """Full state vector: pose rebuilt from the strains, velocities zero."""
-    n, ds = model.n_elements, model.ds
-    zb = z.reshape(n, _BLOCK)
-    q, k, quat = zb[:, :3], zb[:, 3:6], zb[:, 6:]
-    quat = quat / np.linalg.norm(quat, axis=1, keepdims=True)
-    u0 = np.asarray(model.base.position, dtype=float)
-    u = centreline.positions(u0, np.vstack([quat0, quat]), q, k, ds)[1:]
-    zeros = np.zeros((n, 3))
-    return system.layout.pack(u0, quat0, u, quat, q, k, zeros, zeros)

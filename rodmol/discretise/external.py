@@ -1,0 +1,110 @@
+"""External loads at the velocity nodes, compiled: the kinds, their parameter
+rows, what each reads of the state, and the one function that evaluates them.
+
+A model's external loads (:mod:`rodmol.loads`) become *entries*: (kind,
+velocity node, weight, parameter row, value). Every entry adds ``weight`` times
+its force and moment densities to its node's balance laws, in the local frame.
+
+To add a kind: give it a code, its parameter columns and its dependencies in
+:data:`DEPENDS` (the Jacobian's pattern, colouring and preconditioner are
+derived from them), and a branch in :func:`load`. The Jacobian test covers
+every code in :data:`DEPENDS`.
+"""
+
+import numpy as np
+
+from .physics import add, cross, dot, jit, rotation, scale, sub, to_global, to_local
+
+FOLLOWER_FORCE, DEAD_FORCE, FOLLOWER_MOMENT, DEAD_MOMENT, PLANE, CAPSULE = range(6)
+
+#: Which fields of its own element block each kind reads (force rows "v" and
+#: moment rows "w" of that block are the ones written).
+DEPENDS = {
+    FOLLOWER_FORCE: (),
+    DEAD_FORCE: ("Q",),
+    FOLLOWER_MOMENT: (),
+    DEAD_MOMENT: ("Q",),
+    PLANE: ("u", "Q", "v", "w"),
+    CAPSULE: ("u", "Q", "v", "w"),
+}
+
+# Parameter row of the contact kinds: geometry (plane: point, normal; capsule:
+# start, end, radius), then the law and the section radius at the node.
+N_PARAMS = 12
+P_STIFFNESS, P_DAMPING, P_FRICTION, P_SLIP, P_RADIUS = 7, 8, 9, 10, 11
+
+
+def dependency_table(kinds):
+    """The dependency table (see :mod:`rodmol.discretise.layout`) of a set of kinds."""
+    cols = tuple(dict.fromkeys(f for kind in kinds for f in DEPENDS[int(kind)]))
+    return {"v": {0: cols}, "w": {0: cols}} if cols else {}
+
+
+@jit
+def contact_depth(kind, p, u):
+    """Penetration depth [m] of a tube section centred at u (global) into the
+    obstacle of parameter row p, and the obstacle's outward unit normal there."""
+    if kind == PLANE:
+        n = (p[3], p[4], p[5])
+        return p[P_RADIUS] - dot(n, sub(u, (p[0], p[1], p[2]))), n
+    a, b = (p[0], p[1], p[2]), (p[3], p[4], p[5])
+    axis = sub(b, a)
+    length2 = dot(axis, axis)
+    x = 0.0 if length2 == 0.0 else min(1.0, max(0.0, dot(sub(u, a), axis) / length2))
+    d = sub(u, add(a, scale(x, axis)))
+    dist = np.sqrt(dot(d, d))
+    n = scale(1.0 / dist, d) if dist > 0.0 else (0.0, 1.0, 0.0)
+    return p[6] + p[P_RADIUS] - dist, n
+
+
+@jit
+def contact(kind, p, u, r, v, w):
+    """Penalty contact with regularised Coulomb friction (see rodmol.loads),
+    acting at the surface point; returns (force, moment) densities, local."""
+    depth, n_global = contact_depth(kind, p, u)
+    if depth <= 0.0:
+        return (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    n = to_local(r, n_global)
+    arm = scale(-p[P_RADIUS], n)  # from the centreline to the contact point
+    vp = add(v, cross(w, arm))
+    vn = dot(vp, n)
+    normal = p[P_STIFFNESS] * depth - p[P_DAMPING] * vn  # d_t = -vn
+    if normal <= 0.0:
+        return (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    vt = sub(vp, scale(vn, n))
+    slip = np.sqrt(dot(vt, vt) + p[P_SLIP] * p[P_SLIP])
+    f = sub(scale(normal, n), scale(p[P_FRICTION] * normal / slip, vt))
+    return f, cross(arm, f)
+
+
+@jit
+def load(kind, p, value, u, quat, v, w):
+    """(force, moment) densities of one entry of ``kind``, local frame, before
+    its weight; ``value`` is the entry's vector (in its own frame)."""
+    zero = (0.0, 0.0, 0.0)
+    if kind == FOLLOWER_FORCE:
+        return value, zero
+    if kind == FOLLOWER_MOMENT:
+        return zero, value
+    r = rotation(quat)
+    if kind == DEAD_FORCE:
+        return to_local(r, value), zero
+    if kind == DEAD_MOMENT:
+        return zero, to_local(r, value)
+    return contact(kind, p, u, r, v, w)
+
+
+@jit
+def contact_energy(kind, p, u):
+    """Elastic energy density [J/m] of the contact penalty at u: k d^2 / 2."""
+    if kind != PLANE and kind != CAPSULE:
+        return 0.0
+    depth, _ = contact_depth(kind, p, u)
+    return 0.5 * p[P_STIFFNESS] * depth * depth if depth > 0.0 else 0.0
+
+
+@jit
+def global_wrench(force, moment, quat):
+    """Local densities to global components (for output)."""
+    r = rotation(quat)
+    return to_global(r, force), to_global(r, moment)

@@ -1,0 +1,186 @@
+"""SUNDIALS CVODE (BDF) through scikit-sundae."""
+
+import contextlib
+import warnings
+
+import numpy as np
+from scipy import sparse
+
+from ..discretise.preconditioner import check_structure
+from ..errors import ParameterError
+from .outputs import Outputs, step_size_stats
+
+LINEAR_SOLVERS = ("gmres", "band", "lapackband", "sparse", "dense")
+#: How the direct linear solvers get the Jacobian (see :func:`cvode`).
+JACOBIANS = ("compiled", "sundials")
+#: Failed right-hand-side evaluations after which CVODE gives up: it has
+#: then crept up to where the inputs fail and can go no further.
+MAX_RHS_FAILURES = 50
+#: From this many elements on, linsolver="auto" picks the preconditioned GMRES.
+GMRES_MIN_ELEMENTS = 50
+
+
+def cvode(system, y0, t_out, *, rtol, atol, progress=None, linsolver="auto", max_step=0.0,
+          jacobian="auto", max_order=5, max_nonlin_iters=3):
+    """SUNDIALS CVODE (BDF) through scikit-sundae.
+
+    ``linsolver`` is how the Newton systems (I - gamma J) x = r are solved:
+
+    * ``"gmres"``: GMRES preconditioned by an exact O(N) solve of the
+      structured Newton matrix (``system.preconditioner``), so it converges
+      in one or two iterations;
+    * ``"band"``: SUNDIALS' band LU of the full system (the half-bandwidths
+      come from ``system.bandwidths()``);
+    * ``"lapackband"``, ``"sparse"`` (SuperLU_MT on ``system.pattern()``),
+      ``"dense"`` (small systems only);
+    * ``"auto"``: "gmres" from ``GMRES_MIN_ELEMENTS`` elements on or when the
+      system has a global coupling (feedback tensions), if the preconditioner
+      can solve its structure; else "band" (see ``docs/performance.md``).
+
+    ``jacobian`` chooses how the direct solvers get J:
+
+    * ``"sundials"``: SUNDIALS' own finite differences for the band and dense
+      solvers, scikit-sundae's coloured differences for ``"sparse"``;
+    * ``"compiled"``: ``system.jacobian``, finite differences inside numba
+      with the colouring derived from the system's dependencies, handed over
+      as ``jacfn``;
+    * ``"auto"``: "compiled" for "sparse" and "gmres", "sundials" otherwise
+      (measured fastest with the band solvers, whose ``jacfn`` template is a
+      dense (n, n) array; see ``docs/performance.md``).
+
+    ``max_order`` caps the BDF order (1-5) and ``max_nonlin_iters`` the Newton
+    iterations per step (SUNDIALS' defaults, 5 and 3: order 4 and 5 Newton
+    iterations save ~10% on the paper's tests but double the steps of an
+    inviscid oscillation; see ``docs/performance.md``).
+    """
+    from sksundae.cvode import CVODE, CVODEPrecond
+
+    if linsolver == "auto":
+        # GMRES's Jacobian-vector products are differences of the full right-hand
+        # side, so they carry the global coupling of feedback tensions that any
+        # banded Jacobian leaves out (20x fewer steps on a P controller, N = 12).
+        big = system.layout.n_blocks >= GMRES_MIN_ELEMENTS
+        linsolver = "gmres" if (big or system.global_coupling) and _block_solvable(system) else "band"
+    if linsolver not in LINEAR_SOLVERS:
+        raise ParameterError(f"unknown `linsolver` {linsolver!r}; valid: {['auto', *LINEAR_SOLVERS]}")
+    if jacobian == "auto":
+        jacobian = "compiled" if linsolver in ("sparse", "gmres") else "sundials"
+    if jacobian not in JACOBIANS:
+        raise ParameterError(f"unknown `jacobian` {jacobian!r}; valid: {['auto', *JACOBIANS]}")
+    if linsolver == "gmres" and jacobian != "compiled":
+        raise ParameterError("linsolver='gmres' is preconditioned with the compiled Jacobian; "
+                             "use jacobian='auto' or 'compiled'")
+    options = dict(method="BDF", rtol=rtol, atol=atol, linsolver=linsolver,
+                   max_num_steps=1_000_000, max_step=max_step, max_order=int(max_order),
+                   max_nonlin_iters=int(max_nonlin_iters))
+    scale = np.broadcast_to(atol, (system.size,)) / rtol
+    precond = None
+    if linsolver == "gmres":
+        precond = system.preconditioner(scale)
+        # Left preconditioning, SUNDIALS' default Krylov dimension (5): the
+        # fastest of {left, right} x {1, 5} on the bending test.
+        options["precond"] = CVODEPrecond(precond.setup, precond.solve, "left")
+        options["krylov_dim"] = 5
+    elif linsolver in ("band", "lapackband"):
+        options["lband"], options["uband"] = system.bandwidths()
+    if jacobian == "compiled" and linsolver != "gmres":
+        matrix = "band" if linsolver in ("band", "lapackband") else linsolver
+        jac = system.jacobian(scale, matrix)
+        options["jacfn"] = jac
+        if matrix == "sparse":
+            options["sparsity"] = jac.sparsity
+    elif linsolver == "sparse":
+        options["sparsity"] = sparse.csc_matrix(system.pattern())
+
+    out = Outputs(t_out, y0, progress)
+    evals = [0]  # counted here: CVODE's own counter leaves out the Jacobian's evaluations
+
+    failures = []  # (t, exception) raised by the right-hand side
+
+    def rhs(t, y, yp):
+        evals[0] += 1
+        try:
+            system(t, y, yp)
+        except Exception as exc:
+            # scikit-sundae would abort on an exception, throwing away a step that
+            # merely reached past the trouble: NaN rates make CVODE reject the
+            # trial step and retry shorter ones, so the run gets as close as it can.
+            failures.append((t, exc))
+            yp[:] = np.nan
+
+    def stats():
+        info = dict(steps=len(sizes), rhs_evals=evals[0], linear_solver=linsolver,
+                    **step_size_stats(sizes))
+        if precond is not None:
+            info.update(jac_evals=precond.jac_evals, prec_setups=precond.setups,
+                        prec_solves=precond.solves)
+        else:
+            info["jac_evals"] = int(r.njev) if r is not None else 0
+        return info
+
+    t_end = float(t_out[-1])
+    sizes, r, t_last = [], None, float(t_out[0])  # sizes of the steps taken [s]
+    try:
+        with warnings.catch_warnings():
+            # scikit-sundae warns that its own coloured differences are not used
+            # when both `sparsity` and `jacfn` are given: that is the point.
+            warnings.filterwarnings("ignore", "Custom sparse Jacobian", UserWarning)
+            solver = CVODE(rhs, **options)
+        with _small_pages():  # the solver's memory is allocated here
+            solver.init_step(float(t_out[0]), np.asarray(y0, dtype=float))
+        while not out.done:
+            r = solver.step(t_end, method="onestep", tstop=t_end)
+            if not r.success or len(failures) > MAX_RHS_FAILURES:
+                reason = r.message
+                if failures:
+                    t_bad, exc = failures[-1]
+                    reason = f"{type(exc).__name__}: {exc} (at t = {t_bad:.6g} s)"
+                reached = out.t_out[out.next_index - 1]
+                return out.solution(False, f"CVODE failed after t = {reached:.6g} s (last output; "
+                                    f"the solver got to {r.t:.6g} s): {reason}", **stats())
+            # After output times were interpolated inside the last step, CVODE's
+            # next one-step call hands that step back again: count real steps only.
+            if r.t > t_last:
+                sizes.append(r.t - t_last)
+                t_last = r.t
+            while not out.done and out.t_out[out.next_index] <= r.t:
+                t_k = out.t_out[out.next_index]
+                out.add(r.y if t_k == r.t else solver.step(t_k).y)
+    except (Exception, KeyboardInterrupt) as exc:
+        reached = out.t_out[out.next_index - 1]
+        reason = "interrupted" if isinstance(exc, KeyboardInterrupt) else f"{type(exc).__name__}: {exc}"
+        return out.solution(False, f"CVODE stopped after t = {reached:.6g} s: {reason}", **stats())
+    return out.solution(True, "The solver reached the end time.", **stats())
+
+
+@contextlib.contextmanager
+def _small_pages():
+    """Allocate without numpy's transparent-huge-page advice.
+
+    With a ``jacfn``, scikit-sundae allocates a dense (n, n) template for the
+    band solver, of which only the band is ever touched; numpy advises 2 MB
+    pages for large arrays, so writing the band made the kernel clear every
+    2 MB page of it (the whole n^2 array, 460 MB at N = 400, 0.2 s per
+    solver start). With 4 kB pages only the band's own pages are cleared.
+    """
+    core = getattr(np, "_core", None) or getattr(np, "core", None)
+    setter = getattr(getattr(core, "multiarray", None), "_set_madvise_hugepage", None)
+    if setter is None:  # not a numpy that advises huge pages: nothing to undo
+        yield
+        return
+    previous = setter(False)
+    try:
+        yield
+    finally:
+        setter(previous)
+
+
+
+
+def _block_solvable(system):
+    """True if the block preconditioner solves this system's structure exactly."""
+    try:
+        check_structure(system.depends)
+    except ValueError:
+        return False
+    return True

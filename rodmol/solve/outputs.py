@@ -1,0 +1,54 @@
+"""What every backend returns: the states at the output times reached, with
+progress reports and step statistics, so a failed or interrupted run keeps
+what it computed."""
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass
+class RawSolution:
+    t: np.ndarray
+    y: np.ndarray
+    success: bool
+    message: str
+    stats: dict = field(default_factory=dict)
+
+
+class Outputs:
+    """Collects states at the output times (in one preallocated array) and reports progress."""
+
+    def __init__(self, t_out, y0, progress):
+        self.t_out, self.progress = t_out, progress
+        self.start = time.perf_counter()
+        self.ys = np.empty((len(t_out), len(y0)))
+        self.ys[0] = y0
+        self.next_index = 1
+
+    @property
+    def done(self):
+        return self.next_index == len(self.t_out)
+
+    def add(self, y):
+        k = self.next_index
+        self.ys[k] = y
+        self.next_index = k + 1
+        if self.progress is not None:
+            self.progress(self.t_out[k], self.t_out[-1])
+
+    def solution(self, success, message, **stats):
+        stats["wall_time_s"] = time.perf_counter() - self.start
+        n = self.next_index
+        return RawSolution(self.t_out[:n].copy(), self.ys[:n], success, message, stats)
+
+
+def step_size_stats(sizes):
+    """Smallest, median and largest step [s] (0 if none), for the run's stats."""
+    if not sizes:
+        return dict(h_min=0.0, h_median=0.0, h_max=0.0)
+    h = np.asarray(sizes)
+    return dict(h_min=float(h.min()), h_median=float(np.median(h)), h_max=float(h.max()))
+
+
