@@ -21,6 +21,15 @@ from .discretise.system import SemiDiscrete, StateView
 from .errors import EquilibriumError, IntegrationError, ParameterError, RodmolError
 from .io.scenario_file import ScenarioError, load_scenario
 from .io.writers import write_series
+from .loads import (
+    CapsuleContact,
+    DistributedForce,
+    DistributedMoment,
+    PlaneContact,
+    PointForce,
+    PointMoment,
+    SphereContact,
+)
 from .markers import Marker
 from .model import Model
 from .parameters import MEDIA, Material, Medium
@@ -33,7 +42,8 @@ from .solve.equilibrium import equilibrium
 __version__ = "0.1.0"
 
 __all__ = [
-    "BACKENDS", "Base", "BaseMotion", "Cable", "EquilibriumError", "IntegrationError", "MEDIA",
+    "BACKENDS", "Base", "BaseMotion", "Cable", "CapsuleContact", "DistributedForce",
+    "DistributedMoment", "PlaneContact", "PointForce", "PointMoment", "SphereContact", "EquilibriumError", "IntegrationError", "MEDIA",
     "Marker", "Material", "Medium", "Model", "ParameterError", "Result", "Rod", "RodmolError",
     "ScenarioError", "SemiDiscrete", "StateLayout", "StateView", "default_atol", "energy",
     "equilibrium", "load_result", "load_scenario", "marker_errors", "paper_arm",

@@ -5,6 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .discretise import external
 from .errors import ParameterError
 from .model import Q_STAR
 
@@ -14,8 +15,10 @@ def energy(model, result):
 
     Returns a dict of (n_t,) arrays: ``kinetic`` (velocity nodes 1..N, with
     added mass), ``strain`` (strain nodes 0..N-1), ``gravity`` (potential of
-    weight minus buoyancy) and ``total``. With mu = 0, no gravity, no fluid
-    and no cables, ``kinetic + strain`` is conserved by the semi-discrete system.
+    weight minus buoyancy), ``contact`` (elastic energy of the contact
+    penalties) and ``total``. With mu = 0, no gravity, no fluid, no cables and
+    no external loads, ``kinetic + strain`` is conserved by the semi-discrete
+    system; contact damping and friction only remove energy.
     """
     ds = model.ds
     v, w = result.velocity[:, 1:], result.angular_velocity[:, 1:]
@@ -29,7 +32,21 @@ def energy(model, result):
     # so this potential balances the gravity work of the semi-discrete system.
     u = result.integrated_positions[:, 1:]
     gravity = -ds * np.einsum("n,tni,i->t", model.net_mass, u, model.gravity)
-    return dict(kinetic=kinetic, strain=strain, gravity=gravity, total=kinetic + strain + gravity)
+    contact = _contact_energy(model, u)
+    return dict(kinetic=kinetic, strain=strain, gravity=gravity, contact=contact,
+                total=kinetic + strain + gravity + contact)
+
+
+def _contact_energy(model, u):
+    """Penalty energy [J] of every frame, at the integrated positions ``u``
+    (n_t, N, 3) of the velocity nodes (those the contact law sees)."""
+    g = model.grid_loads
+    out = np.zeros(len(u))
+    for e in np.flatnonzero(np.isin(g.kind, (external.PLANE, external.CAPSULE))):
+        node, params, weight = int(g.node[e]) - 1, g.params[e], g.weight[e] * model.ds
+        for i in range(len(u)):
+            out[i] += weight * external.contact_energy(int(g.kind[e]), params, tuple(u[i, node]))
+    return out
 
 
 @dataclass(frozen=True)

@@ -32,6 +32,8 @@ from .errors import ParameterError
 from .inputs import TimeInput, as_time_input
 
 FRAMES = ("global", "local")
+#: Default contact smoothing depth, as a fraction of the section radius.
+SMOOTHING_FRACTION = 0.01
 
 
 @dataclass(frozen=True)
@@ -197,7 +199,10 @@ class _Contact:
 
     Where the surface penetrates the obstacle by a depth d > 0, the rod gets a
     force per unit length ``f_n = max(0, stiffness d - damping d_t)`` along the
-    obstacle's outward normal, and a friction force opposing the sliding
+    obstacle's outward normal (below ``smoothing_depth`` h the penalty is
+    ``stiffness d^2 / (2 h)`` and the damping ramps up as d / h, so the
+    force is continuously differentiable at first touch; beyond it the
+    penalty is ``stiffness (d - h / 2)``), and a friction force opposing the sliding
     velocity ``v_t`` of the surface point, ``friction f_n v_t / sqrt(|v_t|^2 +
     slip_speed^2)`` (Coulomb's law, smoothed below ``slip_speed`` so that
     the implicit solver sees a differentiable law); both act at the surface
@@ -213,6 +218,9 @@ class _Contact:
         object.__setattr__(self, "friction", _checks.non_negative(f"{name} friction", self.friction))
         object.__setattr__(self, "slip_speed", _checks.positive(f"{name} slip_speed",
                                                                  self.slip_speed, " m/s"))
+        if self.smoothing_depth is not None:
+            object.__setattr__(self, "smoothing_depth", _checks.positive(
+                f"{name} smoothing_depth", self.smoothing_depth, " m"))
 
     def _law(self):
         return [self.stiffness, self.damping, self.friction, self.slip_speed]
@@ -223,6 +231,8 @@ class _Contact:
         row = np.array(self._geometry() + self._law())
         params[:, :len(row)] = row
         params[:, external.P_RADIUS] = radius[1:]
+        params[:, external.P_SMOOTHING] = (SMOOTHING_FRACTION * radius[1:] if self.smoothing_depth is None
+                                           else self.smoothing_depth)
         return GridLoad(np.full(count, self._kind), np.arange(1, count + 1), np.ones(count), params,
                         np.zeros((count, 3)))
 
@@ -240,6 +250,8 @@ class PlaneContact(_Contact):
     damping : normal damping per unit length [N s/m^2] (acts only in contact).
     friction : Coulomb coefficient [-].
     slip_speed : sliding speed [m/s] below which friction is smoothed.
+    smoothing_depth : depth [m] over which the penalty is smoothed; default
+        ``SMOOTHING_FRACTION`` (1%) of the section radius at each node.
     """
 
     point: Any
@@ -248,6 +260,7 @@ class PlaneContact(_Contact):
     damping: float = 0.0
     friction: float = 0.0
     slip_speed: float = 1e-4
+    smoothing_depth: float | None = None
     name: str = "plane contact"
     _kind = external.PLANE
 
@@ -275,6 +288,7 @@ class CapsuleContact(_Contact):
     damping: float = 0.0
     friction: float = 0.0
     slip_speed: float = 1e-4
+    smoothing_depth: float | None = None
     name: str = "capsule contact"
     _kind = external.CAPSULE
 
@@ -289,10 +303,11 @@ class CapsuleContact(_Contact):
 
 
 def SphereContact(centre, radius, stiffness, damping=0.0, friction=0.0, slip_speed=1e-4,  # noqa: N802
-                  name="sphere contact"):
+                  smoothing_depth=None, name="sphere contact"):
     """Contact with a sphere of ``radius`` [m] around ``centre`` [m] (global):
     a :class:`CapsuleContact` whose segment is a point."""
-    return CapsuleContact(centre, centre, radius, stiffness, damping, friction, slip_speed, name)
+    return CapsuleContact(centre, centre, radius, stiffness, damping, friction, slip_speed,
+                          smoothing_depth, name)
 
 
 #: The load types a Model accepts.

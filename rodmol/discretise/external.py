@@ -13,7 +13,7 @@ every code in :data:`DEPENDS`.
 
 import numpy as np
 
-from .physics import add, cross, dot, jit, rotation, scale, sub, to_global, to_local
+from .physics import add, cross, dot, jit, rotation, scale, sub, to_local
 
 FOLLOWER_FORCE, DEAD_FORCE, FOLLOWER_MOMENT, DEAD_MOMENT, PLANE, CAPSULE = range(6)
 
@@ -29,9 +29,10 @@ DEPENDS = {
 }
 
 # Parameter row of the contact kinds: geometry (plane: point, normal; capsule:
-# start, end, radius), then the law and the section radius at the node.
-N_PARAMS = 12
-P_STIFFNESS, P_DAMPING, P_FRICTION, P_SLIP, P_RADIUS = 7, 8, 9, 10, 11
+# start, end, radius), then the law, the section radius at the node and the
+# depth over which the penalty is smoothed.
+N_PARAMS = 13
+P_STIFFNESS, P_DAMPING, P_FRICTION, P_SLIP, P_RADIUS, P_SMOOTHING = 7, 8, 9, 10, 11, 12
 
 
 def dependency_table(kinds):
@@ -58,17 +59,31 @@ def contact_depth(kind, p, u):
 
 
 @jit
+def penalty(depth, smoothing):
+    """Penetration measure of the penalty law and its damping ramp: d - h/2
+    beyond the smoothing depth h, d^2 / (2 h) below it (so the force and its
+    slope are continuous at first touch, which Newton iterations and BDF
+    steps need), 0 outside."""
+    if depth <= 0.0:
+        return 0.0, 0.0
+    if depth >= smoothing:
+        return depth - 0.5 * smoothing, 1.0
+    return 0.5 * depth * depth / smoothing, depth / smoothing
+
+
+@jit
 def contact(kind, p, u, r, v, w):
     """Penalty contact with regularised Coulomb friction (see rodmol.loads),
     acting at the surface point; returns (force, moment) densities, local."""
     depth, n_global = contact_depth(kind, p, u)
-    if depth <= 0.0:
+    measure, ramp = penalty(depth, p[P_SMOOTHING])
+    if measure <= 0.0:
         return (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
     n = to_local(r, n_global)
     arm = scale(-p[P_RADIUS], n)  # from the centreline to the contact point
     vp = add(v, cross(w, arm))
     vn = dot(vp, n)
-    normal = p[P_STIFFNESS] * depth - p[P_DAMPING] * vn  # d_t = -vn
+    normal = p[P_STIFFNESS] * measure - ramp * p[P_DAMPING] * vn  # d_t = -vn
     if normal <= 0.0:
         return (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
     vt = sub(vp, scale(vn, n))
@@ -96,15 +111,16 @@ def load(kind, p, value, u, quat, v, w):
 
 @jit
 def contact_energy(kind, p, u):
-    """Elastic energy density [J/m] of the contact penalty at u: k d^2 / 2."""
+    """Elastic energy density [J/m] of the contact penalty at u (the integral
+    of the penalty force over the depth)."""
     if kind != PLANE and kind != CAPSULE:
         return 0.0
     depth, _ = contact_depth(kind, p, u)
-    return 0.5 * p[P_STIFFNESS] * depth * depth if depth > 0.0 else 0.0
+    h = p[P_SMOOTHING]
+    if depth <= 0.0:
+        return 0.0
+    if depth < h:
+        return p[P_STIFFNESS] * depth ** 3 / (6.0 * h)
+    return p[P_STIFFNESS] * (h * h / 6.0 + 0.5 * (depth - h) * (depth + h) - 0.5 * h * (depth - h))
 
 
-@jit
-def global_wrench(force, moment, quat):
-    """Local densities to global components (for output)."""
-    r = rotation(quat)
-    return to_global(r, force), to_global(r, moment)
