@@ -14,10 +14,16 @@ import numpy as np
 from .layout import BLOCK, HEADER
 from .physics import jit
 
+# The right-hand side is a global, not an argument: numba cannot cache a
+# function that takes a compiled function as an argument (its type differs
+# in every process), and recompiling costs seconds per run. A second scheme
+# gets its own instance of this loop.
+from .upwind import rhs
+
 
 @jit
-def jacobian_blocks(y, f0, scale, groups, header_group, rhs, args, ybuf, fbuf, jb, jh):
-    """Fill ``jb`` and ``jh`` by differences of ``rhs(y, out, *args)``.
+def jacobian_blocks(y, f0, scale, groups, header_group, args, ybuf, fbuf, jb, jh):
+    """Fill ``jb`` and ``jh`` by differences of the scheme's ``rhs(y, out, *args)``.
 
     ``groups`` (G, 4) = (entry j, residue r, period p, lowest row offset lo):
     entry j of the blocks b = r, r + p, ... is perturbed at once and reaches
@@ -136,8 +142,8 @@ class CompiledJacobian:
         # Jacobian is only an approximation and may use the last good inputs.
         with contextlib.suppress(Exception):
             self.system.update_inputs(t, y)
-        jacobian_blocks(y, fy, self._scale, self._groups, self._header, self.system.scheme.rhs,
-                        self._args, self._ybuf, self._fbuf, self._jb, self._jh)
+        jacobian_blocks(y, fy, self._scale, self._groups, self._header, self._args, self._ybuf,
+                        self._fbuf, self._jb, self._jh)
 
     def __call__(self, t, y, fy, jj):
         """d f / d y at (t, y), with ``fy`` = f(t, y), into the template ``jj``."""
