@@ -1,0 +1,56 @@
+"""The rod's sectional laws and the material (rodmol.rod, rodmol.parameters)."""
+
+import numpy as np
+import pytest
+
+import rodmol
+
+
+def test_sectional_stiffness_and_viscosity_of_a_circle():
+    mat = rodmol.Material(E=2e6, nu=0.25, mu=10.0, rho=1000.0)
+    rod = rodmol.Rod(1.0, 0.02, mat)
+    a, j = np.pi * 0.02**2, np.pi * 0.02**4 / 4
+    g = 2e6 / 2.5
+    kl, kth = rod.stiffness(np.array([0.3]))
+    vl, vth = rod.viscosity(np.array([0.3]))
+    np.testing.assert_allclose(kl[0], [2e6 * a, g * a, g * a])
+    np.testing.assert_allclose(kth[0], [g * 2 * j, 2e6 * j, 2e6 * j])
+    np.testing.assert_allclose(vl[0], [30 * a, 10 * a, 10 * a])
+    np.testing.assert_allclose(vth[0], [20 * j, 30 * j, 30 * j])
+
+
+def test_taper_and_volume():
+    rod = rodmol.Rod(2.0, (0.3, 0.1), rodmol.Material(E=1.0, nu=0.0, rho=2.0))
+    np.testing.assert_allclose(rod.radius_at([0.0, 1.0, 2.0]), [0.3, 0.2, 0.1])
+    exact = np.pi * 2.0 * (0.3**2 + 0.3 * 0.1 + 0.1**2) / 3  # frustum
+    assert rod.volume() == pytest.approx(exact, rel=1e-12)
+    assert rod.mass() == pytest.approx(2.0 * exact, rel=1e-12)
+
+
+def test_shear_modulus_instead_of_poisson_ratio():
+    mat = rodmol.Material(E=1e6, G=1e4, rho=5000.0)
+    assert mat.G == 1e4 and mat.nu == pytest.approx(49.0)
+    kl, _ = rodmol.Rod(3.0, 0.25, mat).stiffness(np.array([0.0]))
+    assert kl[0, 1] == pytest.approx(1e4 * np.pi * 0.25**2)
+    assert rodmol.Material(E=1e6, nu=0.5, rho=1.0).G == pytest.approx(1e6 / 3)
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    (dict(E=1e6, rho=1.0), "exactly one of `nu`"),
+    (dict(E=1e6, nu=0.3, G=1e5, rho=1.0), "exactly one of `nu`"),
+    (dict(E=1e6, G=-1.0, rho=1.0), "`G` must be > 0"),
+    (dict(E=True, nu=0.3, rho=1.0), "`E` must be a number, got True"),
+    (dict(E=1e6, nu=0.3), "`rho`"),
+])
+def test_bad_material_names_the_parameter(kwargs, words):
+    with pytest.raises(rodmol.ParameterError, match=words):
+        rodmol.Material(**kwargs)
+
+
+def test_model_arrays_are_read_only():
+    """The compiled system copies the sampled coefficients once: changing them
+    afterwards would make it stale, so they cannot be changed."""
+    model = rodmol.paper_arm(6)
+    for name in ("kth", "kl", "mass", "cable_weights"):
+        with pytest.raises(ValueError, match="read-only"):
+            getattr(model, name)[:] *= 2.0
