@@ -31,6 +31,7 @@ sys.path.insert(0, os.path.dirname(HERE))  # run from a checkout without install
 import rodmol  # noqa: E402
 from rodmol.solve.backends import cvode, rk23  # noqa: E402,F401
 from rodmol.result import from_states  # noqa: E402
+from rodmol.discretise.layout import BLOCK, HEADER, StateLayout  # noqa: E402
 from rodmol.discretise.system import SemiDiscrete  # noqa: E402,F401
 from rodmol.simulate import default_atol  # noqa: E402,F401
 
@@ -144,14 +145,15 @@ def save_figure(fig, path):
     return path
 
 
-def initial_state(model, t=0.0):
-    """The static equilibrium (the paper's start). From N ~ 800 on, the
-    equilibrium's default residual tolerance (1e-10 of the load scale) is
-    below its round-off floor, so retry at 1e-9."""
+def initial_state(model, t=0.0, system=None):
+    """The static equilibrium (the paper's start); ``system`` (a SemiDiscrete
+    of ``model``) is reused if given. If the default residual tolerance
+    (1e-10 of the load scale) is below the round-off floor of a fine grid,
+    retry at 1e-9."""
     try:
-        return rodmol.equilibrium(model, t)
+        return rodmol.equilibrium(model, t, system=system)
     except rodmol.EquilibriumError:
-        return rodmol.equilibrium(model, t, tol=1e-9)
+        return rodmol.equilibrium(model, t, tol=1e-9, system=system)
 
 
 def outputs(t_end, dt=0.01):
@@ -165,7 +167,8 @@ def tip(raw, model=None):
     ``model`` is given (as ``Result.tip``; use it to compare grids), else the
     time-integrated u(L), which is cheaper and fine on one grid."""
     if model is None:
-        return np.asarray(raw.y)[:, -19:-16]
+        y = np.asarray(raw.y)
+        return y[:, StateLayout((y.shape[1] - HEADER) // BLOCK).tip_slice("u")]
     return from_states(SemiDiscrete(model), raw.t, np.asarray(raw.y), True, "", {}).tip
 
 

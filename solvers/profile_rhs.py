@@ -1,15 +1,19 @@
 """Where the time goes: right-hand side, Jacobian, linear algebra, callback overhead.
 
-1. Per call (best of 7 batches): the numpy reference right-hand side, the
-   compiled one through ``SemiDiscrete.__call__`` and the bare kernel (the
-   difference is the Python cost of a call: tension tables, dispatch), the
-   compiled Jacobian, and the block preconditioner's factorisation and solve.
+1. Per call (best of 7 batches): the compiled right-hand side through
+   ``SemiDiscrete.__call__`` and the bare kernel (the difference is the
+   Python cost of a call: inputs, dispatch), the compiled Jacobian, and the
+   block preconditioner's factorisation and solve. (There is one kernel, the
+   compiled one; the numpy reference it was once compared with here is gone.)
 2. A whole bending run per linear solver under cProfile, grouped into:
    the compiled kernels (right-hand side, Jacobian, preconditioner), the
    Python around them (rodmol's callbacks), and what runs inside
    scikit-sundae's ``step`` itself: CVODE in C (BDF, Newton, GMRES or the
    band LU, vector operations) plus scikit-sundae's Cython wrappers.
    The run is also timed without the profiler.
+3. What each solver change bought: the same run with the band LU and
+   SUNDIALS' Jacobian, the band LU with the compiled Jacobian, and GMRES
+   with the block preconditioner (interleaved repetitions, median).
 
     python solvers/profile_rhs.py [--quick | --smoke] [--out DIR]
 """
@@ -22,8 +26,7 @@ import time
 import _common as C
 from _common import np, plt, rodmol
 
-from rodmol.discretise import jacobian
-from rodmol.discretise import upwind as kernels
+from rodmol.discretise import upwind
 
 SCRIPT = "profile_rhs.py"
 
@@ -44,11 +47,11 @@ def per_call(fn, reps):
 
 # cProfile entries (file suffix, function name) -> group
 GROUPS = [
-    (("kernels.py", "rhs"), "kernel: right-hand side"),
+    (("upwind.py", "rhs"), "kernel: right-hand side"),
     (("jacobian.py", "jacobian_blocks"), "kernel: Jacobian"),
-    (("jacobian.py", "fill_band"), "kernel: Jacobian"),
-    (("jacobian.py", "block_setup"), "kernel: preconditioner setup"),
-    (("jacobian.py", "block_solve"), "kernel: preconditioner solve"),
+    (("jacobian.py", "fill_matrix"), "kernel: Jacobian"),
+    (("preconditioner.py", "block_setup"), "kernel: preconditioner setup"),
+    (("preconditioner.py", "block_solve"), "kernel: preconditioner solve"),
     (("_solver.py", "step"), "CVODE (C) + scikit-sundae wrappers"),
 ]
 
@@ -78,30 +81,28 @@ def main(argv=None):
 
     model = rodmol.scenarios.get("bending").model(n)
     y0 = C.initial_state(model)
-    fast, ref = C.SemiDiscrete(model), C.SemiDiscrete(model, kernel="numpy")
+    fast = C.SemiDiscrete(model)
     rng = np.random.default_rng(0)
     y = y0 + 1e-4 * rng.normal(size=y0.size)
     out = np.empty_like(y)
     fast.update_inputs(0.3, y)
     karg = fast.kernel_arguments()
     atol = C.default_atol(model, 1e-6)
-    pre = jacobian.BlockPreconditioner(fast, atol / 1e-6)
+    pre = fast.preconditioner(atol / 1e-6)
     fy = fast(0.3, y)
     pre.setup(0.3, y, fy, False, [0], 1e-3)
     z = np.empty_like(y)
 
     calls = [
-        ("right-hand side, numpy reference", per_call(lambda: ref(0.3, y, out), max(20, reps // 20))),
         ("right-hand side, compiled (SemiDiscrete call)", per_call(lambda: fast(0.3, y, out), reps)),
-        ("right-hand side, bare kernel", per_call(lambda: kernels.rhs(y, out, *karg), reps)),
-        ("Jacobian, compiled (34 kernel evaluations)", per_call(lambda: pre.jacobian.evaluate(0.3, y, fy),
+        ("right-hand side, bare kernel", per_call(lambda: upwind.rhs(y, out, *karg), reps)),
+        (f"Jacobian, compiled ({pre.jacobian.evaluations} kernel evaluations)", per_call(lambda: pre.jacobian.evaluate(0.3, y, fy),
                                                                  max(20, reps // 50))),
         ("preconditioner setup (factor I - gamma J)", per_call(lambda: pre.factor(1e-3), max(20, reps // 20))),
         ("preconditioner solve", per_call(lambda: pre.solve(0.3, y, fy, fy, z, 1e-3, 0.0, 1), reps)),
     ]
     call_rows = [dict(operation=k, microseconds=v * 1e6) for k, v in calls]
-    speedup = calls[0][1] / calls[1][1]
-    overhead = calls[1][1] - calls[2][1]
+    overhead = calls[0][1] - calls[1][1]
     for r in call_rows:
         print(f"{r['operation']:48s} {r['microseconds']:9.2f} us", flush=True)
 
@@ -132,29 +133,23 @@ def main(argv=None):
     # What each change bought: the same run with the pieces switched on in
     # turn (same process, interleaved repetitions, median).
     ladder = [
-        ("numpy right-hand side, band LU, SUNDIALS Jacobian (the start)", "numpy",
-         dict(linsolver="band", jacobian="sundials")),
-        ("compiled right-hand side, band LU, SUNDIALS Jacobian", "numba",
-         dict(linsolver="band", jacobian="sundials")),
-        ("compiled right-hand side, band LU, compiled Jacobian", "numba",
-         dict(linsolver="band", jacobian="compiled")),
-        ("compiled right-hand side, GMRES + block preconditioner (default)", "numba",
-         dict(linsolver="gmres")),
+        ("band LU, SUNDIALS Jacobian (the start)", dict(linsolver="band", jacobian="sundials")),
+        ("band LU, compiled Jacobian", dict(linsolver="band", jacobian="compiled")),
+        ("GMRES + block preconditioner (default)", dict(linsolver="gmres")),
     ]
-    systems = {"numba": system, "numpy": C.SemiDiscrete(model, kernel="numpy")}
-    for _, kernel, opts in ladder:
-        C.warm_up(systems[kernel], y0, **opts)
-    walls = {label: [] for label, _, _ in ladder}
+    for _, opts in ladder:
+        C.warm_up(system, y0, **opts)
+    walls = {label: [] for label, _ in ladder}
     last = {}
     for _ in range(args.reps):
-        for label, kernel, opts in ladder:
-            raw = C.run(C.cvode, systems[kernel], y0, t_out, 1e-6, **opts)
+        for label, opts in ladder:
+            raw = C.run(C.cvode, system, y0, t_out, 1e-6, **opts)
             walls[label].append(raw.stats["wall_time_s"])
             last[label] = raw.stats
     start = np.median(walls[ladder[0][0]])
     ladder_rows = []
     prev = start
-    for label, _, _ in ladder:
+    for label, _ in ladder:
         w = float(np.median(walls[label]))
         ladder_rows.append(dict(configuration=label, wall_s=w, wall_per_sim_s=w / t_end,
                                 speedup_vs_previous=prev / w, speedup_vs_start=start / w,
@@ -182,9 +177,9 @@ def main(argv=None):
 
     sections = [
         ("Per call", C.markdown_table(call_rows, None, {"microseconds": ".2f"})
-         + f"\nThe compiled right-hand side is {speedup:.0f}x faster than the numpy reference; "
-           f"the Python around a call costs {overhead * 1e6:.1f} us.\n"),
-        ("What each change bought (same run, median of repetitions)",
+         + f"\nThe Python around a call of the right-hand side costs {overhead * 1e6:.1f} us.\n"),
+        ("What each solver change bought (compiled right-hand side throughout; same run, median of "
+         "repetitions)",
          C.markdown_table(ladder_rows, None, {"wall_s": ".3f", "wall_per_sim_s": ".4f",
                                               "speedup_vs_previous": ".2f", "speedup_vs_start": ".1f"})),
         ("Whole run, grouped", C.markdown_table(run_rows, None, {"seconds": ".4f", "share": ".1%"})

@@ -19,7 +19,7 @@ import os
 import _common as C
 from _common import np, plt, rodmol
 
-from rodmol.discretise.layout import FIELDS
+from rodmol.discretise.layout import StateLayout
 
 SCRIPT = "temporal.py"
 
@@ -34,7 +34,7 @@ def loose_w_atol(model, rtol):
     """default_atol with the angular-velocity scale (L/s)/r_min instead of 1 rad/s."""
     atol = C.default_atol(model, rtol)
     r_min = float(np.min(model.rod.radius_at(model.s_nodes)))
-    atol[7:].reshape(model.n_elements, 19)[:, FIELDS["w"]] = rtol * model.rod.length / r_min
+    StateLayout(model.n_elements).field(atol, "w")[...] = rtol * model.rod.length / r_min
     return atol
 
 
