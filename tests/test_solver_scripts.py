@@ -1,5 +1,7 @@
 """The solver studies under solvers/ run end to end (tiny --smoke sizes) and
-write their CSV, Markdown and PNG outputs. Timings are not checked here."""
+write their CSV, Markdown and PNG outputs. Timings are not checked here.
+core_speed.py also checks out the pre-refactor commit into a temporary git
+worktree (skipped outside a git checkout that has it)."""
 
 import os
 import subprocess
@@ -17,9 +19,11 @@ SCRIPTS = {
     "release.py": ["release.csv", "release.md"],
     "profile_rhs.py": ["profile_rhs.csv", "profile_rhs_calls.csv", "profile_rhs_ladder.csv", "profile_rhs.md",
                        "profile_rhs.png"],
+    "core_speed.py": ["core_speed.csv", "core_speed.md"],
 }
 
 
+@pytest.mark.subprocess
 @pytest.mark.parametrize("script", sorted(SCRIPTS))
 def test_script_smoke_run(script, tmp_path):
     proc = subprocess.run([sys.executable, os.path.join(ROOT, "solvers", script), "--smoke",
