@@ -13,7 +13,9 @@ A series directory holds
 Each frame file is written completely before the ``.pvd`` that lists it is
 replaced (atomically), so an interrupted run leaves valid series of the frames
 done. Vectors carry the Result's frames: strains, velocities and stresses in
-local (material) components, positions and the frame vectors in global ones;
+local (material) components; positions, the frame vectors and the external
+load densities (``external force [N/m]``, ``external moment [N m/m]``: point
+and distributed loads and contact, see :mod:`rodmol.loads`) in global ones;
 ``velocity (global) [m/s]`` is the velocity in global components, for glyphs.
 """
 
@@ -35,6 +37,8 @@ ROD_ARRAYS = {
     "angular velocity [rad/s]": ("angular_velocity", "local"),
     "internal force [N]": ("internal_force", "local"),
     "internal moment [N m]": ("internal_moment", "local"),
+    "external force [N/m]": ("external_force", "global"),
+    "external moment [N m/m]": ("external_moment", "global"),
 }
 PARTS = ("rod", "cables", "markers")
 SUBDIRECTORY = "vtk"
