@@ -5,11 +5,12 @@ pure tip moment that rolls a straight rod into a circle.
 
 The discretisation is first order in ds (the upwind scheme), so the errors
 must halve as N doubles: the observed order over N = 10, 20, 40 is checked.
+
+The reference solutions come from the ``elastica`` fixture (tests/conftest.py).
 """
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_bvp
 
 import rodmol
 from rodmol.discretise.system import SemiDiscrete
@@ -20,50 +21,6 @@ EI = E * np.pi * R**4 / 4.0
 EA = E * np.pi * R**2
 GA = E / (2.0 * (1.0 + NU)) * np.pi * R**2
 NS = (10, 20, 40)
-
-
-def elastica_tip_force(length, ei, ea, ga, force, *, follower=False, weight=0.0):
-    """Planar Reissner elastica (extensible, shearable) of a cantilever
-    clamped at the origin along +x, with a tip force of magnitude ``force``
-    along -y (dead) or along minus the second director of the tip section
-    (follower, i.e. perpendicular to the tip section's axis), plus an
-    optional dead weight ``weight`` [N/m] along -y.
-
-    Unknowns x, y, theta (section angle), m (bending moment); the contact
-    force n(s) is known up to the tip angle (a parameter for the follower).
-    Returns the tip position (x, y) and the tip section angle.
-    """
-    s = np.linspace(0.0, length, 201)
-    z = np.zeros((4, s.size))
-    z[0] = s
-    p = [0.0]
-
-    def contact_force(s, p, f, w):
-        if follower:
-            fx, fy = f * np.sin(p[0]), -f * np.cos(p[0])
-        else:
-            fx, fy = 0.0, -f
-        return fx + 0.0 * s, fy - w * (length - s)
-
-    def rhs(s, z, p, f, w):
-        _, _, th, m = z
-        nx, ny = contact_force(s, p, f, w)
-        c, sn = np.cos(th), np.sin(th)
-        q1 = 1.0 + (nx * c + ny * sn) / ea      # axial strain + 1
-        q2 = (-nx * sn + ny * c) / ga            # shear strain
-        dx, dy = q1 * c - q2 * sn, q1 * sn + q2 * c
-        return np.vstack([dx, dy, m / ei, -(dx * ny - dy * nx)])
-
-    def bc(za, zb, p):
-        return np.array([za[0], za[1], za[2], zb[3], zb[2] - p[0]])
-
-    for frac in np.linspace(0.25, 1.0, 4):  # load continuation
-        f, w = frac * force, frac * weight
-        sol = solve_bvp(lambda s, z, p, f=f, w=w: rhs(s, z, p, f, w), bc, s, z, p=p,
-                        tol=1e-10, max_nodes=100_000)
-        assert sol.success, sol.message
-        s, z, p = sol.x, sol.y, sol.p
-    return z[:2, -1], z[2, -1]
 
 
 def static_result(model):
@@ -77,12 +34,7 @@ def cantilever(n, *loads, gravity=(0.0, 0.0, 0.0)):
     return rodmol.Model(rod, n, gravity=gravity, loads=list(loads))
 
 
-def observed_orders(errors):
-    e = np.asarray(errors)
-    return np.log2(e[:-1] / e[1:])
-
-
-def test_small_dead_tip_force_matches_euler_bernoulli_with_shear():
+def test_small_dead_tip_force_matches_euler_bernoulli_with_shear(observed_orders):
     force = 1e-3 * EI / L**2
     reference = force * L**3 / (3 * EI) + force * L / GA
     errors = []
@@ -95,10 +47,10 @@ def test_small_dead_tip_force_matches_euler_bernoulli_with_shear():
 
 
 @pytest.mark.parametrize("frame", ["global", "local"])
-def test_large_tip_force_matches_elastica(frame):
+def test_large_tip_force_matches_elastica(frame, elastica, observed_orders):
     """F L^2 / EI = 2: the tip deflects by about half the length."""
     force = 2.0 * EI / L**2
-    ref_tip, ref_angle = elastica_tip_force(L, EI, EA, GA, force, follower=frame == "local")
+    ref_tip, ref_angle = elastica(L, EI, EA, GA, force, follower=frame == "local")
     errors = []
     for n in NS:
         res = static_result(cantilever(n, rodmol.PointForce(L, (0.0, -force, 0.0), frame=frame)))
@@ -120,10 +72,10 @@ def test_large_tip_force_matches_elastica(frame):
         assert abs(np.arctan2(d1[1], d1[0]) - ref_angle) < 0.02
 
 
-def test_follower_and_dead_tip_forces_differ():
+def test_follower_and_dead_tip_forces_differ(elastica):
     force = 2.0 * EI / L**2
-    dead_ref, _ = elastica_tip_force(L, EI, EA, GA, force)
-    follower_ref, _ = elastica_tip_force(L, EI, EA, GA, force, follower=True)
+    dead_ref, _ = elastica(L, EI, EA, GA, force)
+    follower_ref, _ = elastica(L, EI, EA, GA, force, follower=True)
     n = 40
     dead = static_result(cantilever(n, rodmol.PointForce(L, (0.0, -force, 0.0)))).positions[0, -1, :2]
     follower = static_result(cantilever(n, rodmol.PointForce(L, (0.0, -force, 0.0), frame="local")))
