@@ -26,6 +26,9 @@ SCRIPTS = {
 @pytest.mark.subprocess
 @pytest.mark.parametrize("script", sorted(SCRIPTS))
 def test_script_smoke_run(script, tmp_path):
+    if script == "core_speed.py" and subprocess.run(
+            ["git", "-C", ROOT, "cat-file", "-e", "9fce6d7^{commit}"], capture_output=True).returncode != 0:
+        pytest.skip("needs a git checkout holding commit 9fce6d7")
     proc = subprocess.run([sys.executable, os.path.join(ROOT, "solvers", script), "--smoke",
                            "--out", str(tmp_path)], capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-4000:]
