@@ -21,6 +21,7 @@ L = paper_rod().length
 WAVY_BASE = rodmol.BaseMotion(
     velocity=lambda t: np.array([0.02 * np.sin(3 * t), 0.05 * np.cos(2 * t), -0.01]),
     angular_velocity=lambda t: np.array([0.3 * np.cos(t), -0.2, 0.1 * t]))
+generic_state = oracle.generic_state
 CONTACT_LAW = dict(stiffness=2e4, damping=40.0, friction=0.6, slip_speed=1e-3)
 
 
@@ -66,52 +67,6 @@ def _models():
 
 
 MODELS = _models()
-
-
-def _contact_positions(model, y, rng):
-    """Place the velocity nodes around each contact obstacle: outside, inside the
-    smoothing layer and beyond it."""
-    lay = rodmol.StateLayout(model.n_elements)
-    u = lay.field(y, "u")
-    radius = model.rod.radius_at(model.s_nodes[1:])
-    for load in model.loads:
-        if not isinstance(load, (rodmol.PlaneContact, rodmol.CapsuleContact)):
-            continue
-        h = 0.01 * radius if load.smoothing_depth is None else np.full(len(radius), load.smoothing_depth)
-        depth = h * rng.choice([-5.0, 0.3, 0.7, 2.0, 10.0, 40.0], size=len(radius))
-        if isinstance(load, rodmol.PlaneContact):
-            n = load.normal
-            tangent = rng.normal(size=(len(radius), 3)) * 0.1
-            tangent -= np.outer(tangent @ n, n)
-            u[:] = load.point + tangent + (radius - depth)[:, None] * n
-        else:
-            a, b = load.start, load.end
-            x = rng.uniform(-0.2, 1.2, size=len(radius))
-            centre = a + np.clip(x, 0.0, 1.0)[:, None] * (b - a)
-            d = rng.normal(size=(len(radius), 3))
-            if np.any(b != a):
-                axis = (b - a) / np.linalg.norm(b - a)
-                inner = (x > 0) & (x < 1)
-                d[inner] -= np.outer(d[inner] @ axis, axis)  # lateral where the cylinder is
-            d /= np.linalg.norm(d, axis=1, keepdims=True)
-            u[:] = centre + (load.radius + radius - depth)[:, None] * d
-    return y
-
-
-def generic_state(model, rng, contact=True):
-    """A perturbed straight rod, moving, with |Q| != 1 (and contact if any)."""
-    n = model.n_elements
-    lay = rodmol.StateLayout(n)
-    y = rodmol.straight_state(model)
-    b = lay.blocks(y)
-    b[:, 3:7] += 0.2 * rng.normal(size=(n, 4))
-    y[3:7] += 0.02 * rng.normal(size=4)
-    lay.field(y, "q")[:] += 0.03 * rng.normal(size=(n, 3))
-    lay.field(y, "k")[:] = 2.0 * rng.normal(size=(n, 3))
-    lay.field(y, "v")[:] = 0.1 * rng.normal(size=(n, 3))
-    lay.field(y, "w")[:] = 1.0 * rng.normal(size=(n, 3))
-    lay.field(y, "u")[:] += 0.01 * rng.normal(size=(n, 3))
-    return _contact_positions(model, y, rng) if contact else y
 
 
 def assert_rates_agree(got, expected, n, rtol):
