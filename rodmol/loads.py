@@ -81,11 +81,11 @@ class _PointLoad:
     def _setup(self, name, value):
         object.__setattr__(self, "s", _checks.non_negative(f"{name} `s`", self.s, " m"))
         object.__setattr__(self, "frame", _frame(self.frame, name))
-        object.__setattr__(self, self._what, as_time_input(f"{name} {self._what}", value, 3,
+        object.__setattr__(self, self._what, as_time_input(f"{self._what}` of `{name}", value, 3,
                                                            self._unit))
 
     def on_grid(self, s_nodes, radius):
-        length = s_nodes[-1]
+        length = float(s_nodes[-1])
         if self.s > length * (1 + 1e-12):
             raise ParameterError(f"{self.name}: `s` must lie in [0, L = {length!r} m], got {self.s!r}")
         nodes, weights = _node_shares(self.s, s_nodes)
