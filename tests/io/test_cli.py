@@ -12,7 +12,7 @@ import pytest
 import rodmol
 from rodmol.io.writers import read_pvd
 
-EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 SCENARIOS = sorted(EXAMPLES.glob("*.toml"))
 
 
@@ -40,6 +40,7 @@ def test_examples_are_shipped():
     assert {p.stem for p in SCENARIOS} >= {"bending", "reaching", "fetching", "uniform_arm_air"}
 
 
+@pytest.mark.subprocess
 @pytest.mark.parametrize("scenario", SCENARIOS, ids=lambda p: p.stem)
 def test_run_each_example_coarse(scenario, tmp_path):
     out = tmp_path / "out"
@@ -52,6 +53,7 @@ def test_run_each_example_coarse(scenario, tmp_path):
     assert "x real time" in run.stdout and "tip" in run.stdout
 
 
+@pytest.mark.subprocess
 def test_builtin_example_quiet(tmp_path):
     out = tmp_path / "fetch"
     run = rodmol_cli("example", "fetching", "--out", out, "--n-elements", 6, "--t-end", 0.05, "--quiet")
@@ -60,6 +62,7 @@ def test_builtin_example_quiet(tmp_path):
     assert rodmol.load_result(out / "result.npz").meta["name"] == "fetching"
 
 
+@pytest.mark.subprocess
 def test_malformed_scenario_exit_2_names_key_and_line_writes_nothing(tmp_path):
     text = (EXAMPLES / "bending.toml").read_text()
     text = text.replace("nu = 0.5", "nuu = 0.5").replace("rho = 1080.0", 'rho = "heavy"')
@@ -76,6 +79,7 @@ def test_malformed_scenario_exit_2_names_key_and_line_writes_nothing(tmp_path):
     assert not out.exists()
 
 
+@pytest.mark.subprocess
 def test_bad_command_line_value_exit_2(tmp_path):
     run = rodmol_cli("run", EXAMPLES / "bending.toml", "--n-elements", 1, "--out", tmp_path / "x")
     assert run.returncode == 2 and "command line --n-elements" in run.stderr
@@ -83,6 +87,7 @@ def test_bad_command_line_value_exit_2(tmp_path):
     assert rodmol_cli("render", tmp_path).returncode == 2
 
 
+@pytest.mark.subprocess
 def test_ctrl_c_keeps_a_valid_partial_run(tmp_path):
     out = tmp_path / "stopped"
     # The explicit backend on this grid takes minutes: the interrupt lands in the solver.
@@ -108,6 +113,7 @@ def test_ctrl_c_keeps_a_valid_partial_run(tmp_path):
     assert assert_valid_series(out) == pytest.approx(list(result.t))
 
 
+@pytest.mark.subprocess
 @pytest.mark.skipif(os.environ.get("RODMOL_SKIP_RENDER") == "1", reason="RODMOL_SKIP_RENDER=1")
 def test_render_and_plot(tmp_path):
     out = tmp_path / "r"

@@ -17,8 +17,8 @@ import rodmol
 from rodmol.io.writers import write_series
 
 PVPYTHON, XVFB = shutil.which("pvpython"), shutil.which("xvfb-run")
-pytestmark = pytest.mark.skipif(
-    not (PVPYTHON and XVFB), reason="needs pvpython and xvfb-run (apt-get install paraview xvfb xauth)")
+pytestmark = [pytest.mark.subprocess, pytest.mark.skipif(
+    not (PVPYTHON and XVFB), reason="needs pvpython and xvfb-run (apt-get install paraview xvfb xauth)")]
 
 SCRIPT = textwrap.dedent("""
     import json, sys

@@ -8,7 +8,7 @@ import pytest
 import rodmol
 from rodmol.io.scenario_file import Override, ScenarioError, load_scenario, parse_scenario
 
-EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 MINIMAL = """
 [rod]

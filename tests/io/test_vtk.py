@@ -48,7 +48,8 @@ def test_every_array_name_carries_its_unit(result, tmp_path):
     rod = pv.read(read_pvd(tmp_path / "rod.pvd")[0][1])
     expected = {"radius [m]", "s [m]", "linear strain [-]", "curvature [1/m]", "velocity [m/s]",
                 "angular velocity [rad/s]", "internal force [N]", "internal moment [N m]",
-                "frame x [-]", "frame y [-]", "frame z [-]"}
+                "frame x [-]", "frame y [-]", "frame z [-]", "external force [N/m]",
+                "external moment [N m/m]"}
     assert expected <= set(rod.point_data.keys())
 
 
@@ -96,3 +97,35 @@ def test_tube_of_radius_is_the_tapered_body(result, tmp_path):
     tube = rod.tube(scalars="radius [m]", absolute=True, n_sides=24)
     base = tube.points[np.abs(tube.points[:, 0]) < 1e-9]
     assert np.max(np.linalg.norm(base[:, 1:], axis=1)) == pytest.approx(result.radius[0], rel=1e-6)
+
+
+@pytest.fixture(scope="module")
+def loaded():
+    """A rod on a frictionless floor, pushed sideways at its tip and twisted along its length."""
+    rod = rodmol.Rod(0.3, 0.01, rodmol.Material(1e5, 0.5, 10.0, 1000.0))
+    loads = [rodmol.PointForce(0.3, [(0.0, 0.0, 0.0, 0.0), (0.04, 0.0, 0.0, 0.02)]),
+             rodmol.DistributedMoment((0.001, 0.0, 0.0)),
+             rodmol.PlaneContact((0.0, -0.05, 0.0), (0.0, 1.0, 0.0), 1e4)]
+    return rodmol.simulate(rodmol.Model(rod, 12, loads=loads), 0.04, output_dt=0.01)
+
+
+def test_external_loads_are_written_as_in_the_result(loaded, tmp_path):
+    write_series(loaded, tmp_path)
+    entries = read_pvd(tmp_path / "rod.pvd")
+    assert len(entries) == len(loaded.t) == 5
+    for k, (_, path) in enumerate(entries):
+        mesh = pv.read(path)
+        np.testing.assert_array_equal(mesh.point_data["external force [N/m]"], loaded.external_force[k])
+        np.testing.assert_array_equal(mesh.point_data["external moment [N m/m]"], loaded.external_moment[k])
+    last = pv.read(entries[-1][1])
+    force, moment = last.point_data["external force [N/m]"], last.point_data["external moment [N m/m]"]
+    assert np.all(force[0] == 0.0) and np.all(moment[0] == 0.0)  # the clamp carries none
+    # Global frame: away from the floor, the dead moment density is (0.001, 0, 0) exactly.
+    free = np.flatnonzero(force[:, 1] == 0.0)[1:]
+    assert len(free) >= 3
+    np.testing.assert_allclose(moment[free], [[0.001, 0.0, 0.0]] * len(free), rtol=0, atol=1e-15)
+    # The tip node carries the point force (0, 0, 0.02) N as a density over ds; the
+    # frictionless floor pushes along +y only.
+    assert force[-1, 2] == pytest.approx(0.02 / loaded.s[1], rel=1e-12)
+    np.testing.assert_allclose(force[:-1, 2], 0.0, rtol=0, atol=1e-14)
+    assert np.max(force[:, 1]) > 0.5  # the floor pushes up where the rod rests on it
