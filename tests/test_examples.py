@@ -1,0 +1,35 @@
+"""The benchmark scripts in examples/ run and print small relative errors."""
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+ERROR = re.compile(r"relative error[^:]*:\s*([0-9.eE+-]+)")
+
+# script -> bound on every printed relative error (measured values in comments).
+CASES = {
+    "cantilever_tip_force.py": 0.01,  # dead 4.2e-3, follower 3.0e-3 at N = 80
+    "tip_moment_circle.py": 0.01,     # tip gap ~1e-16, curvature 0, radius 2.1e-3 (N = 40)
+    "timoshenko_beam.py": 0.01,       # 6.5e-3 at N = 80
+}
+
+
+def run(script, *args):
+    return subprocess.run([sys.executable, str(EXAMPLES / script), *args], capture_output=True,
+                          text=True, timeout=300, check=False)
+
+
+@pytest.mark.subprocess
+@pytest.mark.parametrize("script", sorted(CASES))
+def test_example_prints_small_errors(script, tmp_path):
+    png = tmp_path / "figure.png"
+    out = run(script, "--plot", str(png))
+    assert out.returncode == 0, out.stderr
+    errors = [float(e) for e in ERROR.findall(out.stdout)]
+    assert errors, out.stdout
+    assert max(errors) < CASES[script], out.stdout
+    assert png.stat().st_size > 10_000
