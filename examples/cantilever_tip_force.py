@@ -57,6 +57,7 @@ def rodmol_positions(n, frame):
     rod = rodmol.Rod(L, RADIUS, rodmol.Material(E, NU, rho=RHO))
     model = rodmol.Model(rod, n, gravity=(0.0, 0.0, 0.0),
                          loads=[rodmol.PointForce(L, (0.0, -FORCE, 0.0), frame=frame)])
+    # Frame 0 of a (negligibly short) run is its initial state: the static equilibrium.
     result = rodmol.simulate(model, 1e-6, initial="equilibrium", output_dt=1e-6)
     return result.positions[0]
 

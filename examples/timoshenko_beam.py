@@ -35,6 +35,7 @@ def rodmol_positions(n):
     rod = rodmol.Rod(L, RADIUS, rodmol.Material(E, rho=RHO, G=G))
     model = rodmol.Model(rod, n, gravity=(0.0, 0.0, 0.0),
                          loads=[rodmol.PointForce(L, (0.0, -FORCE, 0.0))])
+    # Frame 0 of a (negligibly short) run is its initial state: the static equilibrium.
     return rodmol.simulate(model, 1e-6, initial="equilibrium", output_dt=1e-6).positions[0]
 
 

@@ -27,6 +27,7 @@ def equilibrium_result(n, moment):
     rod = rodmol.Rod(L, RADIUS, rodmol.Material(E, NU, rho=RHO))
     model = rodmol.Model(rod, n, gravity=(0.0, 0.0, 0.0),
                          loads=[rodmol.PointMoment(L, (0.0, 0.0, moment), frame="local")])
+    # Frame 0 of a (negligibly short) run is its initial state: the static equilibrium.
     return rodmol.simulate(model, 1e-6, initial="equilibrium", output_dt=1e-6)
 
 
