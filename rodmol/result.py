@@ -138,8 +138,10 @@ def from_states(system, t, y, success, message, stats):
     def mechanics():
         """Strains, velocities, stresses and external loads at all nodes."""
         stress, loads = system.frames(t, y)
-        # Tip node: the body carries minus the stress of the cables anchored at the tip.
-        n_tip, m_tip = np.zeros((n_t, 3)), np.zeros((n_t, 3))
+        # Tip node: the body carries the load concentrated on the tip node (a
+        # point load at s = L; distributed loads give an O(ds) share) minus the
+        # stress of the cables anchored at the tip.
+        n_tip, m_tip = loads[:, -1, :3] * model.ds, loads[:, -1, 3:] * model.ds
         for c, cable in enumerate(model.cables):
             if model.cable_weights[c, -1] != 1.0:
                 continue
