@@ -8,14 +8,14 @@ and that central Jacobian has no entry outside ``system.pattern()``.
 """
 
 import numpy as np
+import oracle
 import pytest
 import scipy.linalg
 
-import oracle
 import rodmol
 from rodmol.arm import paper_rod
 from rodmol.discretise import external, preconditioner, upwind
-from rodmol.discretise.layout import FIELDS, HEADER, StateLayout, merge
+from rodmol.discretise.layout import FIELDS, HEADER, merge
 
 L = paper_rod().length
 N = 8
@@ -239,7 +239,6 @@ def test_jacobian_templates_agree():
         np.testing.assert_array_equal(system.jacobian(scale, matrix).dense(t, y), band)
     sparse = system.jacobian(scale, "sparse")
     np.testing.assert_array_equal(sparse.sparsity.toarray() != 0, system.pattern())
-    StateLayout(N)  # layout import is used by the helpers above
 
 
 # ----------------------------------------------------------------------------- solvers built on them

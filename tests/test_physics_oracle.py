@@ -8,14 +8,13 @@ moving away fast enough that the damping cancels the penalty.
 """
 
 import numpy as np
+import oracle
 import pytest
 
 import rodmol
 from rodmol.arm import paper_rod
 from rodmol.discretise import external, physics
 from rodmol.discretise import system as system_module
-
-import oracle
 
 L = paper_rod().length
 WAVY_BASE = rodmol.BaseMotion(
