@@ -5,9 +5,8 @@ import os
 
 import numpy as np
 
-from .discretise import centreline, physics, rotations
-
 from . import markers
+from .discretise import centreline, physics, rotations
 from .model import Q_STAR
 
 #: Arrays of a Result, with their units (also the keys of the .npz file).
@@ -142,7 +141,7 @@ def from_states(system, t, y, success, message, stats):
         # point load at s = L; distributed loads give an O(ds) share) minus the
         # stress of the cables anchored at the tip.
         n_tip, m_tip = loads[:, -1, :3] * model.ds, loads[:, -1, 3:] * model.ds
-        for c, cable in enumerate(model.cables):
+        for c in range(len(model.cables)):
             if model.cable_weights[c, -1] != 1.0:
                 continue
             p = tuple(model.cable_offsets[c])

@@ -5,15 +5,14 @@ import warnings
 import numpy as np
 
 from . import _checks
-
 from .discretise import rotations
-from .solve.backends import DEFAULT_RTOL, get_backend
-from .solve.equilibrium import equilibrium
-from .errors import ParameterError
 from .discretise.layout import StateLayout
+from .discretise.system import SemiDiscrete
+from .errors import ParameterError
 from .model import Model
 from .result import from_states
-from .discretise.system import SemiDiscrete
+from .solve.backends import DEFAULT_RTOL, get_backend
+from .solve.equilibrium import equilibrium
 
 
 def default_atol(model, rtol):

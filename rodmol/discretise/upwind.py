@@ -27,7 +27,7 @@ import numba
 import numpy as np
 
 from .external import load
-from .layout import BLOCK, HEADER, K, QUAT, U, V, W
+from .layout import BLOCK, HEADER, QUAT, K, U, V, W
 from .layout import Q as QS
 from .physics import (
     add,
