@@ -29,11 +29,11 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))  # run from a checkout without installing
 
 import rodmol  # noqa: E402
-from rodmol.solve.backends import cvode, rk23  # noqa: E402,F401
-from rodmol.result import from_states  # noqa: E402
 from rodmol.discretise.layout import BLOCK, HEADER, StateLayout  # noqa: E402
 from rodmol.discretise.system import SemiDiscrete  # noqa: E402,F401
+from rodmol.result import from_states  # noqa: E402
 from rodmol.simulate import default_atol  # noqa: E402,F401
+from rodmol.solve.backends import cvode, rk23  # noqa: E402,F401
 
 RESULTS = os.path.join(HERE, "results")
 

@@ -60,6 +60,7 @@ def _per_call(fn, calls):
 class _Worker:
     def __init__(self, n, t_end):
         import numpy as np
+
         import rodmol
 
         self.np, self.rodmol = np, rodmol
@@ -77,8 +78,9 @@ class _Worker:
             self.jac = system.jacobian(scale, None)
             self.pre = system.preconditioner(scale)
         else:  # before the refactor (9fce6d7)
-            from rodmol import jacobian, kernels
             from rodmol.semidiscrete import SemiDiscrete
+
+            from rodmol import jacobian, kernels
 
             self.version = "old"
             system = SemiDiscrete(self.model)
@@ -160,7 +162,7 @@ def worker_main():
                 answer = w.percall(cmd["calls"])
             else:
                 break
-        except Exception as exc:  # hand the failure to the parent
+        except Exception as exc:  # noqa: BLE001  (hand any failure to the parent)
             import traceback
 
             answer = dict(error=f"{type(exc).__name__}: {exc}", traceback=traceback.format_exc())
@@ -179,7 +181,7 @@ class Version:
         for var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS"):
             env[var] = "1"
         self.label, self.tree = label, tree
-        self._err = open(stderr_path, "w")
+        self._err = open(stderr_path, "w")  # noqa: SIM115  (open for the worker's lifetime)
         self.proc = subprocess.Popen([sys.executable, os.path.abspath(__file__), "--worker"], env=env,
                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self._err,
                                      text=True, cwd=tree)
@@ -202,7 +204,7 @@ class Version:
             self.proc.stdin.write(json.dumps(dict(cmd="quit")) + "\n")
             self.proc.stdin.close()
             self.proc.wait(timeout=30)
-        except Exception:
+        except Exception:  # noqa: BLE001  (a worker that will not quit is killed)
             self.proc.kill()
             self.proc.wait()
         self._err.close()
@@ -296,11 +298,7 @@ def main(argv=None):
         shutil.rmtree(tmp, ignore_errors=True)
 
     # Tip trajectories.
-    length = None
-    try:
-        length = C.rodmol.scenarios.get("bending").model(n).rod.length
-    except Exception:
-        pass
+    length = C.rodmol.scenarios.get("bending").model(n).rod.length
     a, b = tips["old"], tips["new"]
     same_times = a.shape == b.shape and np.allclose(a[:, 0], b[:, 0])
     m = min(len(a), len(b))
