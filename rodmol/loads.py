@@ -52,6 +52,13 @@ class GridLoad:
     initial: np.ndarray
     values: Callable | None = None
 
+    def fill(self, t, out):
+        """Write the entries' values at time t into ``out`` (n_entries, 3),
+        for a combined load whose ``values`` lists (entry slice, values(t))."""
+        for rows, at in self.values:
+            out[rows] = at(t)
+        return out
+
 
 def _frame(frame, name):
     if frame not in FRAMES:

@@ -172,10 +172,7 @@ class Model:
         if self.cables:
             scale += float(np.sum(self.tensions(t)))
         g = self.grid_loads
-        values = g.initial.copy()
-        for rows, at in g.values:
-            values[rows] = at(t)
-        size = np.linalg.norm(values, axis=1) * g.weight * self.ds
+        size = np.linalg.norm(g.fill(t, g.initial.copy()), axis=1) * g.weight * self.ds
         forces = np.isin(g.kind, (external.FOLLOWER_FORCE, external.DEAD_FORCE))
         moments = np.isin(g.kind, (external.FOLLOWER_MOMENT, external.DEAD_MOMENT))
         return scale + float(np.sum(size[forces]) + np.sum(size[moments]) / self.rod.length)

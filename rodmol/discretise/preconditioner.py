@@ -90,6 +90,24 @@ def _invert(a, out, n, work):
 
 
 @jit
+def _shifted_inverse(jac, first, size, gamma, m, out, work):
+    """out[:size, :size] = (I - gamma J)^-1 of the diagonal block of ``jac``
+    starting at row and column ``first``; ``m`` and ``work`` are scratch."""
+    for i in range(size):
+        for j in range(size):
+            m[i, j] = (1.0 if i == j else 0.0) - gamma * jac[first + i, first + j]
+    _invert(m, out, size, work)
+
+
+@jit
+def _store(a, size, row, at):
+    """Copy a[:size, :size] row-major into ``row[at:]``."""
+    for i in range(size):
+        for j in range(size):
+            row[at + size * i + j] = a[i, j]
+
+
+@jit
 def block_setup(jb, jh, gamma, head, fac):
     """Factor (I - gamma J) for :func:`block_solve`; J in the blocks of
     :func:`rodmol.discretise.jacobian.jacobian_blocks`. ``head`` (7, 7) receives
@@ -100,10 +118,7 @@ def block_setup(jb, jh, gamma, head, fac):
     up = np.empty((NX, NX))
     inv = np.empty((NP, NP))
     work = np.empty((NP, 2 * NP))
-    for i in range(NP):
-        for j in range(NP):
-            m[i, j] = (1.0 if i == j else 0.0) - g * jh[i, j]
-    _invert(m, head, NP, work)
+    _shifted_inverse(jh, 0, NP, g, m, head, work)
     for b in range(n):
         f = fac[b]
         for i in range(NX):
@@ -112,20 +127,10 @@ def block_setup(jb, jh, gamma, head, fac):
                 f[F_CP + NX * i + j] = jb[b, 2, _Z0 + i, _X0 + j] if b + 1 < n else 0.0
             for j in range(NP):
                 f[F_G + NP * i + j] = jb[b, 1, _Z0 + i, _P0 + j]
-        for i in range(NP):
-            for j in range(NP):
-                m[i, j] = (1.0 if i == j else 0.0) - g * jb[b, 1, _P0 + i, _P0 + j]
-        _invert(m, inv, NP, work)
-        for i in range(NP):
-            for j in range(NP):
-                f[F_AINV + NP * i + j] = inv[i, j]
-        for i in range(NX):
-            for j in range(NX):
-                m[i, j] = (1.0 if i == j else 0.0) - g * jb[b, 1, _X0 + i, _X0 + j]
-        _invert(m, inv, NX, work)
-        for i in range(NX):
-            for j in range(NX):
-                f[F_BINV + NX * i + j] = inv[i, j]
+        _shifted_inverse(jb[b, 1], _P0, NP, g, m, inv, work)
+        _store(inv, NP, f, F_AINV)
+        _shifted_inverse(jb[b, 1], _X0, NX, g, m, inv, work)  # leaves BINV in inv for SX, TX
+        _store(inv, NX, f, F_BINV)
         for i in range(NX):
             for j in range(NX):
                 sv = 0.0

@@ -73,7 +73,7 @@ class SemiDiscrete:
         self._setup_cables()
         self._setup_loads()
         self.depends = merge(self.scheme.DEPENDS, external.dependency_table(set(self._kinds)))
-        self._inputs_vary = bool(self.global_coupling or self._timed or self._timed_loads
+        self._inputs_vary = bool(self.global_coupling or self._timed or self._grid_loads.values
                                  or not self._fixed_base)
         # The kernel's arguments: arrays whose contents update_inputs refreshes in place.
         self._args = (self._params, self._consts, self._offsets, self._weights, self.tension_values,
@@ -107,7 +107,7 @@ class SemiDiscrete:
         self._entry_weights = np.ascontiguousarray(entries.weight, dtype=float)
         self._entry_params = np.ascontiguousarray(entries.params, dtype=float).reshape(-1, external.N_PARAMS)
         self.entry_values = np.ascontiguousarray(entries.initial, dtype=float).reshape(-1, 3)
-        self._timed_loads = entries.values
+        self._grid_loads = entries
 
     def update_inputs(self, t, y=None):
         """Evaluate the time-dependent inputs at t, in place: the tensions of
@@ -123,8 +123,7 @@ class SemiDiscrete:
         if not self._fixed_base:
             v0, w0 = m.base.velocities(t)
             self.base_velocities[:3], self.base_velocities[3:] = v0, w0
-        for rows, values in self._timed_loads:
-            self.entry_values[rows] = values(t)
+        self._grid_loads.fill(t, self.entry_values)
 
     def tensions(self, t, y=None):
         """Tensions of all cables at (t, y), shape (n_cables,) [N]."""
@@ -152,13 +151,15 @@ class SemiDiscrete:
         load values) scaled by ``load_factor``, for the equilibrium's
         continuation. Feedback tensions are evaluated with ``state=None``."""
         self.update_inputs(t, None)
-        args = self.kernel_arguments()
-        if load_factor != 1.0:
-            consts = self._consts.copy()
-            consts[4:7] *= load_factor
-            args = (args[0], consts, args[2], args[3], args[4] * load_factor, *args[5:10],
-                    args[10] * load_factor, args[11])
-        self.scheme.rhs(y, out, *args)
+        scaled = (self.tension_values, self._consts[4:7], self.entry_values)  # views, in place
+        saved = [inputs.copy() for inputs in scaled]
+        for inputs in scaled:
+            inputs *= load_factor
+        try:
+            self.scheme.rhs(y, out, *self._args)
+        finally:
+            for inputs, value in zip(scaled, saved):
+                inputs[:] = value
         return out
 
     def rates(self, t, states):

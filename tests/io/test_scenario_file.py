@@ -4,27 +4,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scenario_texts import MINIMAL
 
 import rodmol
 from rodmol.io.scenario_file import Override, ScenarioError, load_scenario, parse_scenario
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
-
-MINIMAL = """
-[rod]
-length = 0.3
-radius = 0.01
-
-[material]
-E = 1e5
-nu = 0.5
-mu = 10.0
-rho = 1000.0
-
-[solver]
-t_end = 1.0
-"""
-
 
 def problems(text, base_dir="."):
     with pytest.raises(ScenarioError) as info:

@@ -3,26 +3,14 @@ every problem of a bad load table with its line."""
 
 import numpy as np
 import pytest
+from scenario_texts import MINIMAL
 
 import rodmol
 from rodmol.io.scenario_file import ScenarioError, load_scenario, parse_scenario
 
-ARM = """
-[rod]
-length = 0.3
-radius = 0.01
-
-[material]
-E = 1e5
-nu = 0.5
-mu = 10.0
-rho = 1000.0
-
+ARM = MINIMAL + """
 [discretization]
 n_elements = 20
-
-[solver]
-t_end = 1.0
 """
 
 LOADS = """
