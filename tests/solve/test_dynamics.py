@@ -347,3 +347,25 @@ def test_periodic_input_gives_periodic_positions(long_runs):
         drift = np.max(np.linalg.norm(res.positions[j] - res.positions[i], axis=-1))
         print(f"\ncentreline change over one period from t = {t0} s: {drift / L:.2e} L")
         assert drift < 1e-3 * L
+
+
+# --------------------------------------------------------------------------
+# (e) observed order in space of the tip trajectory, both schemes
+# --------------------------------------------------------------------------
+
+@pytest.mark.parametrize("scheme, order", [("upwind", 1), ("centred", 2)])
+def test_tip_trajectory_converges_at_the_schemes_order(scheme, order):
+    """The bending test's first second (cable 11 ramped to 2 N, the arm
+    swings up), at a tolerance far below the space error: the largest tip
+    difference between N and 2N halves (upwind) or quarters (centred) as N
+    doubles. The full study to N = 800 is solvers/convergence.py."""
+    scenario = rodmol.scenarios.get("bending")
+    tips = []
+    for n in (12, 24, 48):
+        res = rodmol.simulate(scenario.model(n), 1.0, scheme=scheme, rtol=1e-8, output_dt=0.01)
+        assert res.success, res.message
+        tips.append(res.tip)
+    d = [np.max(np.linalg.norm(b - a, axis=1)) for a, b in zip(tips, tips[1:])]
+    observed = np.log2(d[0] / d[1])
+    print(f"\n{scheme}: differences {d} m, observed order {observed:.3f}")
+    assert order - 0.3 < observed < order + 0.5
