@@ -75,11 +75,11 @@ SCHEMES = {
     "centred": Scheme(
         "centred",
         "second order: cell properties at cell midpoints, centred non-derivative "
-        "terms, half a cell at the tip", 2, True, _CENTRED, 2e-5),
+        "terms, half a cell at the tip", 2, True, _CENTRED, 3e-5),
     "upwind": Scheme(
         "upwind",
         "the paper's scheme (section IV-C): one-sided non-derivative terms, first order",
-        1, False, _UPWIND, 1e-4),
+        1, False, _UPWIND, 1e-3),
 }
 DEFAULT_SCHEME = "centred"
 
