@@ -60,7 +60,10 @@ class Model:
     ``inertia``, ``net_mass``, ``drag_coefficient``, ``added``,
     ``cable_offsets``, ``cable_weights``, ``s_nodes``) are read-only: the
     compiled system copies them once, so they must not change afterwards.
-    Build a new Model to change a parameter.
+    Build a new Model to change a parameter. ``kl`` ... ``vth`` are sampled at
+    the strain nodes s_0..s_N-1, as the paper's upwind scheme reads them; a
+    scheme may sample the cells elsewhere (:meth:`cell_properties`,
+    ``SemiDiscrete.cells``: the centred scheme at the cells' midpoints).
     """
 
     def __init__(self, rod, n_elements, *, gravity=(0.0, -9.81, 0.0), medium=None,

@@ -105,8 +105,8 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
     gravity = (consts[4], consts[5], consts[6])
     centred = consts[CENTRED] != 0.0
 
-    # Pass 1, strain nodes i = 0..N-1: compatibility with forward differences
-    # of v, w (strain node 0 moves with the base), and the sectional stress.
+    # Pass 1, cells i = 0..N-1: compatibility with the differences of v, w
+    # across the cell (cell 0 starts at the base), and the sectional stress.
     for i in range(n):
         o = HEADER + BLOCK * i
         q, k, v, w = _vec(y, o + QS), _vec(y, o + K), _vec(y, o + V), _vec(y, o + W)
