@@ -18,7 +18,7 @@ from .base_motion import Base, BaseMotion
 from .cables import Cable, read_tension_csv
 from .discretise.layout import StateLayout
 from .discretise.system import SemiDiscrete, StateView
-from .errors import EquilibriumError, IntegrationError, ParameterError, RodmolError
+from .errors import EquilibriumError, IntegrationError, ParameterError, RodmolError, UserFunctionError
 from .io.scenario_file import ScenarioError, load_scenario
 from .io.writers import write_series
 from .loads import (
@@ -45,7 +45,7 @@ __all__ = [
     "BACKENDS", "Base", "BaseMotion", "Cable", "CapsuleContact", "DistributedForce",
     "DistributedMoment", "PlaneContact", "PointForce", "PointMoment", "SphereContact", "EquilibriumError", "IntegrationError", "MEDIA",
     "Marker", "Material", "Medium", "Model", "ParameterError", "Result", "Rod", "RodmolError",
-    "ScenarioError", "SemiDiscrete", "StateLayout", "StateView", "default_atol", "energy",
+    "ScenarioError", "SemiDiscrete", "StateLayout", "StateView", "UserFunctionError", "default_atol", "energy",
     "equilibrium", "load_result", "load_scenario", "marker_errors", "paper_arm",
     "read_tension_csv", "scenarios", "simulate", "straight_state", "write_series",
 ]

@@ -5,6 +5,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import _checks
 from .errors import ParameterError
 
 _ZERO = np.zeros(3)
@@ -51,8 +52,11 @@ class BaseMotion:
 
     def velocities(self, t):
         """(v0, w0) at time t [m/s, rad/s], local frame."""
-        v = _ZERO if self.velocity is None else _vector(self.velocity(t), "velocity", t)
-        w = _ZERO if self.angular_velocity is None else _vector(self.angular_velocity(t), "angular_velocity", t)
+        try:
+            v = _ZERO if self.velocity is None else _vector(self.velocity(t), "velocity", t)
+            w = _ZERO if self.angular_velocity is None else _vector(self.angular_velocity(t), "angular_velocity", t)
+        except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
+            raise _checks.user_error("a base motion function", exc, t) from exc
         return v, w
 
     @classmethod

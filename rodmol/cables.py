@@ -9,7 +9,7 @@ A tension input is any of
   (an optional header line; ``#`` starts a comment), as logged by a rig;
 * a callable ``T(t)``;
 * a callable ``T(t, state)`` with two required arguments (feedback): ``state`` is a :class:`rodmol.StateView`
-  (``None`` while the initial equilibrium is solved). Its dependence on the
+  (while the initial equilibrium is solved, a view of the current iterate, at rest). Its dependence on the
   state is global, so it is not in the banded Jacobian; CVODE's default
   linear solver for such models is therefore GMRES, whose Jacobian-vector
   products are differences of the full right-hand side and do carry it
@@ -131,7 +131,10 @@ class Cable:
 
     def tension_at(self, t, state=None):
         """Tension [N] at time t; a negative value is an error naming the cable."""
-        value = self.tension(t, state)
+        try:
+            value = self.tension(t, state)
+        except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
+            raise _checks.user_error(f"cable {self.name!r}: the tension function", exc, t) from exc
         if not value >= 0.0:  # also catches NaN
             raise ParameterError(f"cable {self.name!r}: tension must be >= 0 N, got {float(value)!r} at t = {float(t)!r} s")
         return value

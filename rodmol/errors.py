@@ -13,6 +13,12 @@ class ParameterError(RodmolError, ValueError):
     """An input parameter is invalid; the message names it and its value."""
 
 
+class UserFunctionError(ParameterError):
+    """A function the user gave (a tension, a load, a base motion, a radius)
+    raised or returned garbage; the original exception, with its traceback,
+    is the ``__cause__``."""
+
+
 class IntegrationError(RodmolError, RuntimeError):
     """A time integration failed; ``result`` holds what was computed so far."""
 

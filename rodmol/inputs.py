@@ -20,6 +20,7 @@ from bisect import bisect_right
 
 import numpy as np
 
+from ._checks import short, user_error
 from .errors import ParameterError
 
 
@@ -86,9 +87,12 @@ class Function(TimeInput):
         self.function, self.width, self.name = function, width, name
 
     def value(self, t):
-        raw = self.function(t)
-        if self.width == 1:
-            return float(raw)
+        try:
+            raw = self.function(t)
+            if self.width == 1:
+                return float(raw)
+        except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
+            raise user_error(f"`{self.name}` function", exc, t) from exc
         arr = np.asarray(raw, dtype=float)
         if arr.shape != (self.width,) or not np.all(np.isfinite(arr)):
             raise ParameterError(f"`{self.name}`({float(t)!r} s) must return {self.width} finite "
@@ -152,9 +156,8 @@ def _check_minimum(name, values, minimum, unit, where):
                              f"{values[i].tolist() if values.shape[1] > 1 else float(values[i, 0])!r}")
 
 
-def _short(value, limit=200):
-    text = repr(value)
-    return text if len(text) <= limit else text[:limit] + f"... ({len(text)} characters)"
+def _short(value):
+    return short(value)
 
 
 def _number(cell):

@@ -151,7 +151,10 @@ class _DistributedLoad:
         value = getattr(self, self._what)
         if not callable(value):
             return np.tile(value, (len(s), 1))
-        raw = value(s, t)
+        try:
+            raw = value(s, t)
+        except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
+            raise _checks.user_error(f"{self.name}: the {self._what}(s, t) function", exc, t) from exc
         try:
             arr = np.broadcast_to(np.asarray(raw, dtype=float), (len(s), 3))
         except (TypeError, ValueError):

@@ -164,13 +164,14 @@ class Model:
         """Cable tensions [N] at time t, shape (n_cables,)."""
         return np.array([c.tension_at(t, state) for c in self.cables])
 
-    def load_scale(self, t=0.0):
+    def load_scale(self, t=0.0, tensions=None):
         """A force scale [N] of the applied loads at time t: net weight, cable
-        tensions, external forces and external moments divided by L."""
+        tensions (``tensions`` [N] if given, else the inputs at t), external
+        forces and external moments divided by L."""
         net_density = abs(self.rod.material.rho - self.medium.rho)
         scale = net_density * np.linalg.norm(self.gravity) * self.rod.volume()
         if self.cables:
-            scale += float(np.sum(self.tensions(t)))
+            scale += float(np.sum(self.tensions(t) if tensions is None else tensions))
         g = self.grid_loads
         size = np.linalg.norm(g.fill(t, g.initial.copy()), axis=1) * g.weight * self.ds
         forces = np.isin(g.kind, (external.FOLLOWER_FORCE, external.DEAD_FORCE))

@@ -73,6 +73,7 @@ class Result:
         self.success, self.message = bool(success), str(message)
         self.stats = dict(stats or {})
         self.meta = dict(meta or {})
+        self.error = None  # the exception that ended a failed run, if any (not saved)
 
     def __getattr__(self, name):
         deferred = self.__dict__.get("_deferred", {})
