@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 
-from .errors import ParameterError, RodmolError, UserFunctionError
+from .errors import ParameterError, UserFunctionError
 
 #: Longest representation of a value quoted in a message [characters].
 SHORT = 200
@@ -23,9 +23,7 @@ def short(value, limit=SHORT):
 
 def user_error(what, exc, t=None):
     """The :class:`UserFunctionError` for exception ``exc`` raised by the user's
-    function ``what``, to be raised ``from exc`` (rodmol's own errors pass as they are)."""
-    if isinstance(exc, RodmolError):
-        return exc
+    function ``what``, to be raised ``from exc``."""
     text = str(exc)
     text = text if len(text) <= SHORT else text[:SHORT] + f"... ({len(text)} characters)"
     when = f" (at t = {float(t):.6g} s)" if t is not None else ""

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _checks
-from .errors import ParameterError
+from .errors import ParameterError, RodmolError
 
 _ZERO = np.zeros(3)
 
@@ -55,6 +55,8 @@ class BaseMotion:
         try:
             v = _ZERO if self.velocity is None else _vector(self.velocity(t), "velocity", t)
             w = _ZERO if self.angular_velocity is None else _vector(self.angular_velocity(t), "angular_velocity", t)
+        except RodmolError:
+            raise
         except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
             raise _checks.user_error("a base motion function", exc, t) from exc
         return v, w

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from . import _checks
-from .errors import ParameterError
+from .errors import ParameterError, RodmolError
 from .inputs import Knots, TimeInput, as_time_input, read_table
 
 
@@ -133,6 +133,8 @@ class Cable:
         """Tension [N] at time t; a negative value is an error naming the cable."""
         try:
             value = self.tension(t, state)
+        except RodmolError:
+            raise
         except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
             raise _checks.user_error(f"cable {self.name!r}: the tension function", exc, t) from exc
         if not value >= 0.0:  # also catches NaN

@@ -21,7 +21,7 @@ from bisect import bisect_right
 import numpy as np
 
 from ._checks import short, user_error
-from .errors import ParameterError
+from .errors import ParameterError, RodmolError
 
 
 class TimeInput:
@@ -91,6 +91,8 @@ class Function(TimeInput):
             raw = self.function(t)
             if self.width == 1:
                 return float(raw)
+        except RodmolError:
+            raise
         except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
             raise user_error(f"`{self.name}` function", exc, t) from exc
         arr = np.asarray(raw, dtype=float)

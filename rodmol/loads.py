@@ -28,7 +28,7 @@ import numpy as np
 
 from . import _checks
 from .discretise import external
-from .errors import ParameterError
+from .errors import ParameterError, RodmolError
 from .inputs import TimeInput, as_time_input
 
 FRAMES = ("global", "local")
@@ -153,6 +153,8 @@ class _DistributedLoad:
             return np.tile(value, (len(s), 1))
         try:
             raw = value(s, t)
+        except RodmolError:
+            raise
         except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
             raise _checks.user_error(f"{self.name}: the {self._what}(s, t) function", exc, t) from exc
         try:
