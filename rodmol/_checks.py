@@ -32,7 +32,7 @@ def user_error(what, exc, t=None):
 
 def finite(name, value):
     """Return ``value`` as a float, or raise if it is not a finite number."""
-    if isinstance(value, (bool, np.bool_)):
+    if isinstance(value, (bool, np.bool_, str, bytes)):  # float("1e5") and float(True) work
         raise ParameterError(f"`{name}` must be a number, got {short(value)}")
     try:
         x = float(value)
