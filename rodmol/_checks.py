@@ -30,6 +30,16 @@ def user_error(what, exc, t=None):
     return UserFunctionError(f"{what} raised {type(exc).__name__}: {text}{when}")
 
 
+def floats(value):
+    """``value`` as a float array, or None if it is not numbers (ragged, huge, text)."""
+    if isinstance(value, (str, bytes)):
+        return None
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        return None
+
+
 def finite(name, value):
     """Return ``value`` as a float, or raise if it is not a finite number."""
     if isinstance(value, (bool, np.bool_, str, bytes)):  # float("1e5") and float(True) work
@@ -61,7 +71,7 @@ def vector3(name, value):
     """Return ``value`` as a finite float array of shape (3,)."""
     try:
         arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ParameterError(f"`{name}` must be three numbers, got {short(value)}") from None
     if arr.shape != (3,):
         raise ParameterError(f"`{name}` must have three components, got {short(value)}")

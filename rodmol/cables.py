@@ -86,7 +86,7 @@ def _required_arguments(function):
     """Positional parameters without defaults (``lambda t, gain=1.0: ...`` has one)."""
     try:
         parameters = inspect.signature(function).parameters.values()
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         return 1
     kinds = (inspect.Parameter.POSITIONAL_ONLY, inspect.Parameter.POSITIONAL_OR_KEYWORD)
     return sum(1 for p in parameters if p.kind in kinds and p.default is inspect.Parameter.empty)
@@ -114,10 +114,11 @@ class Cable:
     name: str = field(default="cable")
 
     def __post_init__(self):
-        p = np.asarray(self.offset, dtype=float) if np.ndim(self.offset) == 1 else None
+        p = _checks.floats(self.offset)
         if p is None or p.shape != (2,) or not np.all(np.isfinite(p)):
             raise ParameterError(
-                f"cable {self.name!r}: `offset` must be (p_y, p_z) in m, got {self.offset!r}"
+                f"cable {_checks.short(self.name)}: `offset` must be (p_y, p_z) in m, got "
+                f"{_checks.short(self.offset)}"
             )
         object.__setattr__(self, "offset", (float(p[0]), float(p[1])))
         object.__setattr__(self, "anchor", _checks.positive(f"cable {self.name!r} anchor",

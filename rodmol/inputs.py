@@ -20,7 +20,7 @@ from bisect import bisect_right
 
 import numpy as np
 
-from ._checks import short, user_error
+from ._checks import floats, short, user_error
 from .errors import ParameterError, RodmolError
 
 
@@ -95,10 +95,10 @@ class Function(TimeInput):
             raise
         except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
             raise user_error(f"`{self.name}` function", exc, t) from exc
-        arr = np.asarray(raw, dtype=float)
-        if arr.shape != (self.width,) or not np.all(np.isfinite(arr)):
+        arr = floats(raw)
+        if arr is None or arr.shape != (self.width,) or not np.all(np.isfinite(arr)):
             raise ParameterError(f"`{self.name}`({float(t)!r} s) must return {self.width} finite "
-                                 f"numbers, got {raw!r}")
+                                 f"numbers, got {short(raw)}")
         return arr
 
     def __repr__(self):
@@ -120,7 +120,7 @@ def as_time_input(name, value, width=1, unit="", minimum=None):
         return Function(value, width, name)
     try:
         arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ParameterError(f"`{name}` must be a number, {width} numbers, knots, a CSV path "
                              f"or a callable of t, got {_short(value)}") from None
     if arr.shape == (width,) or (width == 1 and arr.ndim == 0):

@@ -159,7 +159,7 @@ class _DistributedLoad:
             raise _checks.user_error(f"{self.name}: the {self._what}(s, t) function", exc, t) from exc
         try:
             arr = np.broadcast_to(np.asarray(raw, dtype=float), (len(s), 3))
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise ParameterError(f"{self.name}: {self._what}(s, t) must return (len(s), 3) values "
                                  f"for an array s, got {raw!r}") from None
         if not np.all(np.isfinite(arr)):

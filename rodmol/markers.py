@@ -21,8 +21,8 @@ class Marker:
     def __post_init__(self):
         object.__setattr__(self, "s", _checks.non_negative(f"marker {self.name!r} s", self.s, " m"))
         if self.offset is not None:
-            p = np.asarray(self.offset, dtype=float)
-            if p.shape != (2,) or not np.all(np.isfinite(p)):
+            p = _checks.floats(self.offset)
+            if p is None or p.shape != (2,) or not np.all(np.isfinite(p)):
                 raise ParameterError(f"marker {self.name!r}: `offset` must be (p_y, p_z) in m, "
                                      f"got {self.offset!r}")
             object.__setattr__(self, "offset", (float(p[0]), float(p[1])))

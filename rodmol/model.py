@@ -22,6 +22,9 @@ from .rod import Rod
 #: Strain of the straight reference configuration, q* = (1, 0, 0).
 Q_STAR = np.array([1.0, 0.0, 0.0])
 Q_STAR.flags.writeable = False
+#: Most elements a Model accepts (memory, not accuracy, is the limit: a run at
+#: N = 1e4 already takes minutes per simulated second).
+MAX_ELEMENTS = 100_000
 #: The sampled arrays of a Model (read-only once built).
 SAMPLED = ("s_nodes", "kl", "kth", "vl", "vth", "added", "mass", "inertia", "net_mass",
            "drag_coefficient", "cable_offsets", "cable_weights")
@@ -70,6 +73,8 @@ class Model:
             raise ParameterError(f"`rod` must be a rodmol.Rod, got {rod!r}")
         self.rod = rod
         self.n_elements = _checks.integer_at_least("n_elements", n_elements, 2)
+        if self.n_elements > MAX_ELEMENTS:  # refused before the grid is allocated
+            raise ParameterError(f"`n_elements` must be <= {MAX_ELEMENTS}, got {self.n_elements}")
         self.gravity = _checks.vector3("gravity", gravity)
         self.medium = _medium(medium, medium_density)
         self.cables = tuple(cables)

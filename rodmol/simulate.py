@@ -129,7 +129,7 @@ def _state_sized(name, value, size, positive=False, layout=None):
     the error names the first bad entry, which numpy's summarised repr would hide."""
     try:
         arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ParameterError(f"`{name}` must be numbers, got {_checks.short(value)}") from None
     if positive and arr.ndim == 0:
         if not (np.isfinite(arr) and arr > 0):

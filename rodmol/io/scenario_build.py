@@ -12,7 +12,7 @@ from ..arm import LENGTH as PAPER_LENGTH
 from ..arm import paper_arm
 from ..discretise.layout import StateLayout
 from ..errors import ParameterError
-from ..model import Model
+from ..model import MAX_ELEMENTS, Model
 from ..solve import options as run_options
 from ..solve.backends import BACKENDS, DEFAULT_RTOL
 from . import scenario_arm as arm_tables
@@ -108,7 +108,7 @@ def _entry_name(kind, index, entry):
 def _discretization(data, ctx):
     path = ("discretization",)
     table = ctx.table(data.get("discretization", {}), path, DISCRETIZATION)
-    return ctx.read(table, path, "n_elements", read.integer(2), 100)
+    return ctx.read(table, path, "n_elements", read.integer(2, MAX_ELEMENTS), 100)
 
 
 def _solver(data, ctx, t_end_default, n_elements):
