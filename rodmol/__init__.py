@@ -19,7 +19,7 @@ from .cables import Cable, read_tension_csv
 from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
 from .discretise.system import SemiDiscrete, StateView
-from .errors import EquilibriumError, IntegrationError, ParameterError, RodmolError
+from .errors import EquilibriumError, IntegrationError, ParameterError, RodmolError, UserFunctionError
 from .io.scenario_file import ScenarioError, load_scenario
 from .io.writers import write_series
 from .loads import (
@@ -46,7 +46,8 @@ __all__ = [
     "BACKENDS", "Base", "BaseMotion", "Cable", "CapsuleContact", "DistributedForce",
     "DistributedMoment", "PlaneContact", "PointForce", "PointMoment", "SphereContact", "EquilibriumError", "IntegrationError", "MEDIA",
     "Marker", "Material", "Medium", "Model", "ParameterError", "Result", "Rod", "RodmolError",
-    "SCHEMES", "ScenarioError", "SemiDiscrete", "StateLayout", "StateView", "default_atol", "energy",
+    "SCHEMES", "ScenarioError", "SemiDiscrete", "StateLayout", "StateView", "UserFunctionError",
+    "default_atol", "energy",
     "equilibrium", "load_result", "load_scenario", "marker_errors", "paper_arm",
     "read_tension_csv", "scenarios", "simulate", "straight_state", "write_series",
 ]

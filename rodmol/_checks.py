@@ -4,33 +4,66 @@ import math
 
 import numpy as np
 
-from .errors import ParameterError
+from .errors import ParameterError, UserFunctionError
+
+#: Longest representation of a value quoted in a message [characters].
+SHORT = 200
+
+
+def short(value, limit=SHORT):
+    """``repr(value)``, cut to ``limit`` characters (a 100,000-entry list is not echoed whole)."""
+    if isinstance(value, np.ndarray) and value.size > 64:
+        return f"<array of shape {value.shape}, dtype {value.dtype}>"
+    try:
+        text = repr(value)
+    except Exception as exc:  # noqa: BLE001 (a user object whose repr fails is still named)
+        return f"<{type(value).__name__} object (repr failed: {type(exc).__name__})>"
+    return text if len(text) <= limit else text[:limit] + f"... ({len(text)} characters)"
+
+
+def user_error(what, exc, t=None):
+    """The :class:`UserFunctionError` for exception ``exc`` raised by the user's
+    function ``what``, to be raised ``from exc``."""
+    text = str(exc)
+    text = text if len(text) <= SHORT else text[:SHORT] + f"... ({len(text)} characters)"
+    when = f" (at t = {float(t):.6g} s)" if t is not None else ""
+    return UserFunctionError(f"{what} raised {type(exc).__name__}: {text}{when}")
+
+
+def floats(value):
+    """``value`` as a float array, or None if it is not numbers (ragged, huge, text)."""
+    if isinstance(value, (str, bytes)):
+        return None
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        return None
 
 
 def finite(name, value):
     """Return ``value`` as a float, or raise if it is not a finite number."""
-    if isinstance(value, (bool, np.bool_)):
-        raise ParameterError(f"`{name}` must be a number, got {value!r}")
+    if isinstance(value, (bool, np.bool_, str, bytes)):  # float("1e5") and float(True) work
+        raise ParameterError(f"`{name}` must be a number, got {short(value)}")
     try:
         x = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"`{name}` must be a number, got {value!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(f"`{name}` must be a number, got {short(value)}") from None
     if not math.isfinite(x):
-        raise ParameterError(f"`{name}` must be finite, got {value!r}")
+        raise ParameterError(f"`{name}` must be finite, got {short(value)}")
     return x
 
 
 def positive(name, value, unit=""):
     x = finite(name, value)
     if x <= 0.0:
-        raise ParameterError(f"`{name}` must be > 0{unit}, got {value!r}")
+        raise ParameterError(f"`{name}` must be > 0{unit}, got {short(value)}")
     return x
 
 
 def non_negative(name, value, unit=""):
     x = finite(name, value)
     if x < 0.0:
-        raise ParameterError(f"`{name}` must be >= 0{unit}, got {value!r}")
+        raise ParameterError(f"`{name}` must be >= 0{unit}, got {short(value)}")
     return x
 
 
@@ -38,18 +71,18 @@ def vector3(name, value):
     """Return ``value`` as a finite float array of shape (3,)."""
     try:
         arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ParameterError(f"`{name}` must be three numbers, got {value!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(f"`{name}` must be three numbers, got {short(value)}") from None
     if arr.shape != (3,):
-        raise ParameterError(f"`{name}` must have three components, got {value!r}")
+        raise ParameterError(f"`{name}` must have three components, got {short(value)}")
     if not np.all(np.isfinite(arr)):
-        raise ParameterError(f"`{name}` must be finite, got {value!r}")
+        raise ParameterError(f"`{name}` must be finite, got {short(value)}")
     return arr
 
 
 def integer_at_least(name, value, minimum):
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise ParameterError(f"`{name}` must be an integer, got {value!r}")
+        raise ParameterError(f"`{name}` must be an integer, got {short(value)}")
     if value < minimum:
-        raise ParameterError(f"`{name}` must be >= {minimum}, got {value!r}")
+        raise ParameterError(f"`{name}` must be >= {minimum}, got {short(value)}")
     return int(value)

@@ -5,7 +5,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import ParameterError
+from . import _checks
+from .errors import ParameterError, RodmolError
 
 _ZERO = np.zeros(3)
 
@@ -38,11 +39,10 @@ class BaseMotion:
             f = getattr(self, name)
             if f is not None and not callable(f):
                 raise ParameterError(f"base `{name}` must be a callable of t, got {f!r}")
-        u = np.asarray(self.position, dtype=float)
-        r = np.asarray(self.rotation, dtype=float)
-        if u.shape != (3,) or not np.all(np.isfinite(u)):
+        u, r = _checks.floats(self.position), _checks.floats(self.rotation)
+        if u is None or u.shape != (3,) or not np.all(np.isfinite(u)):
             raise ParameterError(f"base `position` must be three finite numbers, got {self.position!r}")
-        if r.shape != (3, 3) or not np.allclose(r.T @ r, np.eye(3), atol=1e-9) or np.linalg.det(r) < 0:
+        if r is None or r.shape != (3, 3) or not np.all(np.isfinite(r)) or not np.allclose(r.T @ r, np.eye(3), atol=1e-9) or np.linalg.det(r) < 0:
             raise ParameterError(f"base `rotation` must be a 3x3 rotation matrix, got {self.rotation!r}")
 
     @property
@@ -51,8 +51,13 @@ class BaseMotion:
 
     def velocities(self, t):
         """(v0, w0) at time t [m/s, rad/s], local frame."""
-        v = _ZERO if self.velocity is None else _vector(self.velocity(t), "velocity", t)
-        w = _ZERO if self.angular_velocity is None else _vector(self.angular_velocity(t), "angular_velocity", t)
+        try:
+            v = _ZERO if self.velocity is None else _vector(self.velocity(t), "velocity", t)
+            w = _ZERO if self.angular_velocity is None else _vector(self.angular_velocity(t), "angular_velocity", t)
+        except RodmolError:
+            raise
+        except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
+            raise _checks.user_error("a base motion function", exc, t) from exc
         return v, w
 
     @classmethod
@@ -80,8 +85,8 @@ class BaseMotion:
 
 
 def _vector(value, name, t):
-    arr = np.asarray(value, dtype=float)
-    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+    arr = _checks.floats(value)
+    if arr is None or arr.shape != (3,) or not np.all(np.isfinite(arr)):
         raise ParameterError(f"base `{name}`({t!r}) must return three finite numbers, got {value!r}")
     return arr
 

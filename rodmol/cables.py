@@ -9,7 +9,7 @@ A tension input is any of
   (an optional header line; ``#`` starts a comment), as logged by a rig;
 * a callable ``T(t)``;
 * a callable ``T(t, state)`` with two required arguments (feedback): ``state`` is a :class:`rodmol.StateView`
-  (``None`` while the initial equilibrium is solved). Its dependence on the
+  (while the initial equilibrium is solved, a view of the current iterate, at rest). Its dependence on the
   state is global, so it is not in the banded Jacobian; CVODE's default
   linear solver for such models is therefore GMRES, whose Jacobian-vector
   products are differences of the full right-hand side and do carry it
@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from . import _checks
-from .errors import ParameterError
+from .errors import ParameterError, RodmolError
 from .inputs import Knots, TimeInput, as_time_input, read_table
 
 
@@ -86,7 +86,7 @@ def _required_arguments(function):
     """Positional parameters without defaults (``lambda t, gain=1.0: ...`` has one)."""
     try:
         parameters = inspect.signature(function).parameters.values()
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         return 1
     kinds = (inspect.Parameter.POSITIONAL_ONLY, inspect.Parameter.POSITIONAL_OR_KEYWORD)
     return sum(1 for p in parameters if p.kind in kinds and p.default is inspect.Parameter.empty)
@@ -114,10 +114,11 @@ class Cable:
     name: str = field(default="cable")
 
     def __post_init__(self):
-        p = np.asarray(self.offset, dtype=float) if np.ndim(self.offset) == 1 else None
+        p = _checks.floats(self.offset)
         if p is None or p.shape != (2,) or not np.all(np.isfinite(p)):
             raise ParameterError(
-                f"cable {self.name!r}: `offset` must be (p_y, p_z) in m, got {self.offset!r}"
+                f"cable {_checks.short(self.name)}: `offset` must be (p_y, p_z) in m, got "
+                f"{_checks.short(self.offset)}"
             )
         object.__setattr__(self, "offset", (float(p[0]), float(p[1])))
         object.__setattr__(self, "anchor", _checks.positive(f"cable {self.name!r} anchor",
@@ -131,7 +132,12 @@ class Cable:
 
     def tension_at(self, t, state=None):
         """Tension [N] at time t; a negative value is an error naming the cable."""
-        value = self.tension(t, state)
+        try:
+            value = self.tension(t, state)
+        except RodmolError:
+            raise
+        except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
+            raise _checks.user_error(f"cable {self.name!r}: the tension function", exc, t) from exc
         if not value >= 0.0:  # also catches NaN
             raise ParameterError(f"cable {self.name!r}: tension must be >= 0 N, got {float(value)!r} at t = {float(t)!r} s")
         return value

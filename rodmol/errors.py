@@ -9,8 +9,25 @@ class RodmolError(Exception):
     """Base class of every rodmol exception."""
 
 
+#: Longest line of an error message [characters]: a value quoted in full
+#: (say a 100,000-entry list) is cut, so messages stay readable.
+MAX_LINE = 600
+
+
 class ParameterError(RodmolError, ValueError):
     """An input parameter is invalid; the message names it and its value."""
+
+    def __init__(self, message="", *args):
+        lines = str(message).split("\n")
+        cut = [line if len(line) <= MAX_LINE else f"{line[:MAX_LINE]}... ({len(line)} characters)"
+               for line in lines]
+        super().__init__("\n".join(cut), *args)
+
+
+class UserFunctionError(ParameterError):
+    """A function the user gave (a tension, a load, a base motion, a radius)
+    raised or returned garbage; the original exception, with its traceback,
+    is the ``__cause__``."""
 
 
 class IntegrationError(RodmolError, RuntimeError):

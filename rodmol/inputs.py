@@ -20,7 +20,8 @@ from bisect import bisect_right
 
 import numpy as np
 
-from .errors import ParameterError
+from ._checks import floats, short, user_error
+from .errors import ParameterError, RodmolError
 
 
 class TimeInput:
@@ -86,13 +87,18 @@ class Function(TimeInput):
         self.function, self.width, self.name = function, width, name
 
     def value(self, t):
-        raw = self.function(t)
-        if self.width == 1:
-            return float(raw)
-        arr = np.asarray(raw, dtype=float)
-        if arr.shape != (self.width,) or not np.all(np.isfinite(arr)):
+        try:
+            raw = self.function(t)
+            if self.width == 1:
+                return float(raw)
+        except RodmolError:
+            raise
+        except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
+            raise user_error(f"`{self.name}` function", exc, t) from exc
+        arr = floats(raw)
+        if arr is None or arr.shape != (self.width,) or not np.all(np.isfinite(arr)):
             raise ParameterError(f"`{self.name}`({float(t)!r} s) must return {self.width} finite "
-                                 f"numbers, got {raw!r}")
+                                 f"numbers, got {short(raw)}")
         return arr
 
     def __repr__(self):
@@ -114,7 +120,7 @@ def as_time_input(name, value, width=1, unit="", minimum=None):
         return Function(value, width, name)
     try:
         arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ParameterError(f"`{name}` must be a number, {width} numbers, knots, a CSV path "
                              f"or a callable of t, got {_short(value)}") from None
     if arr.shape == (width,) or (width == 1 and arr.ndim == 0):
@@ -152,9 +158,8 @@ def _check_minimum(name, values, minimum, unit, where):
                              f"{values[i].tolist() if values.shape[1] > 1 else float(values[i, 0])!r}")
 
 
-def _short(value, limit=200):
-    text = repr(value)
-    return text if len(text) <= limit else text[:limit] + f"... ({len(text)} characters)"
+def _short(value):
+    return short(value)
 
 
 def _number(cell):

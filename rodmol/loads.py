@@ -28,7 +28,7 @@ import numpy as np
 
 from . import _checks
 from .discretise import external
-from .errors import ParameterError
+from .errors import ParameterError, RodmolError
 from .inputs import TimeInput, as_time_input
 
 FRAMES = ("global", "local")
@@ -157,10 +157,15 @@ class _DistributedLoad:
         value = getattr(self, self._what)
         if not callable(value):
             return np.tile(value, (len(s), 1))
-        raw = value(s, t)
+        try:
+            raw = value(s, t)
+        except RodmolError:
+            raise
+        except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
+            raise _checks.user_error(f"{self.name}: the {self._what}(s, t) function", exc, t) from exc
         try:
             arr = np.broadcast_to(np.asarray(raw, dtype=float), (len(s), 3))
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             raise ParameterError(f"{self.name}: {self._what}(s, t) must return (len(s), 3) values "
                                  f"for an array s, got {raw!r}") from None
         if not np.all(np.isfinite(arr)):

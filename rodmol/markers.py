@@ -21,8 +21,8 @@ class Marker:
     def __post_init__(self):
         object.__setattr__(self, "s", _checks.non_negative(f"marker {self.name!r} s", self.s, " m"))
         if self.offset is not None:
-            p = np.asarray(self.offset, dtype=float)
-            if p.shape != (2,) or not np.all(np.isfinite(p)):
+            p = _checks.floats(self.offset)
+            if p is None or p.shape != (2,) or not np.all(np.isfinite(p)):
                 raise ParameterError(f"marker {self.name!r}: `offset` must be (p_y, p_z) in m, "
                                      f"got {self.offset!r}")
             object.__setattr__(self, "offset", (float(p[0]), float(p[1])))
@@ -34,7 +34,13 @@ def marker_offsets(markers, rod):
     for i, m in enumerate(markers):
         if m.s > rod.length * (1 + 1e-12):
             raise ParameterError(f"marker {m.name!r}: `s` must lie in [0, L = {rod.length} m], got {m.s!r}")
-        out[i, 1:] = (float(rod.radius_at(min(m.s, rod.length))), 0.0) if m.offset is None else m.offset
+        radius = float(rod.radius_at(min(m.s, rod.length)))
+        out[i, 1:] = (radius, 0.0) if m.offset is None else m.offset
+        reach = float(np.hypot(*out[i, 1:]))
+        if reach > radius * (1 + 1e-9):
+            raise ParameterError(f"marker {m.name!r}: offset {m.offset} m (|p| = {reach:.6g} m) lies "
+                                 f"outside the body, whose radius at s = {m.s!r} m is {radius:.6g} m "
+                                 "(a marker is a point of the body or of its surface)")
     return out
 
 

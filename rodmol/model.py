@@ -22,6 +22,9 @@ from .rod import Rod
 #: Strain of the straight reference configuration, q* = (1, 0, 0).
 Q_STAR = np.array([1.0, 0.0, 0.0])
 Q_STAR.flags.writeable = False
+#: Most elements a Model accepts (memory, not accuracy, is the limit: a run at
+#: N = 1e4 already takes minutes per simulated second).
+MAX_ELEMENTS = 100_000
 #: The sampled arrays of a Model (read-only once built).
 SAMPLED = ("s_nodes", "kl", "kth", "vl", "vth", "added", "mass", "inertia", "net_mass",
            "drag_coefficient", "cable_offsets", "cable_weights")
@@ -73,6 +76,8 @@ class Model:
             raise ParameterError(f"`rod` must be a rodmol.Rod, got {rod!r}")
         self.rod = rod
         self.n_elements = _checks.integer_at_least("n_elements", n_elements, 2)
+        if self.n_elements > MAX_ELEMENTS:  # refused before the grid is allocated
+            raise ParameterError(f"`n_elements` must be <= {MAX_ELEMENTS}, got {self.n_elements}")
         self.gravity = _checks.vector3("gravity", gravity)
         self.medium = _medium(medium, medium_density)
         self.cables = tuple(cables)
@@ -176,13 +181,14 @@ class Model:
         """Cable tensions [N] at time t, shape (n_cables,)."""
         return np.array([c.tension_at(t, state) for c in self.cables])
 
-    def load_scale(self, t=0.0):
+    def load_scale(self, t=0.0, tensions=None):
         """A force scale [N] of the applied loads at time t: net weight, cable
-        tensions, external forces and external moments divided by L."""
+        tensions (``tensions`` [N] if given, else the inputs at t), external
+        forces and external moments divided by L."""
         net_density = abs(self.rod.material.rho - self.medium.rho)
         scale = net_density * np.linalg.norm(self.gravity) * self.rod.volume()
         if self.cables:
-            scale += float(np.sum(self.tensions(t)))
+            scale += float(np.sum(self.tensions(t) if tensions is None else tensions))
         g = self.grid_loads
         size = np.linalg.norm(g.fill(t, g.initial.copy()), axis=1) * g.weight * self.ds
         forces = np.isin(g.kind, (external.FOLLOWER_FORCE, external.DEAD_FORCE))

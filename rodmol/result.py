@@ -1,11 +1,11 @@
 """The result of a simulation: time series on the nodes, and its .npz file format."""
 
 import json
-import os
 
 import numpy as np
 
 from . import markers
+from ._files import write_atomically
 from .discretise import centreline, physics, rotations
 from .model import Q_STAR
 
@@ -78,6 +78,7 @@ class Result:
         self.success, self.message = bool(success), str(message)
         self.stats = dict(stats or {})
         self.meta = dict(meta or {})
+        self.error = None  # the exception that ended a failed run, if any (not saved)
 
     def __getattr__(self, name):
         deferred = self.__dict__.get("_deferred", {})
@@ -101,9 +102,9 @@ class Result:
         """Write the result to ``path`` (.npz); read it back with :func:`load_result`."""
         info = dict(success=self.success, message=self.message, stats=self.stats, meta=self.meta,
                     units=ARRAYS)
-        tmp = f"{os.fspath(path)}.part.npz"
-        np.savez_compressed(tmp, info=json.dumps(info), **{k: getattr(self, k) for k in ARRAYS})
-        os.replace(tmp, path)  # never leave a half-written file under the real name
+        arrays = {k: getattr(self, k) for k in ARRAYS}
+        # Never a half-written file under the real name (see write_atomically).
+        write_atomically(path, lambda handle: np.savez_compressed(handle, info=json.dumps(info), **arrays))
 
 
 def load_result(path):

@@ -34,15 +34,16 @@ class Rod:
         if not isinstance(self.material, Material):
             raise ParameterError(f"`material` must be a rodmol.Material, got {self.material!r}")
         if not callable(self.radius):
-            if np.ndim(self.radius) == 0:
+            shape = np.shape(r) if (r := _checks.floats(self.radius)) is not None else None
+            if shape == ():
                 _checks.positive("radius", self.radius, " m")
-            elif np.shape(self.radius) == (2,):
+            elif shape == (2,):
                 _checks.positive("radius[0] (base)", self.radius[0], " m")
                 _checks.positive("radius[1] (tip)", self.radius[1], " m")
             else:
                 raise ParameterError(
                     "`radius` must be a number, a (base, tip) pair or a callable r(s), "
-                    f"got {self.radius!r}"
+                    f"got {_checks.short(self.radius)}"
                 )
         # Callables are checked where they are sampled, on the actual grid.
         self.radius_at(np.linspace(0.0, self.length, 65))

@@ -7,13 +7,17 @@ import numpy as np
 from . import _checks
 from .discretise import rotations
 from .discretise.layout import StateLayout
-from .discretise.schemes import DEFAULT_SCHEME
+from .discretise.schemes import DEFAULT_SCHEME, get_scheme
 from .discretise.system import SemiDiscrete, field_scales
 from .errors import ParameterError
 from .model import Model
 from .result import from_states
+from .solve import options
 from .solve.backends import get_backend
 from .solve.equilibrium import equilibrium
+from .solve.watch import state_problem
+
+INITIAL = ("equilibrium", "straight")
 
 
 def default_atol(model, rtol):
@@ -34,7 +38,8 @@ def straight_state(model):
 
 
 def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, backend="cvode",
-             rtol=None, atol=None, output_dt=0.01, progress=None, **backend_options):
+             rtol=None, atol=None, output_dt=0.01, progress=None, max_wall_time=None,
+             **backend_options):
     """Integrate the model from t = 0 to ``t_end``.
 
     Parameters
@@ -60,35 +65,52 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
     output_dt : float
         Interval between output frames [s]; ``t_end`` is always an output.
     progress : callable, optional
-        ``progress(t, t_end)`` is called at each output time.
+        ``progress(t, t_end)`` is called at each output time, and between
+        them every half second of wall time (``rodmol.solve.watch``).
+    max_wall_time : float, optional
+        Wall-time budget [s]: the run stops there with ``success=False``.
     **backend_options
-        Passed to the backend (e.g. ``linsolver="sparse"`` for CVODE).
+        Passed to the backend (e.g. ``linsolver="sparse"`` for CVODE);
+        unknown names and bad values are refused before any work.
 
     Returns
     -------
     Result
-        If the solver fails or is interrupted, the result holds the frames
-        computed so far, ``success`` is False, ``message`` says where and why,
-        and a warning is issued.
+        If the solver fails, blows up, stalls or is interrupted, the result
+        holds the frames computed so far, ``success`` is False, ``message``
+        says where and why (see ``docs/troubleshooting.md``), ``error`` holds
+        the exception that ended it (e.g. a user function's, with its
+        traceback) and a warning is issued.
     """
     if not isinstance(model, Model):
         raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
     t_end = _checks.positive("t_end", t_end, " s")
     output_dt = _checks.positive("output_dt", output_dt, " s")
+    scheme = get_scheme(scheme)
+    rtol = options.rtol(scheme.default_rtol if rtol is None else rtol)
+    progress = options.progress(progress)
+    max_wall_time = options.max_wall_time(max_wall_time)
     run = get_backend(backend)
+    backend_options = options.backend_options(backend, run, backend_options)
+    size = StateLayout(model.n_elements).size
+    n_out = options.output_count(t_end, output_dt, size)
+    if isinstance(initial, str) and initial not in INITIAL:
+        raise ParameterError(f"unknown `initial` {_checks.short(initial)}"
+                             f"{options.did_you_mean(initial, INITIAL)}; use 'equilibrium', "
+                             "'straight' or a state")
+    if atol is not None:
+        atol = _state_sized("atol", atol, size, positive=True, layout=StateLayout(model.n_elements))
     system = SemiDiscrete(model, scheme)  # the one system of this run
-    rtol = _checks.positive("rtol", system.scheme.default_rtol if rtol is None else rtol)
     y0 = _initial_state(system, initial)
     if atol is None:
         atol = default_atol(model, rtol)
-    else:
-        atol = _state_sized("atol", atol, system.size, positive=True, layout=system.layout)
 
-    n_out = int(np.floor(t_end / output_dt + 1e-9))
     t_out = np.unique(np.append(np.arange(n_out + 1) * output_dt, t_end))
-    raw = run(system, y0, t_out, rtol=rtol, atol=atol, progress=progress, **backend_options)
+    raw = run(system, y0, t_out, rtol=rtol, atol=atol, progress=progress,
+              max_wall_time=max_wall_time, **backend_options)
     raw.stats["backend"] = backend
     result = from_states(system, raw.t, raw.y, raw.success, raw.message, raw.stats)
+    result.error = raw.error
     if not raw.success:
         warnings.warn(raw.message, RuntimeWarning, stacklevel=2)
     return result
@@ -100,8 +122,11 @@ def _initial_state(system, initial):
             return equilibrium(system.model, 0.0, system=system)
         if initial == "straight":
             return straight_state(system.model)
-        raise ParameterError(f"unknown `initial` {initial!r}; use 'equilibrium', 'straight' or a state")
-    return _state_sized("initial", initial, system.size, layout=system.layout)
+    y0 = _state_sized("initial", initial, system.size, layout=system.layout)
+    problem = state_problem(system.layout, system.model.ds, 0.0, y0)
+    if problem:
+        raise ParameterError(f"`initial` is not a state of this rod: {problem}")
+    return y0
 
 
 def _state_sized(name, value, size, positive=False, layout=None):
@@ -109,8 +134,8 @@ def _state_sized(name, value, size, positive=False, layout=None):
     the error names the first bad entry, which numpy's summarised repr would hide."""
     try:
         arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ParameterError(f"`{name}` must be numbers, got {value!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(f"`{name}` must be numbers, got {_checks.short(value)}") from None
     if positive and arr.ndim == 0:
         if not (np.isfinite(arr) and arr > 0):
             raise ParameterError(f"`{name}` must be finite and > 0, got {float(arr)!r}")

@@ -19,15 +19,33 @@ GAIN = 10.0  # N/m
 
 
 def controller(t, state):
-    if state is None:  # the initial equilibrium: no pull yet
-        return 0.0
     return max(0.0, GAIN * (TARGET - state.tip[1]))
 
 
 @pytest.fixture(scope="module")
 def controlled():
     model = rodmol.paper_arm(N, tensions={11: controller})
-    return model, rodmol.simulate(model, 15.0, output_dt=0.05)
+    sagging = rodmol.equilibrium(rodmol.paper_arm(N))  # the controller is switched on at t = 0
+    return model, rodmol.simulate(model, 15.0, output_dt=0.05, initial=sagging)
+
+
+def test_equilibrium_of_a_feedback_law_is_the_closed_loop_rest_state():
+    # The law reads the equilibrium's iterates (never state=None): the rest
+    # state found satisfies it, T = Kp (target - tip_y) at the rod's own tip.
+    seen = []
+
+    def law(t, state):
+        seen.append(state)
+        return controller(t, state)
+
+    model = rodmol.paper_arm(N, tensions={11: law})
+    y = rodmol.equilibrium(model)
+    assert seen and all(isinstance(s, rodmol.StateView) for s in seen)
+    tip_y = rodmol.StateLayout(N).field(y, "u")[-1, 1]
+    tension = GAIN * (TARGET - tip_y)
+    assert tension > 0.0
+    open_loop = rodmol.equilibrium(rodmol.paper_arm(N, tensions={11: tension}))
+    assert np.allclose(open_loop, y, atol=1e-6)
 
 
 def test_controller_lifts_the_tip_toward_the_target(controlled):

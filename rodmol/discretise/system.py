@@ -160,12 +160,15 @@ class SemiDiscrete:
         self.entry_values = np.ascontiguousarray(entries.initial, dtype=float).reshape(-1, 3)
         self._grid_loads = entries
 
-    def update_inputs(self, t, y=None):
+    def update_inputs(self, t, y=None, tensions=None):
         """Evaluate the time-dependent inputs at t, in place: the tensions of
         the cables the kernel sees, the base velocities (v0, w0) and the
-        values of time-dependent loads. ``y`` is read by feedback tensions."""
+        values of time-dependent loads. ``y`` is read by feedback tensions;
+        ``tensions`` (n_cables,) [N], if given, are used instead of the inputs."""
         m = self.model
-        if self.global_coupling:
+        if tensions is not None:
+            self.tension_values[:] = np.asarray(tensions, dtype=float)[self._active]
+        elif self.global_coupling:
             state = StateView(self.layout, t, y, m.ds) if y is not None else None
             self.tension_values[:] = m.tensions(t, state)
         else:
@@ -197,11 +200,12 @@ class SemiDiscrete:
         stencil.rhs(y, out, *self._args)
         return out
 
-    def rest_rates(self, t, y, out, load_factor=1.0):
+    def rest_rates(self, t, y, out, load_factor=1.0, tensions=None):
         """dy/dt at (t, y) with every applied load (gravity, tensions, external
         load values) scaled by ``load_factor``, for the equilibrium's
-        continuation. Feedback tensions are evaluated with ``state=None``."""
-        self.update_inputs(t, None)
+        continuation. ``tensions`` (n_cables,) [N] replace the cables' inputs
+        (the equilibrium of a feedback law iterates on them)."""
+        self.update_inputs(t, y, tensions)
         scaled = (self.tension_values, self._consts[4:7], self.entry_values)  # views, in place
         saved = [inputs.copy() for inputs in scaled]
         for inputs in scaled:

@@ -6,8 +6,10 @@
     rodmol render DIR        # last_frame.png and animation.gif from DIR/result.npz
     rodmol plot DIR          # tip_path.png, markers.png, tensions.png
 
-Exit codes: 0 done, 1 the solver failed, 2 bad scenario or arguments,
-130 interrupted (Ctrl-C); an interrupted run keeps the frames done.
+Exit codes: 0 done, 1 the solver failed, 2 bad scenario or arguments (or the
+output directory is in use by another run), 3 outputs could not be written
+(what was written is valid), 130 interrupted (Ctrl-C), 143 terminated
+(SIGTERM); an interrupted or terminated run keeps the frames done.
 """
 
 import argparse
@@ -18,9 +20,12 @@ import warnings
 from pathlib import Path
 
 from ..errors import ParameterError
+from .lock import OutputLock
 from .progress import Progress
 
-EXIT_FAILED, EXIT_USAGE, EXIT_INTERRUPTED = 1, 2, 130
+EXIT_FAILED, EXIT_USAGE, EXIT_OUTPUT, EXIT_INTERRUPTED = 1, 2, 3, 130
+#: Exit code of a run stopped by each signal (128 + the signal's number, as a shell reports it).
+EXIT_SIGNAL = {signal.SIGINT: 130, signal.SIGTERM: 143}
 EXAMPLES = ("bending", "reaching", "fetching")
 __all__ = ["Progress", "main", "summary"]
 
@@ -73,6 +78,8 @@ def _run_options(parser):
     parser.add_argument("--n-elements", type=int, metavar="N", help="number of elements N")
     parser.add_argument("--scheme", metavar="NAME", help="spatial scheme (centred, upwind)")
     parser.add_argument("--t-end", type=float, metavar="T", help="end time [s]")
+    parser.add_argument("--max-wall-time", type=float, metavar="S",
+                        help="wall-time budget [s]: stop the run there (the frames done are kept)")
     parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
 
 
@@ -84,7 +91,8 @@ def _load(args):
 
     overrides = {}
     for option, key in (("backend", "solver.backend"), ("n_elements", "discretization.n_elements"),
-                        ("scheme", "discretization.scheme"), ("t_end", "solver.t_end")):
+                        ("scheme", "discretization.scheme"), ("t_end", "solver.t_end"),
+                        ("max_wall_time", "solver.max_wall_time")):
         if getattr(args, option) is not None:
             overrides[key] = Override(getattr(args, option), "--" + option.replace("_", "-"))
     if args.example and args.scenario:
@@ -102,8 +110,14 @@ def _run(args):
     out = args.out or spec.output.directory or Path("out") / spec.name
     try:  # before the run, so a directory that cannot be made does not waste it
         out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise ParameterError(f"cannot create the output directory {str(out)!r}: {exc.strerror}") from None
+    except (OSError, ValueError) as exc:
+        reason = getattr(exc, "strerror", None) or str(exc)
+        raise ParameterError(f"cannot create the output directory {str(out)!r}: {reason}") from None
+    with OutputLock(out):  # one run per output directory
+        return _run_locked(args, spec, out)
+
+
+def _run_locked(args, spec, out):
     say = (lambda *a, **k: None) if args.quiet else print
     model = spec.model
     say(f"rodmol: {spec.name}: N = {model.n_elements} elements, t_end = {spec.t_end:g} s, "
@@ -112,7 +126,7 @@ def _run(args):
         say("rodmol: finding the initial equilibrium ...")
 
     interrupts = _Interrupts()
-    previous = signal.signal(signal.SIGINT, interrupts)
+    previous = {signum: signal.signal(signum, interrupts) for signum in EXIT_SIGNAL}
     try:
         progress = None if args.quiet else Progress(spec.t_end)
         started = time.perf_counter()
@@ -129,50 +143,80 @@ def _run(args):
         written["seconds"] = time.perf_counter() - started - wall
     except KeyboardInterrupt:
         print("\nrodmol: interrupted before the first frame; nothing written", file=sys.stderr)
-        return EXIT_INTERRUPTED
+        return EXIT_SIGNAL.get(interrupts.signal, EXIT_INTERRUPTED)
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
     if not args.quiet:
         print(summary(spec, result, wall, written))
     elif not result.success:
         print(f"rodmol: {spec.name}: {result.message}", file=sys.stderr)
+    if "error" in written:
+        print(f"rodmol: {written['error']}", file=sys.stderr)
     if interrupts.count:
-        return EXIT_INTERRUPTED
+        return EXIT_SIGNAL.get(interrupts.signal, EXIT_INTERRUPTED)
+    if "error" in written:
+        return EXIT_OUTPUT
     return 0 if result.success else EXIT_FAILED
 
 
 class _Interrupts:
-    """SIGINT handler: raises KeyboardInterrupt (``raising``) or only counts."""
+    """SIGINT and SIGTERM handler (schedulers, ``timeout`` and ``docker stop``
+    send SIGTERM): raises KeyboardInterrupt (``raising``) or only counts.
+    Either way the frames done are kept."""
 
     def __init__(self):
-        self.count, self.raising = 0, True
+        self.count, self.raising, self.signal = 0, True, None
 
     def __call__(self, signum, frame):
         self.count += 1
+        self.signal = signal.Signals(signum)
         if self.raising:
             raise KeyboardInterrupt
 
 
 def _write_outputs(result, options, out, interrupts):
-    """Write result.npz, then the VTK frames; stop between frames on a new Ctrl-C."""
+    """Write result.npz, then the VTK frames; stop between frames on a new Ctrl-C.
+
+    A file that cannot be written (a full disk, a directory in its place) ends
+    the writing with ``written["error"]`` saying which and why; what was
+    written before stays valid (files are replaced atomically, the series
+    list only complete frames).
+    """
     from .writers import SeriesWriter, frame_indices
 
     before = interrupts.count
-    out.mkdir(parents=True, exist_ok=True)
     written = {}
     if options.npz:
-        result.save(out / "result.npz")
-        written["npz"] = out / "result.npz"
+        try:
+            result.save(out / "result.npz")
+            written["npz"] = out / "result.npz"
+        except OSError as exc:  # the series may still fit (a directory in its place)
+            written["error"] = _cannot_write(out / "result.npz", exc)
     if options.vtk:
         indices = frame_indices(len(result.t), options.every)
-        with SeriesWriter.for_result(result, out) as writer:
-            for k in indices:
-                if interrupts.count > before:
-                    break
-                writer.write(result, k)
+        writer = None
+        try:
+            with SeriesWriter.for_result(result, out) as writer:
+                for k in indices:
+                    if interrupts.count > before:
+                        break
+                    writer.write(result, k)
+        except OSError as exc:
+            problem = _cannot_write(out / "vtk", exc)
+            written["error"] = f"{written['error']}\nrodmol: {problem}" if "error" in written else problem
+            if writer is None:
+                return written
         written.update(pvd=writer.pvd("rod"), parts=writer.parts, frames=writer.frames,
                        all_frames=len(indices))
     return written
+
+
+def _cannot_write(path, exc):
+    reason = exc.strerror or str(exc)
+    where = exc.filename if isinstance(exc.filename, str) else str(path)
+    return (f"cannot write {where!r}: {reason}; the outputs written before it are valid "
+            "(free some space or choose another --out)")
 
 
 def summary(spec, result, wall, written):

@@ -10,9 +10,11 @@ from pathlib import Path
 from .. import scenarios
 from ..arm import LENGTH as PAPER_LENGTH
 from ..arm import paper_arm
+from ..discretise.layout import StateLayout
 from ..errors import ParameterError
-from ..model import Model
 from ..discretise.schemes import DEFAULT_SCHEME, SCHEMES
+from ..model import MAX_ELEMENTS, Model
+from ..solve import options as run_options
 from ..solve.backends import BACKENDS
 from . import scenario_arm as arm_tables
 from . import scenario_readers as read
@@ -36,7 +38,7 @@ def build(data, ctx, default_name):
     medium, switches = arm_tables.medium(data, ctx, default="water" if arm == "paper" else "air")
     base = arm_tables.base(data, ctx)
     t_end_default = scenarios.get(scenario).t_end if scenario not in (None, FAILED) else scenario
-    solver, t_end = _solver(data, ctx, t_end_default)
+    solver, t_end = _solver(data, ctx, t_end_default, n_elements)
     solver["scheme"] = scheme
     output = _output(data, ctx)
     loads = load_tables(data, ctx)
@@ -108,30 +110,39 @@ def _entry_name(kind, index, entry):
 def _discretization(data, ctx):
     path = ("discretization",)
     table = ctx.table(data.get("discretization", {}), path, DISCRETIZATION)
-    return (ctx.read(table, path, "n_elements", read.integer(2), 100),
+    return (ctx.read(table, path, "n_elements", read.integer(2, MAX_ELEMENTS), 100),
             ctx.read(table, path, "scheme", read.choice(tuple(SCHEMES)), DEFAULT_SCHEME))
 
 
-def _solver(data, ctx, t_end_default):
+def _solver(data, ctx, t_end_default, n_elements):
+    """simulate's options and t_end, checked by the same rules as in Python
+    (:mod:`rodmol.solve.options`)."""
     path = ("solver",)
     table = ctx.table(data.get("solver", {}), path, SOLVER)
     options = dict(
         backend=ctx.read(table, path, "backend", read.choice(tuple(BACKENDS)), "cvode"),
-        rtol=ctx.read(table, path, "rtol", read.number("positive")),
+        rtol=ctx.read(table, path, "rtol", lambda v: run_options.rtol(read.number()(v))),
         atol=ctx.read(table, path, "atol", read.number("positive")),
         output_dt=ctx.read(table, path, "output_dt", read.number("positive", "s"), 0.01),
         initial=ctx.read(table, path, "initial", read.choice(INITIAL), "equilibrium"),
     )
+    if "max_wall_time" in table:
+        options["max_wall_time"] = ctx.read(table, path, "max_wall_time", read.number("positive", "s"))
     t_end = ctx.read(table, path, "t_end", read.number("positive", "s"), t_end_default)
     if t_end is None:  # (FAILED if the scenario that would give it is wrong)
         ctx.add(path, "missing required key `t_end` [s] (only `scenario = ...` gives a default)")
+    elif not failed(t_end, options["output_dt"], n_elements):
+        try:
+            run_options.output_count(t_end, options["output_dt"], StateLayout(n_elements).size)
+        except ParameterError as exc:
+            ctx.add(path + (("output_dt",) if "output_dt" in table else ("t_end",)), str(exc))
     return options, t_end
 
 
 def _output(data, ctx):
     path = ("output",)
     table = ctx.table(data.get("output", {}), path, OUTPUT)
-    directory = ctx.read(table, path, "directory", read.string)
+    directory = ctx.read(table, path, "directory", read.path)
     values = dict(vtk=ctx.read(table, path, "vtk", read.boolean, True),
                   npz=ctx.read(table, path, "npz", read.boolean, True),
                   every=ctx.read(table, path, "every", read.integer(1), 1))

@@ -58,12 +58,18 @@ def parse_scenario(text, base_dir=".", source="<string>", overrides=None, defaul
 
     ``base_dir`` is where relative paths (CSV tables, output directory) start.
     """
+    if not isinstance(text, str):
+        raise ScenarioError(source, [Problem(source, None, "", f"the scenario must be text, got "
+                                             f"{type(text).__name__}")])
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         match = re.search(r"line (\d+)", str(exc))
         line = int(match.group(1)) if match else None
         raise ScenarioError(source, [Problem(source, line, "", f"not valid TOML: {exc}")]) from None
+    except RecursionError:  # tomllib recurses once per level of nested arrays and tables
+        raise ScenarioError(source, [Problem(source, None, "", "not a scenario: arrays or inline "
+                                             "tables nested too deeply")]) from None
     ctx = Context(source, KeyLines(text), Path(base_dir))
     for dotted, value in (overrides or {}).items():
         ctx.override(dotted, value, data)

@@ -10,6 +10,7 @@ import difflib
 import re
 from dataclasses import dataclass
 
+from .._checks import short
 from ..errors import ParameterError
 from .scenario_schema import UNITS
 
@@ -104,7 +105,7 @@ class Context:
     def table(self, data, path, allowed, required=(), hint="", units=UNITS):
         """Check a table's keys; return it (an empty dict if it is not a table)."""
         if not isinstance(data, dict):
-            self.add(path, f"`{path[-1]}` must be a table, got {data!r}")
+            self.add(path, f"`{path[-1]}` must be a table, got {short(data)}")
             return {}
         for key in data:
             if key not in allowed:

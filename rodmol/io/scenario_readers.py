@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._checks import short
 from ..cables import as_tension, read_tension_csv
 from ..inputs import as_time_input
 from .scenario_problems import Bad
@@ -25,11 +26,11 @@ def number(condition=None, unit=""):
     """A finite number; ``condition`` "positive" or "non-negative"."""
     def read(value):
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-            raise Bad(f"must be a number{f' [{unit}]' if unit else ''}, got {value!r}")
+            raise Bad(f"must be a number{f' [{unit}]' if unit else ''}, got {short(value)}")
         if condition == "positive" and value <= 0:
-            raise Bad(f"must be > 0{f' {unit}' if unit else ''}, got {value!r}")
+            raise Bad(f"must be > 0{f' {unit}' if unit else ''}, got {short(value)}")
         if condition == "non-negative" and value < 0:
-            raise Bad(f"must be >= 0{f' {unit}' if unit else ''}, got {value!r}")
+            raise Bad(f"must be >= 0{f' {unit}' if unit else ''}, got {short(value)}")
         return float(value)
     return read
 
@@ -37,24 +38,32 @@ def number(condition=None, unit=""):
 def integer(minimum, maximum=None):
     def read(value):
         if isinstance(value, bool) or not isinstance(value, int):
-            raise Bad(f"must be an integer, got {value!r}")
+            raise Bad(f"must be an integer, got {short(value)}")
         if value < minimum:
-            raise Bad(f"must be >= {minimum}, got {value!r}")
+            raise Bad(f"must be >= {minimum}, got {short(value)}")
         if maximum is not None and value > maximum:
-            raise Bad(f"must be <= {maximum}, got {value!r}")
+            raise Bad(f"must be <= {maximum}, got {short(value)}")
         return value
     return read
 
 
 def boolean(value):
     if not isinstance(value, bool):
-        raise Bad(f"must be true or false, got {value!r}")
+        raise Bad(f"must be true or false, got {short(value)}")
     return value
 
 
 def string(value):
     if not isinstance(value, str):
-        raise Bad(f"must be a string, got {value!r}")
+        raise Bad(f"must be a string, got {short(value)}")
+    return value
+
+
+def path(value):
+    """A file or directory name."""
+    string(value)
+    if "\0" in value:
+        raise Bad(f"must be a path without NUL characters, got {short(value)}")
     return value
 
 
@@ -64,7 +73,7 @@ def choice(options):
         if value not in options:
             close = difflib.get_close_matches(str(value), options, n=1, cutoff=0.6)
             tip = f"did you mean {close[0]!r}? " if close else ""
-            raise Bad(f"is {value!r}: {tip}valid values are {', '.join(map(repr, options))}")
+            raise Bad(f"is {short(value)}: {tip}valid values are {', '.join(map(repr, options))}")
         return value
     return read
 
@@ -72,7 +81,7 @@ def choice(options):
 def vector(length, unit):
     def read(value):
         if not isinstance(value, list) or len(value) != length or not all(map(_is_number, value)):
-            raise Bad(f"must be {length} numbers [{unit}], got {value!r}")
+            raise Bad(f"must be {length} numbers [{unit}], got {short(value)}")
         return tuple(float(x) for x in value)
     return read
 
@@ -82,7 +91,7 @@ def matrix3(value):
     try:
         return tuple(vector(3, "-")(row) for row in rows)
     except (Bad, TypeError):
-        raise Bad(f"must be a 3x3 rotation matrix (three rows of three numbers), got {value!r}") from None
+        raise Bad(f"must be a 3x3 rotation matrix (three rows of three numbers), got {short(value)}") from None
 
 
 def pairs(what, unit):
@@ -90,7 +99,7 @@ def pairs(what, unit):
         ok = isinstance(value, list) and len(value) >= 1 and all(
             isinstance(p, list) and len(p) == 2 and all(map(_is_number, p)) for p in value)
         if not ok:
-            raise Bad(f"must be a list of {what} pairs [{unit}], got {value!r}")
+            raise Bad(f"must be a list of {what} pairs [{unit}], got {short(value)}")
         return [(float(a), float(b)) for a, b in value]
     return read
 
@@ -118,7 +127,7 @@ def radius(length):
             points = pairs("(s, r)", "m")(value)
             s, r = np.array(points).T
             if len(s) < 2:
-                raise Bad(f"needs at least two (s, r) points, got {value!r}")
+                raise Bad(f"needs at least two (s, r) points, got {short(value)}")
             if np.any(np.diff(s) <= 0):
                 raise Bad(f"points must have increasing s, got s = {s.tolist()}")
             if np.any(r <= 0):
@@ -137,7 +146,7 @@ def radius(length):
 
 def _bad_radius(value):
     raise Bad("must be a number [m], a [base, tip] pair [m] or a list of [s, r] points [m], "
-              f"got {value!r}")
+              f"got {short(value)}")
 
 
 def tension(base_dir, name):
@@ -149,7 +158,7 @@ def tension(base_dir, name):
             return as_tension(pairs("(t, T)", "s, N")(value), f"{name!r} tension")
         if isinstance(value, (int, float)) and not isinstance(value, bool):
             return number("non-negative", "N")(value)
-        raise Bad(f"must be a number [N], a list of [t, T] knots [s, N] or a CSV file name, got {value!r}")
+        raise Bad(f"must be a number [N], a list of [t, T] knots [s, N] or a CSV file name, got {short(value)}")
     return read
 
 
@@ -161,12 +170,12 @@ def vector_input(base_dir, key, unit):
             return as_time_input(key, _resolve(base_dir, value), 3, unit)
         if isinstance(value, list) and value and all(isinstance(row, list) for row in value):
             if not all(len(row) == 4 and all(map(_is_number, row)) for row in value):
-                raise Bad(f"knots must be rows of 4 numbers [t, x, y, z] [s, {unit}], got {value!r}")
+                raise Bad(f"knots must be rows of 4 numbers [t, x, y, z] [s, {unit}], got {short(value)}")
             return as_time_input(key, [[float(x) for x in row] for row in value], 3, unit)
         if isinstance(value, list) and len(value) == 3 and all(map(_is_number, value)):
             return as_time_input(key, [float(x) for x in value], 3, unit)
         raise Bad(f"must be 3 numbers [{unit}], a list of [t, x, y, z] knots [s, {unit}] or a CSV "
-                  f"file name, got {value!r}")
+                  f"file name, got {short(value)}")
     return read
 
 
@@ -175,6 +184,6 @@ def constant_vector(unit):
     def read(value):
         if not isinstance(value, list) or len(value) != 3 or not all(map(_is_number, value)):
             raise Bad(f"must be 3 numbers [{unit}] (a constant; a load that varies along the rod "
-                      f"or in time needs Python: rodmol.loads), got {value!r}")
+                      f"or in time needs Python: rodmol.loads), got {short(value)}")
         return tuple(float(x) for x in value)
     return read

@@ -20,12 +20,12 @@ PAPER_CABLE = ("number", "tension")
 MARKER = ("name", "s", "offset")
 BASE = ("fixed", "position", "rotation", "velocity", "angular_velocity")
 DISCRETIZATION = ("n_elements", "scheme")
-SOLVER = ("backend", "rtol", "atol", "t_end", "output_dt", "initial")
+SOLVER = ("backend", "rtol", "atol", "t_end", "output_dt", "initial", "max_wall_time")
 OUTPUT = ("directory", "vtk", "npz", "every")
 ARMS = ("paper",)
 INITIAL = ("equilibrium", "straight")
 UNITS = {"length": "m", "radius": "m", "E": "Pa", "G": "Pa", "mu": "Pa s", "rho": "kg/m^3",
-         "anchor": "m", "s": "m", "t_end": "s", "output_dt": "s", "offset": "m", "tension": "N"}
+         "anchor": "m", "s": "m", "t_end": "s", "output_dt": "s", "max_wall_time": "s", "offset": "m", "tension": "N"}
 
 # --------------------------------------------------------------------------- [[load]]
 

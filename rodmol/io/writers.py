@@ -19,7 +19,6 @@ and distributed loads and contact, see :mod:`rodmol.loads`) in global ones;
 ``velocity (global) [m/s]`` is the velocity in global components, for glyphs.
 """
 
-import os
 import re
 import time
 import xml.etree.ElementTree as ET
@@ -27,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._files import write_atomically
 from ..errors import ParameterError
 
 #: Point arrays of the centreline: VTK name -> (Result attribute, frame).
@@ -177,9 +177,8 @@ def write_pvd(path, entries):
         ET.SubElement(collection, "DataSet", timestep=repr(float(t)), group="", part="0",
                       file=str(file))
     ET.indent(root)
-    tmp = Path(f"{path}.part")
-    ET.ElementTree(root).write(tmp, encoding="utf-8", xml_declaration=True)
-    os.replace(tmp, path)
+    write_atomically(path, lambda handle: ET.ElementTree(root).write(handle, encoding="utf-8",
+                                                                     xml_declaration=True))
 
 
 def read_pvd(path):

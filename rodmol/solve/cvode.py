@@ -8,7 +8,8 @@ from scipy import sparse
 
 from ..discretise.preconditioner import check_structure
 from ..errors import ParameterError
-from .outputs import Outputs, step_size_stats
+from .outputs import Outputs, cause, step_size_stats
+from .watch import Watch
 
 LINEAR_SOLVERS = ("gmres", "band", "lapackband", "sparse", "dense")
 #: How the direct linear solvers get the Jacobian (see :func:`cvode`).
@@ -20,8 +21,8 @@ MAX_RHS_FAILURES = 50
 GMRES_MIN_ELEMENTS = 50
 
 
-def cvode(system, y0, t_out, *, rtol, atol, progress=None, linsolver="auto", max_step=0.0,
-          jacobian="auto", max_order="auto", max_nonlin_iters=3):
+def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, linsolver="auto",
+          max_step=0.0, jacobian="auto", max_order="auto", max_nonlin_iters=3):
     """SUNDIALS CVODE (BDF) through scikit-sundae.
 
     ``linsolver`` is how the Newton systems (I - gamma J) x = r are solved:
@@ -52,9 +53,13 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, linsolver="auto", max
     mode of the grid oscillates (``system.lightly_damped``): BDF 3-5 are not
     stable near the imaginary axis, and there they either take many short
     steps or let the energy grow, while BDF2 is A-stable (see
-    ``docs/performance.md``). ``max_nonlin_iters`` caps the Newton iterations
+    ``docs/model.md``). ``max_nonlin_iters`` caps the Newton iterations
     per step (SUNDIALS' default 3: order 4 and 5 Newton iterations save ~10%
     on the paper's tests but double the steps of an inviscid oscillation).
+
+    Every internal step is checked by :class:`rodmol.solve.watch.Watch`
+    (blow-ups, degenerate elements, stalls, the wall-time budget
+    ``max_wall_time`` [s]), which also reports ``progress`` between outputs.
     """
     from sksundae.cvode import CVODE, CVODEPrecond
 
@@ -98,6 +103,7 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, linsolver="auto", max
         options["sparsity"] = sparse.csc_matrix(system.pattern())
 
     out = Outputs(t_out, y0, progress)
+    watch = Watch(system, t_out, max_wall_time, progress)
     evals = [0]  # counted here: CVODE's own counter leaves out the Jacobian's evaluations
 
     failures = []  # (t, exception) raised by the right-hand side
@@ -123,6 +129,11 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, linsolver="auto", max
             info["jac_evals"] = int(r.njev) if r is not None else 0
         return info
 
+    def stop(reason, error=None):
+        reached = out.t_out[out.next_index - 1]
+        return out.solution(False, f"CVODE stopped after t = {reached:.6g} s (last output frame; "
+                            f"{watch.summary()}): {reason}", error=error, **stats())
+
     t_end = float(t_out[-1])
     sizes, r, t_last = [], None, float(t_out[0])  # sizes of the steps taken [s]
     try:
@@ -136,25 +147,28 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, linsolver="auto", max
         while not out.done:
             r = solver.step(t_end, method="onestep", tstop=t_end)
             if not r.success or len(failures) > MAX_RHS_FAILURES:
-                reason = r.message
                 if failures:
                     t_bad, exc = failures[-1]
-                    reason = f"{type(exc).__name__}: {exc} (at t = {t_bad:.6g} s)"
-                reached = out.t_out[out.next_index - 1]
-                return out.solution(False, f"CVODE failed after t = {reached:.6g} s (last output; "
-                                    f"the solver got to {r.t:.6g} s): {reason}", **stats())
+                    return stop(cause(exc, t_bad), exc)
+                return stop(r.message)
             # After output times were interpolated inside the last step, CVODE's
             # next one-step call hands that step back again: count real steps only.
             if r.t > t_last:
                 sizes.append(r.t - t_last)
                 t_last = r.t
+                broken = watch.state(r.t, sizes[-1], r.y)
+                if broken:  # the frames inside this step are not kept either
+                    return stop(broken)
             while not out.done and out.t_out[out.next_index] <= r.t:
                 t_k = out.t_out[out.next_index]
                 out.add(r.y if t_k == r.t else solver.step(t_k).y)
-    except (Exception, KeyboardInterrupt) as exc:
-        reached = out.t_out[out.next_index - 1]
-        reason = "interrupted" if isinstance(exc, KeyboardInterrupt) else f"{type(exc).__name__}: {exc}"
-        return out.solution(False, f"CVODE stopped after t = {reached:.6g} s: {reason}", **stats())
+            slow = watch.pace(r.t, r.y)
+            if slow and not out.done:
+                return stop(slow)
+    except KeyboardInterrupt:
+        return stop("interrupted")
+    except Exception as exc:
+        return stop(cause(exc), exc)
     return out.solution(True, "The solver reached the end time.", **stats())
 
 

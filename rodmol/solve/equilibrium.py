@@ -20,6 +20,7 @@ from ..discretise.schemes import DEFAULT_SCHEME
 from ..discretise.system import SemiDiscrete
 from ..errors import EquilibriumError, ParameterError
 from ..model import Model
+from .watch import state_problem
 
 #: Unknowns per element, and the equation each row of a block carries:
 #: u -> position compatibility, Q -> orientation compatibility, q -> force
@@ -64,14 +65,68 @@ def equilibrium(model, t=0.0, *, scheme=DEFAULT_SCHEME, tol=1e-10, max_iter=40, 
     numpy.ndarray
         A state vector that is a rest state of the dynamic right-hand side.
 
+    Feedback tensions T(t, state) read the rest state: the tensions are
+    iterated (Newton's method on the feedback cables' tensions, each step an
+    equilibrium under frozen tensions) until the law, evaluated on the rest
+    state, gives back the tensions that hold it there.
+
     Raises
     ------
     EquilibriumError
-        If no equilibrium is found (e.g. a buckling load).
+        If no equilibrium is found (e.g. a buckling load), or the one found
+        has degenerate elements (see :mod:`rodmol.solve.watch`).
     """
     if not isinstance(model, Model):
         raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
     system = SemiDiscrete(model, scheme) if system is None else system
+    solve = _closed_loop if model.feedback else _rest_state
+    y = solve(system, t, tol, max_iter)
+    problem = state_problem(system.layout, model.ds, t, y)
+    if problem:
+        raise EquilibriumError(f"the static equilibrium is not a valid state of the rod: {problem}")
+    return y
+
+
+def _closed_loop(system, t, tol, max_iter, max_rounds=30):
+    """The rest state under feedback tensions: Newton on the tensions T of the
+    feedback cables, F(T) = law(rest state under T) - T = 0, with differences."""
+    model = system.model
+    layout = system.layout
+    feedback = np.array([c.tension.feedback for c in model.cables])
+
+    def law(y):
+        return system.tensions(t, y)
+
+    y = layout.straight(model.s_nodes, np.asarray(model.base.position, dtype=float),
+                        np.asarray(model.base.rotation, dtype=float),
+                        rotations.from_matrix(model.base.rotation))
+    tensions = law(y)
+    scale = max(model.load_scale(t, tensions), 1e-12)
+    for _ in range(max_rounds):
+        y = _rest_state(system, t, tol, max_iter, tensions)
+        residual = (law(y) - tensions)[feedback]
+        if np.max(np.abs(residual)) <= 1e-9 * scale:
+            return y
+        jac = np.empty((residual.size, residual.size))
+        for j, i in enumerate(np.flatnonzero(feedback)):
+            h = 1e-6 * max(abs(tensions[i]), scale)
+            shifted = tensions.copy()
+            shifted[i] += h
+            jac[:, j] = ((law(_rest_state(system, t, tol, max_iter, shifted)) - shifted)[feedback]
+                         - residual) / h
+        try:
+            step = np.linalg.solve(jac, -residual)
+        except np.linalg.LinAlgError:
+            break
+        tensions = tensions.copy()
+        tensions[feedback] = np.maximum(tensions[feedback] + step, 0.0)
+    raise EquilibriumError(f"no static equilibrium found for the feedback tensions at t = {t} s "
+                           "(the law and the arm have no common rest state, or it is unstable)")
+
+
+def _rest_state(system, t, tol, max_iter, tensions=None):
+    """The rest state under the loads at t (cable ``tensions`` [N] if given)."""
+    model = system.model
     layout, n, ds = system.layout, model.n_elements, model.ds
     static = BlockLayout(n, dict(STATIC_FIELDS))
     sl = static.slices()
@@ -80,7 +135,7 @@ def equilibrium(model, t=0.0, *, scheme=DEFAULT_SCHEME, tol=1e-10, max_iter=40, 
     u0 = np.asarray(base.position, dtype=float)
     y = layout.straight(model.s_nodes, u0, np.asarray(base.rotation, dtype=float), quat0)
     z = np.hstack([layout.field(y, f) for f in STATIC_FIELDS]).ravel()
-    scale = model.load_scale(t)
+    scale = model.load_scale(t, tensions)
     if scale == 0.0 and not model.loads:
         return y
 
@@ -96,7 +151,7 @@ def equilibrium(model, t=0.0, *, scheme=DEFAULT_SCHEME, tol=1e-10, max_iter=40, 
         zb = static.blocks(z)
         for f in STATIC_FIELDS:
             layout.field(y, f)[:] = zb[:, sl[f]]
-        system.rest_rates(t, y, rates, lam)
+        system.rest_rates(t, y, rates, lam, tensions)
         u, quat, q, k = (zb[:, sl[f]] for f in STATIC_FIELDS)
         u_prev = np.vstack([u0, u[:-1]])
         q_prev = np.vstack([quat0, quat[:-1]])

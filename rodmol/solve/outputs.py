@@ -7,6 +7,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import RodmolError
+
 
 @dataclass
 class RawSolution:
@@ -15,6 +17,8 @@ class RawSolution:
     success: bool
     message: str
     stats: dict = field(default_factory=dict)
+    #: The exception that ended the run (a user callback's, with its traceback), or None.
+    error: BaseException = None
 
 
 class Outputs:
@@ -38,10 +42,10 @@ class Outputs:
         if self.progress is not None:
             self.progress(self.t_out[k], self.t_out[-1])
 
-    def solution(self, success, message, **stats):
+    def solution(self, success, message, error=None, **stats):
         stats["wall_time_s"] = time.perf_counter() - self.start
         n = self.next_index
-        return RawSolution(self.t_out[:n].copy(), self.ys[:n], success, message, stats)
+        return RawSolution(self.t_out[:n].copy(), self.ys[:n], success, message, stats, error)
 
 
 def step_size_stats(sizes):
@@ -52,3 +56,10 @@ def step_size_stats(sizes):
     return dict(h_min=float(h.min()), h_median=float(np.median(h)), h_max=float(h.max()))
 
 
+
+
+def cause(exc, t=None):
+    """An exception as the cause in a run's message (rodmol's own errors say where already)."""
+    if isinstance(exc, RodmolError):
+        return str(exc)
+    return f"{type(exc).__name__}: {exc}" + (f" (at t = {t:.6g} s)" if t is not None else "")

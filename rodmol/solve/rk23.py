@@ -3,14 +3,15 @@
 import numpy as np
 from scipy.integrate import RK23
 
-from .outputs import Outputs, step_size_stats
+from .outputs import Outputs, cause, step_size_stats
+from .watch import Watch
 
 
-def rk23(system, y0, t_out, *, rtol, atol, progress=None, max_step=np.inf):
+def rk23(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, max_step=np.inf):
     """scipy's explicit Bogacki-Shampine RK23 on the same right-hand side (cross-check).
 
     Its step is bounded by the explicit stability limits, so it is slow on
-    fine grids.
+    fine grids. Every step is checked by :class:`rodmol.solve.watch.Watch`.
     """
     evals = [0]
 
@@ -19,10 +20,16 @@ def rk23(system, y0, t_out, *, rtol, atol, progress=None, max_step=np.inf):
         return system(t, y)
 
     out = Outputs(t_out, y0, progress)
+    watch = Watch(system, t_out, max_wall_time, progress)
     sizes = []
 
     def stats():
         return dict(steps=len(sizes), rhs_evals=evals[0], jac_evals=0, **step_size_stats(sizes))
+
+    def stop(reason, error=None):
+        reached = out.t_out[out.next_index - 1]
+        return out.solution(False, f"RK23 stopped after t = {reached:.6g} s (last output frame; "
+                            f"{watch.summary()}): {reason}", error=error, **stats())
 
     try:
         solver = RK23(rhs, float(t_out[0]), np.array(y0, dtype=float), float(t_out[-1]),
@@ -30,17 +37,20 @@ def rk23(system, y0, t_out, *, rtol, atol, progress=None, max_step=np.inf):
         while not out.done:
             message = solver.step()
             if solver.status == "failed":
-                return out.solution(False, f"RK23 failed at t = {solver.t:.6g} s: {message}",
-                                    **stats())
+                return stop(message)
             sizes.append(solver.t - solver.t_old)
+            broken = watch.state(solver.t, sizes[-1], solver.y)
+            if broken:
+                return stop(broken)
             if out.t_out[out.next_index] <= solver.t:  # the interpolant only when needed
                 dense = solver.dense_output()
                 while not out.done and out.t_out[out.next_index] <= solver.t:
                     out.add(dense(out.t_out[out.next_index]))
-    except (Exception, KeyboardInterrupt) as exc:
-        reached = out.t_out[out.next_index - 1]
-        reason = "interrupted" if isinstance(exc, KeyboardInterrupt) else f"{type(exc).__name__}: {exc}"
-        return out.solution(False, f"RK23 stopped after t = {reached:.6g} s: {reason}", **stats())
+            slow = watch.pace(solver.t, solver.y)
+            if slow and not out.done:
+                return stop(slow)
+    except KeyboardInterrupt:
+        return stop("interrupted")
+    except Exception as exc:
+        return stop(cause(exc), exc)
     return out.solution(True, "The solver reached the end time.", **stats())
-
-

@@ -1,0 +1,122 @@
+"""Checks of :func:`rodmol.simulate`'s arguments, all made before any work is done.
+
+Backend options are checked against the backend's own keyword arguments
+(unknown or misspelled names get a did-you-mean), and their values against
+:data:`VALUES`; output sizes are bounded before anything is allocated.
+"""
+
+import difflib
+import inspect
+import math
+
+from .. import _checks
+from ..errors import ParameterError
+
+#: Relative tolerances accepted (outside: round-off, or no accuracy at all).
+RTOL_RANGE = (1e-14, 0.1)
+#: Most output frames a run may ask for, and most memory [bytes] its states may take.
+MAX_OUTPUT_FRAMES = 1_000_000
+MAX_STATE_BYTES = 2 * 1024**3
+#: Arguments every backend takes from simulate itself (not backend options).
+COMMON = ("rtol", "atol", "progress", "max_wall_time")
+#: simulate's own keywords, offered as suggestions for misspelled options.
+SIMULATE_KEYWORDS = ("initial", "scheme", "backend", "rtol", "atol", "output_dt", "progress",
+                     "max_wall_time")
+
+
+def _integer_in(low, high):
+    def check(name, value):
+        value = _checks.integer_at_least(name, value, low)
+        if value > high:
+            raise ParameterError(f"`{name}` must be an integer in [{low}, {high}], got {value!r}")
+        return value
+    return check
+
+
+def _auto_or(check):
+    def either(name, value):
+        return value if isinstance(value, str) and value == "auto" else check(name, value)
+    return either
+
+
+def _max_step(name, value):
+    if value == math.inf:
+        return value
+    return _checks.non_negative(name, value, " s (0: no limit)")
+
+
+def _choice(options):
+    def check(name, value):
+        if value not in options:
+            raise ParameterError(f"unknown `{name}` {_checks.short(value)}{did_you_mean(value, options)}; "
+                                 f"valid: {', '.join(map(repr, options))}")
+        return value
+    return check
+
+
+def _values():
+    from .cvode import JACOBIANS, LINEAR_SOLVERS
+
+    return {
+        "max_order": _auto_or(_integer_in(1, 5)),
+        "max_nonlin_iters": _integer_in(1, 100),
+        "max_step": _max_step,
+        "linsolver": _choice(("auto", *LINEAR_SOLVERS)),
+        "jacobian": _choice(("auto", *JACOBIANS)),
+    }
+
+
+def did_you_mean(value, options):
+    """``"; did you mean 'x'?"`` for a near miss among ``options``, else ``""``."""
+    if not isinstance(value, str):
+        return ""
+    close = difflib.get_close_matches(value, [str(o) for o in options], n=1, cutoff=0.6)
+    return f"; did you mean {close[0]!r}?" if close else ""
+
+
+def backend_options(backend, run, options):
+    """The checked ``options`` of backend function ``run`` (named ``backend``)."""
+    accepted = [name for name, p in inspect.signature(run).parameters.items()
+                if p.kind is inspect.Parameter.KEYWORD_ONLY and name not in COMMON]
+    values = _values()
+    checked = {}
+    for key, value in options.items():
+        if key not in accepted:
+            tip = did_you_mean(key, accepted + list(SIMULATE_KEYWORDS))
+            valid = ", ".join(accepted) if accepted else "none"
+            raise ParameterError(f"unknown option `{key}` for backend {backend!r}{tip} "
+                                 f"(its options: {valid})")
+        checked[key] = values[key](key, value) if key in values else value
+    return checked
+
+
+def rtol(value):
+    value = _checks.positive("rtol", value)
+    low, high = RTOL_RANGE
+    if not low <= value <= high:
+        raise ParameterError(f"`rtol` must lie in [{low:g}, {high:g}], got {value!r}")
+    return value
+
+
+def progress(value):
+    if value is not None and not callable(value):
+        raise ParameterError(f"`progress` must be a callable progress(t, t_end) or None, "
+                             f"got {_checks.short(value)}")
+    return value
+
+
+def max_wall_time(value):
+    return None if value is None else _checks.positive("max_wall_time", value, " s")
+
+
+def output_count(t_end, output_dt, state_size):
+    """Number of output intervals, refused before anything is allocated if the
+    frames would be too many or their states too large."""
+    frames = t_end / output_dt + 1.0
+    limit = min(MAX_OUTPUT_FRAMES, MAX_STATE_BYTES // (8 * state_size))
+    if frames > limit:
+        raise ParameterError(
+            f"t_end = {t_end!r} s with output_dt = {output_dt!r} s asks for {frames:.3g} output "
+            f"frames; at most {limit} are allowed (states of {state_size} numbers each): raise "
+            f"`output_dt` to at least {t_end / (limit - 1):.3g} s or shorten `t_end`")
+    return int(math.floor(t_end / output_dt + 1e-9))
