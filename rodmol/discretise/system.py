@@ -80,6 +80,10 @@ class SemiDiscrete:
                       self.base_velocities, self._kinds, self._nodes, self._entry_weights,
                       self._entry_params, self.entry_values, self._work)
 
+    def __reduce__(self):
+        # Pickled as its model (the compiled scheme and the packed arrays are rebuilt).
+        return (SemiDiscrete, (self.model,))
+
     # ------------------------------------------------------------------ inputs
 
     def _setup_cables(self):
