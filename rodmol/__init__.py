@@ -15,6 +15,15 @@ from . import scenarios
 from .analysis import energy, marker_errors
 from .arm import paper_arm
 from .base_motion import Base, BaseMotion
+from .calibrate import (
+    calibrate_dlt,
+    identify,
+    linearize,
+    paper_errors,
+    sweep,
+    triangulate,
+    worsened_models,
+)
 from .cables import Cable, read_tension_csv
 from .discretise.layout import StateLayout
 from .discretise.system import SemiDiscrete, StateView
@@ -48,4 +57,7 @@ __all__ = [
     "ScenarioError", "SemiDiscrete", "StateLayout", "StateView", "default_atol", "energy",
     "equilibrium", "load_result", "load_scenario", "marker_errors", "paper_arm",
     "read_tension_csv", "scenarios", "simulate", "straight_state", "write_series",
+    # rodmol.calibrate: from experiment to model
+    "calibrate_dlt", "identify", "linearize", "paper_errors", "sweep", "triangulate",
+    "worsened_models",
 ]
