@@ -4,7 +4,9 @@ measured markers."""
 
 from dataclasses import dataclass
 
-from .paper_errors import as_tracks, plot_errors, table
+import numpy as np
+
+from .paper_errors import ErrorTable, as_tracks, plot_errors, table
 from .parallel import SERIAL, check_picklable, executor
 from .runs import Errors, Task
 from .variants import apply, as_spec
@@ -58,7 +60,10 @@ def worsened_models(spec, measured, *, client=None, variants=None, progress=None
     with executor(client, n_workers) as ex:
         outcomes = ex.map(_run_variant, [(task, variants[name]) for name, task in tasks], progress)
     named = dict(zip(variants, outcomes))
-    return Study({name: o.value for name, o in named.items()}, named)
+    nan = np.full(len(tracks.t), np.nan)
+    errors = {name: o.value if o.value is not None else ErrorTable(tracks.t, nan, nan, np.ones(len(nan), bool), name)
+              for name, o in named.items()}  # a run that failed before its first frame: no errors
+    return Study(errors, named)
 
 
 def _run_variant(item):

@@ -226,4 +226,5 @@ def _guard(key, value, build):
     try:
         return build()
     except ParameterError as exc:
-        raise ParameterError(f"override {key!r} = {value!r}: {exc}") from None
+        given = "" if isinstance(value, dict) else f" = {value!r}"
+        raise ParameterError(f"override {key!r}{given}: {exc}") from None
