@@ -4,7 +4,7 @@ its extractors are module-level classes holding plain data."""
 
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -112,11 +112,13 @@ def run_indexed(task, item):
     """``task(overrides)`` for ``item = (index, overrides, out)``; saves the result
     to ``out/run_<index>/result.npz`` when ``out`` is set (module level so it pickles)."""
     index, overrides, out = item
-    outcome = task(overrides)
+    outcome = (task if out is None else replace(task, keep=True))(overrides)
     if out is not None and outcome.result is not None:
         folder = Path(out) / f"run_{index:04d}"
         folder.mkdir(parents=True, exist_ok=True)
         outcome.result.meta.update(overrides={k: repr(v) for k, v in overrides.items()})
         outcome.result.save(folder / "result.npz")
         outcome.value = dict(outcome.value or {}, path=str(folder / "result.npz"))
+        if not task.keep:
+            outcome.result = None  # read back from the file when needed
     return outcome

@@ -31,6 +31,15 @@ class Sweep:
     runs: list
     out: object = None
 
+    def result(self, i):
+        """The Result of run ``i``: kept in memory, or read from ``out``."""
+        run = self.runs[i]
+        if run.result is None and (run.value or {}).get("path"):
+            from ..result import load_result
+
+            return load_result(run.value["path"])
+        return run.result
+
     def rows(self):
         """One dict per run: index, overrides, success, wall time [s] and the summary."""
         rows = []
@@ -69,7 +78,8 @@ def _cell(value):
     return f"{value:.6g}" if isinstance(value, float) else str(value)
 
 
-def sweep(spec, overrides, *, client=None, out=None, measured=None, progress=None, n_workers=None):
+def sweep(spec, overrides, *, client=None, out=None, measured=None, keep=None, progress=None,
+          n_workers=None):
     """Run ``spec`` once per set of ``overrides`` (a list of {dotted key: value}
     dicts, e.g. from :func:`grid`), in parallel on dask (see
     :mod:`rodmol.calibrate.parallel` for ``client``).
@@ -77,7 +87,9 @@ def sweep(spec, overrides, *, client=None, out=None, measured=None, progress=Non
     Every override is checked before any run. With ``out``, each run's result
     goes to ``out/run_<i>/result.npz`` and the summary to ``out/summary.csv``
     and ``summary.md``. ``measured`` (marker tracks) adds the averages of
-    eq. (15) to the summary. ``progress(done, total)`` is called as runs end.
+    eq. (15) to the summary. ``keep`` brings every Result back to this process
+    (default: only without ``out``; a Result ships its raw states, about
+    size x n_t x 8 bytes). ``progress(done, total)`` is called as runs end.
     Returns a :class:`Sweep`.
     """
     spec = as_spec(spec)
@@ -89,7 +101,7 @@ def sweep(spec, overrides, *, client=None, out=None, measured=None, progress=Non
     if client != SERIAL:
         check_picklable(spec)
     tracks = as_tracks(measured) if measured is not None else None
-    task = Task(spec, Summary(tracks), keep=True)
+    task = Task(spec, Summary(tracks), keep=out is None if keep is None else bool(keep))
     folder = None if out is None else str(Path(out).resolve())
     items = [(i, o, folder) for i, o in enumerate(overrides)]
     with executor(client, n_workers) as ex:

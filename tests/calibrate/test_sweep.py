@@ -19,7 +19,7 @@ def test_sweep_on_a_local_cluster_equals_serial_runs(dask_client, tmp_path):
     spec = paper_spec("bending", t_end=1.0)
     overrides = grid({"material.E": [90e3, 130e3], "medium.Cy,Cz": [2.0, 3.0]})
     done = []
-    runs = sweep(spec, overrides, client=dask_client, out=tmp_path,
+    runs = sweep(spec, overrides, client=dask_client, out=tmp_path, keep=True,
                  progress=lambda i, n: done.append((i, n)))
     assert done[-1] == (4, 4)
     for o, run in zip(overrides, runs.runs):
@@ -35,6 +35,13 @@ def test_sweep_on_a_local_cluster_equals_serial_runs(dask_client, tmp_path):
     assert len(rows) == 4 and rows[3]["material.E"] == "130000.0"
     saved = load_result(tmp_path / "run_0003" / "result.npz")
     assert np.array_equal(saved.markers, runs.runs[3].result.markers)
+
+
+def test_sweep_with_output_reads_results_back_from_files(tmp_path):
+    spec = paper_spec("bending", t_end=0.3)
+    runs = sweep(spec, [{"material.E": 9e4}], client="serial", out=tmp_path)
+    assert runs.runs[0].result is None
+    assert np.array_equal(runs.result(0).markers, apply(spec, {"material.E": 9e4}).simulate().markers)
 
 
 def test_bad_overrides_stop_the_sweep_before_any_run():
