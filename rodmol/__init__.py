@@ -8,13 +8,16 @@ parameters, rod, cables, base motion, loads, markers, model, simulate,
 result, analysis. The machinery sits in folders: ``discretise/`` (state
 layout, the compiled physics and the semi-discrete scheme, its Jacobian),
 ``solve/`` (static equilibrium and the time-integration backends) and
-``io/`` (scenario files, ParaView series, pictures, command line).
+``io/`` (scenario files, ParaView series, pictures, command line) and
+``calibrate/`` (measured data, stereo reconstruction, the paper's error
+study, identification, sweeps, linearisation).
 """
 
 from . import scenarios
 from .analysis import energy, marker_errors
 from .arm import paper_arm
 from .base_motion import Base, BaseMotion
+from .cables import Cable, read_tension_csv
 from .calibrate import (
     calibrate_dlt,
     identify,
@@ -24,7 +27,6 @@ from .calibrate import (
     triangulate,
     worsened_models,
 )
-from .cables import Cable, read_tension_csv
 from .discretise.layout import StateLayout
 from .discretise.system import SemiDiscrete, StateView
 from .errors import EquilibriumError, IntegrationError, ParameterError, RodmolError

@@ -8,7 +8,9 @@ machine code) are timed apart from the sweep. Each run also rebuilds its
 pose for the summary row, in the worker or here. On the cluster, the sweep
 is timed twice: returning the summary rows only (``keep=False``, as when the
 results go to files) and returning every Result (``keep=True``: each ships
-its raw states to this process).
+its raw states to this process). The machine's 1-minute load average is
+recorded before and after each size: on a shared machine, a worker gets a
+core only if nobody else holds it.
 
     python solvers/sweep_throughput.py [--quick | --smoke] [--out DIR]
 """
@@ -56,9 +58,10 @@ def main(argv=None):
             spec = bending(n, t_end)
             overrides = [{"material.E": float(e)} for e in np.linspace(80e3, 140e3, n_runs)]
             apply(spec, overrides[0]).simulate()  # warm up this process
+            load = os.getloadavg()[0]  # 1-minute load: other users of the cores
             with C.Stopwatch() as clock:
                 serial = sweep(spec, overrides, client="serial")
-            row = dict(N=n, runs=n_runs, t_end_s=spec.t_end, serial_s=clock.seconds,
+            row = dict(N=n, runs=n_runs, load_before=load, t_end_s=spec.t_end, serial_s=clock.seconds,
                        serial_runs_per_min=60 * n_runs / clock.seconds)
             for w, (_, client) in clusters.items():
                 with C.Stopwatch() as clock:
@@ -71,6 +74,7 @@ def main(argv=None):
                             f"cluster{w}_speedup": row["serial_s"] / clock.seconds,
                             f"cluster{w}_with_results_runs_per_min": 60 * n_runs / back.seconds,
                             f"cluster{w}_same": same})
+            row["load_after"] = os.getloadavg()[0]
             rows.append(row)
             print(", ".join(f"{k} {v:.3g}" if isinstance(v, float) else f"{k} {v}" for k, v in row.items()),
                   flush=True)

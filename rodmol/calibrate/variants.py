@@ -111,7 +111,7 @@ def apply(spec, overrides):
         elif table == "medium" and name in SWITCHES:
             groups["switches"][name] = _boolean(key, value)
         elif key == "discretization.n_elements":
-            n_elements = _guard(key, value, lambda: _checks.integer_at_least("n_elements", value, 2))
+            n_elements = _guard(key, value, lambda v=value: _checks.integer_at_least("n_elements", v, 2))
         elif table == "solver" and name in SOLVER:
             groups["solver"][name] = value if name in ("backend", "initial", "atol") else _number(key, value)
         elif table == "tension" and name:
