@@ -28,6 +28,7 @@ from .calibrate import (
     worsened_models,
 )
 from .discretise.layout import StateLayout
+from .discretise.schemes import SCHEMES
 from .discretise.system import SemiDiscrete, StateView
 from .errors import EquilibriumError, IntegrationError, ParameterError, RodmolError
 from .io.scenario_file import ScenarioError, load_scenario
@@ -56,7 +57,7 @@ __all__ = [
     "BACKENDS", "Base", "BaseMotion", "Cable", "CapsuleContact", "DistributedForce",
     "DistributedMoment", "PlaneContact", "PointForce", "PointMoment", "SphereContact", "EquilibriumError", "IntegrationError", "MEDIA",
     "Marker", "Material", "Medium", "Model", "ParameterError", "Result", "Rod", "RodmolError",
-    "ScenarioError", "SemiDiscrete", "StateLayout", "StateView", "default_atol", "energy",
+    "SCHEMES", "ScenarioError", "SemiDiscrete", "StateLayout", "StateView", "default_atol", "energy",
     "equilibrium", "load_result", "load_scenario", "marker_errors", "paper_arm",
     "read_tension_csv", "scenarios", "simulate", "straight_state", "write_series",
     # rodmol.calibrate: from experiment to model

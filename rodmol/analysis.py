@@ -6,44 +6,48 @@ from dataclasses import dataclass
 import numpy as np
 
 from .discretise import external
+from .discretise.system import SemiDiscrete
 from .errors import ParameterError
 from .model import Q_STAR
 
 
 def energy(model, result):
-    """Discrete energies [J] of every frame, consistent with the semi-discrete scheme.
+    """Discrete energies [J] of every frame, consistent with the run's scheme.
 
-    Returns a dict of (n_t,) arrays: ``kinetic`` (velocity nodes 1..N, with
-    added mass), ``strain`` (strain nodes 0..N-1), ``gravity`` (potential of
+    Returns a dict of (n_t,) arrays: ``kinetic`` (velocity nodes 1..N, each
+    over the length of rod it stands for, with added mass), ``strain`` (the
+    cells, with the scheme's cell stiffness), ``gravity`` (potential of
     weight minus buoyancy), ``contact`` (elastic energy of the contact
     penalties) and ``total``. With mu = 0, no gravity, no fluid, no cables and
     no external loads, ``kinetic + strain`` is conserved by the semi-discrete
-    system; contact damping and friction only remove energy.
+    system of either scheme; contact damping and friction only remove energy.
     """
-    ds = model.ds
+    system = SemiDiscrete(model, result.meta.get("scheme", "upwind"))
+    lengths, (kl, kth) = system.node_lengths, system.cells[:2]
     v, w = result.velocity[:, 1:], result.angular_velocity[:, 1:]
-    kinetic = 0.5 * ds * (np.einsum("tni,ni,tni->t", v, model.mass, v)
-                          + np.einsum("tni,ni,tni->t", w, model.inertia, w))
+    kinetic = 0.5 * (np.einsum("tni,n,ni,tni->t", v, lengths, model.mass, v)
+                     + np.einsum("tni,n,ni,tni->t", w, lengths, model.inertia, w))
     dq = result.linear_strain[:, :-1] - Q_STAR
     k = result.curvature[:, :-1]
-    strain = 0.5 * ds * (np.einsum("tni,ni,tni->t", dq, model.kl, dq)
-                         + np.einsum("tni,ni,tni->t", k, model.kth, k))
+    strain = 0.5 * model.ds * (np.einsum("tni,ni,tni->t", dq, kl, dq)
+                               + np.einsum("tni,ni,tni->t", k, kth, k))
     # The time-integrated positions, not the rebuilt ones: their rate is exactly R v,
     # so this potential balances the gravity work of the semi-discrete system.
     u = result.integrated_positions[:, 1:]
-    gravity = -ds * np.einsum("n,tni,i->t", model.net_mass, u, model.gravity)
-    contact = _contact_energy(model, u)
+    gravity = -np.einsum("n,n,tni,i->t", lengths, model.net_mass, u, model.gravity)
+    contact = _contact_energy(model, u, lengths)
     return dict(kinetic=kinetic, strain=strain, gravity=gravity, contact=contact,
                 total=kinetic + strain + gravity + contact)
 
 
-def _contact_energy(model, u):
+def _contact_energy(model, u, lengths):
     """Penalty energy [J] of every frame, at the integrated positions ``u``
     (n_t, N, 3) of the velocity nodes (those the contact law sees)."""
     g = model.grid_loads
     out = np.zeros(len(u))
     for e in np.flatnonzero(np.isin(g.kind, (external.PLANE, external.CAPSULE))):
-        node, params, weight = int(g.node[e]) - 1, g.params[e], g.weight[e] * model.ds
+        node, params = int(g.node[e]) - 1, g.params[e]
+        weight = g.weight[e] * lengths[node]
         for i in range(len(u)):
             out[i] += weight * external.contact_energy(int(g.kind[e]), params, tuple(u[i, node]))
     return out

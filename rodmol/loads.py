@@ -41,8 +41,12 @@ class GridLoad:
     """A load mapped onto the velocity nodes 1..N of a grid (see
     :mod:`rodmol.discretise.external` for the kinds and parameter rows).
 
-    ``values(t)`` returns the (n_entries, 3) vectors at time t, or is None
-    when they are constant (``initial`` is then used throughout).
+    ``weight`` is the entry's share of the node's load density [1/m for a
+    point load, 1 for densities], taking every node as standing for a length
+    ds; ``concentrated`` marks point loads, whose density a scheme scales to
+    its own node lengths. ``values(t)`` returns the (n_entries, 3) vectors at
+    time t, or is None when they are constant (``initial`` is then used
+    throughout).
     """
 
     kind: np.ndarray
@@ -50,6 +54,7 @@ class GridLoad:
     weight: np.ndarray
     params: np.ndarray
     initial: np.ndarray
+    concentrated: np.ndarray
     values: Callable | None = None
 
     def fill(self, t, out):
@@ -101,7 +106,8 @@ class _PointLoad:
         kind = np.full(count, self._kinds[self.frame])
         initial = np.tile(signal.value(0.0), (count, 1))
         values = None if signal.constant else (lambda t: np.tile(signal.value(t), (count, 1)))
-        return GridLoad(kind, nodes, weights, np.zeros((count, external.N_PARAMS)), initial, values)
+        return GridLoad(kind, nodes, weights, np.zeros((count, external.N_PARAMS)), initial,
+                        np.ones(count, dtype=bool), values)
 
 
 @dataclass(frozen=True)
@@ -167,7 +173,8 @@ class _DistributedLoad:
         kind = np.full(count, self._kinds[self.frame])
         values = (lambda t: self._sample(s, t)) if callable(getattr(self, self._what)) else None
         return GridLoad(kind, np.arange(1, count + 1), np.ones(count),
-                        np.zeros((count, external.N_PARAMS)), self._sample(s, 0.0), values)
+                        np.zeros((count, external.N_PARAMS)), self._sample(s, 0.0),
+                        np.zeros(count, dtype=bool), values)
 
 
 @dataclass(frozen=True)
@@ -241,7 +248,7 @@ class _Contact:
         params[:, external.P_SMOOTHING] = (SMOOTHING_FRACTION * radius[1:] if self.smoothing_depth is None
                                            else self.smoothing_depth)
         return GridLoad(np.full(count, self._kind), np.arange(1, count + 1), np.ones(count), params,
-                        np.zeros((count, 3)))
+                        np.zeros((count, 3)), np.zeros(count, dtype=bool))
 
 
 @dataclass(frozen=True)
@@ -338,4 +345,4 @@ def on_grid(loads, s_nodes, radius):
 
     return GridLoad(cat("kind", 0).astype(np.int64), cat("node", 0).astype(np.int64),
                     cat("weight", 0), cat("params", (0, external.N_PARAMS)), cat("initial", (0, 3)),
-                    timed)
+                    cat("concentrated", 0).astype(bool), timed)

@@ -62,7 +62,10 @@ class Model:
     ``inertia``, ``net_mass``, ``drag_coefficient``, ``added``,
     ``cable_offsets``, ``cable_weights``, ``s_nodes``) are read-only: the
     compiled system copies them once, so they must not change afterwards.
-    Build a new Model to change a parameter.
+    Build a new Model to change a parameter. ``kl`` ... ``vth`` are sampled at
+    the strain nodes s_0..s_N-1, as the paper's upwind scheme reads them; a
+    scheme may sample the cells elsewhere (:meth:`cell_properties`,
+    ``SemiDiscrete.cells``: the centred scheme at the cells' midpoints).
     """
 
     def __init__(self, rod, n_elements, *, gravity=(0.0, -9.81, 0.0), medium=None,
@@ -147,10 +150,7 @@ class Model:
         self.s_nodes = np.linspace(0.0, rod.length, n + 1)
         s_str, s_vel = self.s_nodes[:-1], self.s_nodes[1:]
 
-        self.kl, self.kth = rod.stiffness(s_str)
-        self.vl, self.vth = rod.viscosity(s_str)
-        if not self.viscosity:
-            self.vl, self.vth = np.zeros_like(self.vl), np.zeros_like(self.vth)
+        self.kl, self.kth, self.vl, self.vth = self.cell_properties(s_str)
 
         a, r = rod.area(s_vel), rod.radius_at(s_vel)
         coeff = np.array([0.0, med.By, med.Bz]) if self.added_mass else np.zeros(3)
@@ -171,6 +171,18 @@ class Model:
         self.grid_loads = load_types.on_grid(self.loads, self.s_nodes, rod.radius_at(self.s_nodes))
         for name in SAMPLED:
             getattr(self, name).flags.writeable = False
+
+    def cell_properties(self, s):
+        """Sectional stiffness and viscosity diagonals at arc lengths ``s`` [m]:
+        (Kl, Kth, Vl, Vth), each (len(s), 3) [N, N m^2, N s, N m^2 s], with
+        ``viscosity=False`` honoured. The model's own ``kl`` ... ``vth`` are
+        these at the strain nodes; a scheme may sample them elsewhere."""
+        s = np.asarray(s, dtype=float)
+        kl, kth = self.rod.stiffness(s)
+        vl, vth = self.rod.viscosity(s)
+        if not self.viscosity:
+            vl, vth = np.zeros_like(vl), np.zeros_like(vth)
+        return kl, kth, vl, vth
 
     def tensions(self, t, state=None):
         """Cable tensions [N] at time t, shape (n_cables,)."""

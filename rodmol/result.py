@@ -15,6 +15,7 @@ ARRAYS = {
     "t": "s",
     "s": "m",
     "radius": "m",
+    "node_length": "m",
     "positions": "m, global",
     "integrated_positions": "m, global",
     "rotations": "local to global",
@@ -40,6 +41,10 @@ class Result:
     t : (n_t,) output times [s].
     s : (N+1,) arc length of the nodes [m]; node 0 is the base.
     radius : (N+1,) section radius at the nodes [m].
+    node_length : (N+1,) length of rod [m] each node stands for in the
+        scheme (0 at the clamp; ds, and ds/2 at the tip in the centred
+        scheme): ``sum(external_force[k, :, i] * node_length)`` is the total
+        external force at frame k.
     positions : (n_t, N+1, 3) centreline positions [m], global frame,
         rebuilt from the strains and orientations (see ``rodmol.centreline``).
     integrated_positions : (n_t, N+1, 3) positions integrated in time
@@ -52,7 +57,7 @@ class Result:
         and M [N m] in the body, local (without the cables' own tension).
     external_force, external_moment : (n_t, N+1, 3) external load densities
         [N/m, N m/m] at the nodes, global frame (point loads appear as their
-        share over the element length ds; node 0, the clamp, carries none).
+        share over the node's ``node_length``; node 0, the clamp, carries none).
     tensions : (n_t, n_cables) cable tensions [N].
     quaternion_norm_error : (n_t,) max over nodes of ||Q| - 1|.
     markers : (n_t, n_markers, 3) marker positions [m], global; their names
@@ -106,7 +111,8 @@ def load_result(path):
     """Read a :class:`Result` written by :meth:`Result.save`."""
     with np.load(path, allow_pickle=False) as data:
         info = json.loads(str(data["info"]))
-        arrays = {k: data[k] for k in ARRAYS}
+        # Files written before a key existed load without it.
+        arrays = {k: data[k] for k in ARRAYS if k in data}
     return Result(arrays, info["success"], info["message"], info["stats"], info.get("meta"))
 
 
@@ -133,11 +139,12 @@ def from_states(system, t, y, success, message, stats):
     tensions = np.array([system.tensions(ti, yi) for ti, yi in zip(t, y)]).reshape(n_t, -1)
     arrays = dict(
         t=t, s=model.s_nodes, radius=model.rod.radius_at(model.s_nodes), tensions=tensions,
+        node_length=np.concatenate([[0.0], system.node_lengths]),
         quaternion_norm_error=np.max(np.abs(np.linalg.norm(quat_all, axis=-1) - 1.0), axis=-1),
     )
     groups = {"mechanics": partial(_mechanics, system, t, y, tensions), "pose": partial(_pose, system, y)}
     deferred = {name: groups[group] for group, names in _GROUPS.items() for name in names}
-    meta = dict(n_elements=model.n_elements, length=model.rod.length,
+    meta = dict(n_elements=model.n_elements, length=model.rod.length, scheme=system.scheme.name,
                 cables=[dict(name=c.name, offset=list(c.offset), anchor=c.anchor)
                         for c in model.cables],
                 markers=[dict(name=mk.name, s=mk.s, offset=list(model.marker_offsets[i, 1:]))
@@ -159,7 +166,8 @@ def _mechanics(system, t, y, tensions):
     # Tip node: the body carries the load concentrated on the tip node (a
     # point load at s = L; distributed loads give an O(ds) share) minus the
     # stress of the cables anchored at the tip.
-    n_tip, m_tip = loads[:, -1, :3] * model.ds, loads[:, -1, 3:] * model.ds
+    tip_length = system.node_lengths[-1]
+    n_tip, m_tip = loads[:, -1, :3] * tip_length, loads[:, -1, 3:] * tip_length
     for c in range(len(model.cables)):
         if model.cable_weights[c, -1] != 1.0:
             continue

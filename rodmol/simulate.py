@@ -7,24 +7,22 @@ import numpy as np
 from . import _checks
 from .discretise import rotations
 from .discretise.layout import StateLayout
-from .discretise.system import SemiDiscrete
+from .discretise.schemes import DEFAULT_SCHEME
+from .discretise.system import SemiDiscrete, field_scales
 from .errors import ParameterError
 from .model import Model
 from .result import from_states
-from .solve.backends import DEFAULT_RTOL, get_backend
+from .solve.backends import get_backend
 from .solve.equilibrium import equilibrium
 
 
 def default_atol(model, rtol):
-    """Per-variable absolute tolerances: ``rtol`` times a scale of each field
-    (see ``StateLayout.scales``: positions L, quaternions 1, strains q 1,
-    curvatures 1/L, velocities L/(1 s), angular velocities 1 rad/s).
-
-    (A looser angular-velocity scale, e.g. (L/s)/r_min, takes 15-20% fewer
-    steps on the paper's tests, but lets energy creep up in inviscid
-    oscillations; see ``docs/performance.md``.)
-    """
-    return rtol * StateLayout(model.n_elements).scales(model.rod.length)
+    """Per-variable absolute tolerances: ``rtol`` times the typical size of
+    each field (``rodmol.discretise.system.field_scales``: positions L,
+    strains 1, curvatures 1/L, velocities L/T, angular velocities L/(T r_min)
+    with T the first bending period), so that every field's error moves the
+    rod by about ``rtol`` L."""
+    return rtol * StateLayout(model.n_elements).scales(field_scales(model))
 
 
 def straight_state(model):
@@ -35,8 +33,8 @@ def straight_state(model):
         rotations.from_matrix(base.rotation))
 
 
-def simulate(model, t_end, *, initial="equilibrium", backend="cvode", rtol=DEFAULT_RTOL,
-             atol=None, output_dt=0.01, progress=None, **backend_options):
+def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, backend="cvode",
+             rtol=None, atol=None, output_dt=0.01, progress=None, **backend_options):
     """Integrate the model from t = 0 to ``t_end``.
 
     Parameters
@@ -48,12 +46,17 @@ def simulate(model, t_end, *, initial="equilibrium", backend="cvode", rtol=DEFAU
         Initial state: the static equilibrium under the loads at t = 0 (the
         paper's choice), the undeformed straight rod at rest, or a state
         vector (e.g. the last state of an earlier run).
+    scheme : str
+        The spatial scheme, a name from ``rodmol.SCHEMES``: ``"centred"``
+        (second order in ds, default) or ``"upwind"`` (the paper's, first
+        order); see ``docs/model.md``.
     backend : str
         A name from ``rodmol.BACKENDS``: ``"cvode"`` (implicit BDF, default)
         or ``"rk23"`` (explicit, cross-check).
     rtol, atol : float, float or array
-        Tolerances shared by all backends; ``atol=None`` uses
-        :func:`default_atol`.
+        Tolerances shared by all backends; ``rtol=None`` is the scheme's
+        ``default_rtol`` (the time error about a tenth of the spatial error
+        at N = 100), ``atol=None`` uses :func:`default_atol`.
     output_dt : float
         Interval between output frames [s]; ``t_end`` is always an output.
     progress : callable, optional
@@ -72,9 +75,9 @@ def simulate(model, t_end, *, initial="equilibrium", backend="cvode", rtol=DEFAU
         raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
     t_end = _checks.positive("t_end", t_end, " s")
     output_dt = _checks.positive("output_dt", output_dt, " s")
-    rtol = _checks.positive("rtol", rtol)
     run = get_backend(backend)
-    system = SemiDiscrete(model)  # the one system of this run
+    system = SemiDiscrete(model, scheme)  # the one system of this run
+    rtol = _checks.positive("rtol", system.scheme.default_rtol if rtol is None else rtol)
     y0 = _initial_state(system, initial)
     if atol is None:
         atol = default_atol(model, rtol)

@@ -68,16 +68,19 @@ class _Worker:
         self.t_end = t_end
         package = os.path.dirname(os.path.abspath(rodmol.__file__))
         if os.path.isdir(os.path.join(package, "discretise")):  # the current layout
-            from rodmol.discretise import upwind
+            from rodmol.discretise import stencil
             from rodmol.discretise.system import SemiDiscrete
 
             self.version = "new"
-            system = SemiDiscrete(self.model)
-            self.kernel = upwind.rhs
+            # The old core's scheme and tolerance, so that both sides do the same work.
+            self.options = dict(scheme="upwind", rtol=1e-6)
+            system = SemiDiscrete(self.model, "upwind")  # the scheme the old core had
+            self.kernel = stencil.rhs
             scale = rodmol.default_atol(self.model, 1e-6) / 1e-6
             self.jac = system.jacobian(scale, None)
             self.pre = system.preconditioner(scale)
         else:  # before the refactor (9fce6d7)
+            self.options = {}
             from rodmol.semidiscrete import SemiDiscrete
 
             from rodmol import jacobian, kernels
@@ -101,11 +104,11 @@ class _Worker:
         self.fy = system(self.t, self.y)
         self.pre.setup(self.t, self.y, self.fy, False, [0], self.gamma)
         # Warm-up: compile (or load) everything a default run and the per-call timings use.
-        rodmol.simulate(self.model, min(t_end, 0.05))
+        rodmol.simulate(self.model, min(t_end, 0.05), **self.options)
         self.percall(7)
 
     def info(self):
-        res = self.rodmol.simulate(self.model, min(self.t_end, 0.05))
+        res = self.rodmol.simulate(self.model, min(self.t_end, 0.05), **self.options)
         package = os.path.dirname(os.path.abspath(self.rodmol.__file__))
         foreign = sorted(name for name, mod in sys.modules.items()
                          if (name == "rodmol" or name.startswith("rodmol."))
@@ -121,7 +124,7 @@ class _Worker:
 
         gc.collect()
         t0 = time.perf_counter()
-        res = self.rodmol.simulate(self.model, self.t_end)
+        res = self.rodmol.simulate(self.model, self.t_end, **self.options)
         total = time.perf_counter() - t0
         if tip_path:
             self.np.save(tip_path, self.np.column_stack([res.t, res.tip]))

@@ -26,7 +26,7 @@ import time
 import _common as C
 from _common import np, plt, rodmol
 
-from rodmol.discretise import upwind
+from rodmol.discretise import stencil
 
 SCRIPT = "profile_rhs.py"
 
@@ -47,7 +47,7 @@ def per_call(fn, reps):
 
 # cProfile entries (file suffix, function name) -> group
 GROUPS = [
-    (("upwind.py", "rhs"), "kernel: right-hand side"),
+    (("stencil.py", "rhs"), "kernel: right-hand side"),
     (("jacobian.py", "jacobian_blocks"), "kernel: Jacobian"),
     (("jacobian.py", "fill_matrix"), "kernel: Jacobian"),
     (("preconditioner.py", "block_setup"), "kernel: preconditioner setup"),
@@ -95,7 +95,7 @@ def main(argv=None):
 
     calls = [
         ("right-hand side, compiled (SemiDiscrete call)", per_call(lambda: fast(0.3, y, out), reps)),
-        ("right-hand side, bare kernel", per_call(lambda: upwind.rhs(y, out, *karg), reps)),
+        ("right-hand side, bare kernel", per_call(lambda: stencil.rhs(y, out, *karg), reps)),
         (f"Jacobian, compiled ({pre.jacobian.evaluations} kernel evaluations)", per_call(lambda: pre.jacobian.evaluate(0.3, y, fy),
                                                                  max(20, reps // 50))),
         ("preconditioner setup (factor I - gamma J)", per_call(lambda: pre.factor(1e-3), max(20, reps // 20))),

@@ -20,6 +20,8 @@ SCRIPTS = {
     "profile_rhs.py": ["profile_rhs.csv", "profile_rhs_calls.csv", "profile_rhs_ladder.csv", "profile_rhs.md",
                        "profile_rhs.png"],
     "core_speed.py": ["core_speed.csv", "core_speed.md"],
+    "continuum.py": ["continuum.csv", "continuum.md", "continuum.png"],
+    "schemes.py": ["schemes.csv", "schemes.md", "schemes.png"],
 }
 
 

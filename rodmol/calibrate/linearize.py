@@ -3,12 +3,13 @@
 import numpy as np
 
 from ..cables import Cable
+from ..discretise.schemes import DEFAULT_SCHEME
 from ..discretise.system import SemiDiscrete, StateView
 from ..errors import ParameterError
 from ..model import Model
 
 
-def linearize(model, state, t=0.0):
+def linearize(model, state, t=0.0, scheme=DEFAULT_SCHEME):
     """State and input Jacobians of the semi-discrete system at (``state``, ``t``).
 
     Parameters
@@ -18,6 +19,8 @@ def linearize(model, state, t=0.0):
         ``"equilibrium"`` for the static equilibrium under the loads at ``t``.
     t : float
         Time [s] at which the inputs (tensions, base motion, loads) are read.
+    scheme : str
+        The spatial scheme (``rodmol.SCHEMES``), as given to ``simulate``.
 
     Returns
     -------
@@ -34,12 +37,12 @@ def linearize(model, state, t=0.0):
     if isinstance(state, str) and state == "equilibrium":
         from ..solve.equilibrium import equilibrium
 
-        state = equilibrium(model, t)
+        state = equilibrium(model, t, scheme=scheme)
     y = np.asarray(state, dtype=float)
-    layout_size = SemiDiscrete(model).size
+    probe = SemiDiscrete(model, scheme)
+    layout_size = probe.size
     if y.shape != (layout_size,) or not np.all(np.isfinite(y)):
         raise ParameterError(f"`state` must be {layout_size} finite numbers (the state size), got shape {y.shape}")
-    probe = SemiDiscrete(model)
     tensions = model.tensions(t, StateView(probe.layout, t, y, model.ds) if model.feedback else None)
     # The same model with every cable active and its tension set by hand: a
     # constant nonzero tension keeps each cable in the kernel.
@@ -48,7 +51,7 @@ def linearize(model, state, t=0.0):
                  base=model.base, drag=model.drag, added_mass=model.added_mass,
                  viscosity=model.viscosity, munk_moment=model.munk_moment, markers=model.markers,
                  loads=model.loads)
-    system = SemiDiscrete(held)
+    system = SemiDiscrete(held, scheme)
     system.tension_values[:] = tensions
     a = system.jacobian(system.atol_scale(), matrix="dense").dense(t, y)
     b = np.empty((system.size, len(model.cables)))

@@ -8,7 +8,7 @@ and they apply to the built run, so they also change the paper's fixed arm:
 * ``medium.rho``, ``medium.Cx``, ``medium.Cy``, ``medium.Cz``, ``medium.By``,
   ``medium.Bz``; switches ``medium.drag``, ``medium.added_mass``,
   ``medium.munk_moment`` (true/false);
-* ``discretization.n_elements``; ``solver.t_end``, ``solver.rtol``,
+* ``discretization.n_elements``, ``discretization.scheme``; ``solver.t_end``, ``solver.rtol``,
   ``solver.atol``, ``solver.output_dt``, ``solver.backend``, ``solver.initial``;
 * ``tension.<cable>``: a tension input (number, knots, CSV path, TimeInput);
   ``tension.<cable>.scale`` [-] and ``tension.<cable>.offset`` [N]: the
@@ -25,6 +25,7 @@ from dataclasses import replace
 
 from .. import _checks
 from ..cables import Cable, Tension, as_tension
+from ..discretise.schemes import DEFAULT_SCHEME, get_scheme
 from ..errors import ParameterError
 from ..inputs import TimeInput
 from ..io.scenario_spec import RunSpec
@@ -37,7 +38,7 @@ MEDIUM = ("rho", "Cx", "Cy", "Cz", "By", "Bz")
 SWITCHES = ("drag", "added_mass", "munk_moment")
 SOLVER = ("t_end", "rtol", "atol", "output_dt", "backend", "initial")
 KEYS = ([f"material.{k}" for k in MATERIAL] + [f"medium.{k}" for k in MEDIUM + SWITCHES]
-        + ["discretization.n_elements"] + [f"solver.{k}" for k in SOLVER]
+        + ["discretization.n_elements", "discretization.scheme"] + [f"solver.{k}" for k in SOLVER]
         + ["tension.<cable>", "tension.<cable>.scale", "tension.<cable>.offset"])
 
 
@@ -112,6 +113,8 @@ def apply(spec, overrides):
             groups["switches"][name] = _boolean(key, value)
         elif key == "discretization.n_elements":
             n_elements = _guard(key, value, lambda v=value: _checks.integer_at_least("n_elements", v, 2))
+        elif key == "discretization.scheme":
+            groups["solver"]["scheme"] = _guard(key, value, lambda v=value: get_scheme(v).name)
         elif table == "solver" and name in SOLVER:
             groups["solver"][name] = value if name in ("backend", "initial", "atol") else _number(key, value)
         elif table == "tension" and name:
@@ -154,6 +157,8 @@ def current(spec, key):
         return getattr(model, name)
     if key == "discretization.n_elements":
         return model.n_elements
+    if key == "discretization.scheme":
+        return spec.solver.get("scheme", DEFAULT_SCHEME)
     if key == "solver.t_end":
         return spec.t_end
     if table == "solver" and name in SOLVER:

@@ -18,7 +18,7 @@ from .physics import jit
 # function that takes a compiled function as an argument (its type differs
 # in every process), and recompiling costs seconds per run. A second scheme
 # gets its own instance of this loop.
-from .upwind import rhs
+from .stencil import rhs
 
 
 @jit

@@ -186,11 +186,9 @@ class StateLayout(BlockLayout):
         q = np.tile([1.0, 0.0, 0.0], (n, 1))
         return self.pack(position, quaternion, u, np.tile(quaternion, (n, 1)), q, zeros, zeros, zeros)
 
-    def scales(self, length):
-        """Typical magnitude of every entry (for absolute tolerances and
-        difference increments): positions L, quaternions 1, strains q 1,
-        curvatures 1/L, velocities L/(1 s), angular velocities 1 rad/s."""
-        per_field = {"u": length, "Q": 1.0, "q": 1.0, "k": 1.0 / length, "v": length, "w": 1.0}
+    def scales(self, per_field):
+        """Every entry's typical magnitude, from one scale per field
+        (``per_field``: a dict with "u", "Q", "q", "k", "v", "w")."""
         block = np.concatenate([np.full(w, per_field[f]) for f, w in STATE_FIELDS.items()])
         head = np.concatenate([np.full(w, per_field[f]) for f, w in HEADER_FIELDS.items()])
         return np.concatenate([head, np.tile(block, self.n_blocks)])

@@ -12,8 +12,9 @@ interface (``size``, ``__call__``, ``layout``, ``pattern``, ``bandwidths``,
 
 import numpy as np
 
-from . import centreline, external, rotations, upwind
+from . import centreline, external, rotations, stencil
 from .layout import StateLayout, merge
+from .schemes import DEFAULT_SCHEME, get_scheme
 
 #: Rate [1/s] at which the quaternion norm is pulled back to 1; the exact
 #: dynamics keep |Q| = 1, so this only damps integration drift.
@@ -21,6 +22,33 @@ QUATERNION_RESTORING_RATE = 1.0
 #: Smoothing speed [m/s] of |v| in the drag law, so the implicit solver's
 #: Newton iterations see a differentiable right-hand side near v = 0.
 DRAG_SMOOTHING_SPEED = 1e-6
+
+
+def field_scales(model):
+    """Typical size of each field, chosen so that an error of ``rtol``
+    times the scale in any field moves the rod by about ``rtol`` L:
+    positions L, quaternions 1, strains q 1, curvatures 1/L, velocities
+    L / T and angular velocities L / (T r_min), the angular velocity that
+    moves the thinnest section's surface as fast. T is the period of the
+    first bending mode of a uniform cantilever with the base section
+    (Euler-Bernoulli, without the fluid), the time scale of the motion."""
+    rod = model.rod
+    length, r_base = rod.length, float(rod.radius_at(0.0))
+    r_min = float(np.min(rod.radius_at(model.s_nodes)))
+    mat = rod.material
+    omega = 1.8751**2 * np.sqrt(mat.E * r_base**2 / (4.0 * mat.rho)) / length**2
+    speed = length * omega / (2.0 * np.pi)
+    return {"u": length, "Q": 1.0, "q": 1.0, "k": 1.0 / length, "v": speed, "w": speed / r_min}
+
+
+def grid_damping_ratio(model):
+    """Kelvin-Voigt damping ratio zeta = omega tau / 2 of the fastest axial
+    wave the grid carries, omega = (pi / ds) sqrt(E / rho), with the
+    relaxation time tau = 3 mu / E of the sectional law. Below 1 every mode
+    of the grid is underdamped; the paper's arm at N = 100 has about 30."""
+    mat = model.rod.material
+    tau = 3.0 * mat.mu / mat.E if model.viscosity else 0.0
+    return 0.5 * tau * np.pi / model.ds * np.sqrt(mat.E / mat.rho)
 
 
 class StateView:
@@ -48,31 +76,49 @@ class StateView:
 
 
 class SemiDiscrete:
-    """The method-of-lines system of a :class:`rodmol.Model` (paper's upwind scheme).
+    """The method-of-lines system of a :class:`rodmol.Model`.
 
     Parameters
     ----------
     model : Model
+    scheme : str or Scheme
+        A name from ``rodmol.SCHEMES``: ``"centred"`` (second order, default)
+        or ``"upwind"`` (the paper's).
+
+    Attributes
+    ----------
+    cells : tuple of (N, 3) arrays
+        Kl, Kth, Vl, Vth of the cells, sampled where the scheme says.
+    node_lengths : (N,) array
+        Length of rod [m] each velocity node 1..N stands for.
+    lightly_damped : bool
+        True if even the grid's fastest mode oscillates (see
+        :func:`grid_damping_ratio`), so that no mode is damped by the
+        material: time integrators must then not add or remove energy.
     """
 
-    scheme = upwind
-
-    def __init__(self, model):
+    def __init__(self, model, scheme=DEFAULT_SCHEME):
         self.model = model
+        self.scheme = get_scheme(scheme)
         self.layout = StateLayout(model.n_elements)
         self.size = self.layout.size
         self.global_coupling = model.feedback  # feedback tensions read the whole state
         m = model
-        self._params = upwind.pack_params(m.kl, m.kth, m.vl, m.vth, m.mass, m.inertia, m.net_mass,
-                                          m.drag_coefficient, m.added)
-        self._consts = np.array([m.ds, QUATERNION_RESTORING_RATE, DRAG_SMOOTHING_SPEED**2,
-                                 1.0 if m.munk_moment else 0.0, *m.gravity])
-        self._work = np.zeros((m.n_elements, upwind.WORK_COLUMNS))
+        self.cells = m.cell_properties(self.scheme.cell_points(m.s_nodes))
+        self.node_lengths = self.scheme.node_lengths(m.n_elements, m.ds)
+        self.lightly_damped = grid_damping_ratio(m) < 1.0
+        self._params = stencil.pack_params(*self.cells, m.mass, m.inertia, m.net_mass,
+                                           m.drag_coefficient, m.added)
+        self._consts = np.zeros(stencil.N_CONSTS)
+        self._consts[:7] = (m.ds, QUATERNION_RESTORING_RATE, DRAG_SMOOTHING_SPEED**2,
+                            1.0 if m.munk_moment else 0.0, *m.gravity)
+        self._consts[stencil.CENTRED] = 1.0 if self.scheme.centred else 0.0
+        self._work = np.zeros((m.n_elements, stencil.WORK_COLUMNS))
         self.base_velocities = np.zeros(6)
         self._fixed_base = m.base.fixed
         self._setup_cables()
         self._setup_loads()
-        self.depends = merge(self.scheme.DEPENDS, external.dependency_table(set(self._kinds)))
+        self.depends = merge(self.scheme.depends, external.dependency_table(set(self._kinds)))
         self._inputs_vary = bool(self.global_coupling or self._timed or self._grid_loads.values
                                  or not self._fixed_base)
         # The kernel's arguments: arrays whose contents update_inputs refreshes in place.
@@ -81,8 +127,7 @@ class SemiDiscrete:
                       self._entry_params, self.entry_values, self._work)
 
     def __reduce__(self):
-        # Pickled as its model (the compiled scheme and the packed arrays are rebuilt).
-        return (SemiDiscrete, (self.model,))
+        return SemiDiscrete, (self.model, self.scheme.name)
 
     # ------------------------------------------------------------------ inputs
 
@@ -108,7 +153,9 @@ class SemiDiscrete:
         entries = self.model.grid_loads
         self._kinds = np.ascontiguousarray(entries.kind, dtype=np.int64)
         self._nodes = np.ascontiguousarray(entries.node - 1, dtype=np.int64)  # element blocks
-        self._entry_weights = np.ascontiguousarray(entries.weight, dtype=float)
+        # A point load's share of a node is spread over the node's own length.
+        stretch = np.where(entries.concentrated, self.model.ds / self.node_lengths[self._nodes], 1.0)
+        self._entry_weights = np.ascontiguousarray(entries.weight * stretch, dtype=float)
         self._entry_params = np.ascontiguousarray(entries.params, dtype=float).reshape(-1, external.N_PARAMS)
         self.entry_values = np.ascontiguousarray(entries.initial, dtype=float).reshape(-1, 3)
         self._grid_loads = entries
@@ -135,7 +182,7 @@ class SemiDiscrete:
         return self.model.tensions(t, state)
 
     def kernel_arguments(self):
-        """Arguments of :func:`rodmol.discretise.upwind.rhs` after (y, out):
+        """Arguments of :func:`rodmol.discretise.stencil.rhs` after (y, out):
         the packed model, the inputs :meth:`update_inputs` refreshes, scratch."""
         return self._args
 
@@ -147,7 +194,7 @@ class SemiDiscrete:
             out = np.empty(self.size)
         if self._inputs_vary:
             self.update_inputs(t, y)
-        self.scheme.rhs(y, out, *self._args)
+        stencil.rhs(y, out, *self._args)
         return out
 
     def rest_rates(self, t, y, out, load_factor=1.0):
@@ -160,7 +207,7 @@ class SemiDiscrete:
         for inputs in scaled:
             inputs *= load_factor
         try:
-            self.scheme.rhs(y, out, *self._args)
+            stencil.rhs(y, out, *self._args)
         finally:
             for inputs, value in zip(scaled, saved):
                 inputs[:] = value
@@ -202,8 +249,8 @@ class SemiDiscrete:
         return self.layout.bandwidths(self.depends)
 
     def atol_scale(self):
-        """Typical magnitude of each state entry (see ``StateLayout.scales``)."""
-        return self.layout.scales(self.model.rod.length)
+        """Typical magnitude of each state entry (see :func:`field_scales`)."""
+        return self.layout.scales(field_scales(self.model))
 
     def jacobian(self, scale, matrix="band"):
         """The compiled finite-difference Jacobian (scikit-sundae ``jacfn``)."""

@@ -1,6 +1,7 @@
 """The ``rodmol`` command line: run scenario files, render and plot results.
 
-    rodmol run SCENARIO.toml [--out DIR] [--backend NAME] [--n-elements N] [--t-end T] [--quiet]
+    rodmol run SCENARIO.toml [--out DIR] [--backend NAME] [--n-elements N] [--scheme NAME]
+               [--t-end T] [--quiet]
     rodmol run --example fetching [--out DIR] ...
     rodmol render DIR        # last_frame.png and animation.gif from DIR/result.npz
     rodmol plot DIR          # tip_path.png, markers.png, tensions.png
@@ -75,6 +76,7 @@ def _run_options(parser):
                                                  "else out/NAME)")
     parser.add_argument("--backend", metavar="NAME", help="solver backend (cvode, rk23)")
     parser.add_argument("--n-elements", type=int, metavar="N", help="number of elements N")
+    parser.add_argument("--scheme", metavar="NAME", help="spatial scheme (centred, upwind)")
     parser.add_argument("--t-end", type=float, metavar="T", help="end time [s]")
     parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
 
@@ -87,7 +89,7 @@ def _load(args):
 
     overrides = {}
     for option, key in (("backend", "solver.backend"), ("n_elements", "discretization.n_elements"),
-                        ("t_end", "solver.t_end")):
+                        ("scheme", "discretization.scheme"), ("t_end", "solver.t_end")):
         if getattr(args, option) is not None:
             overrides[key] = Override(getattr(args, option), "--" + option.replace("_", "-"))
     if args.example and args.scenario:
@@ -110,7 +112,7 @@ def _run(args):
     say = (lambda *a, **k: None) if args.quiet else print
     model = spec.model
     say(f"rodmol: {spec.name}: N = {model.n_elements} elements, t_end = {spec.t_end:g} s, "
-        f"backend {spec.solver['backend']} -> {out}")
+        f"{spec.solver['scheme']} scheme, backend {spec.solver['backend']} -> {out}")
     if spec.solver["initial"] == "equilibrium":
         say("rodmol: finding the initial equilibrium ...")
 

@@ -12,7 +12,8 @@ from ..arm import LENGTH as PAPER_LENGTH
 from ..arm import paper_arm
 from ..errors import ParameterError
 from ..model import Model
-from ..solve.backends import BACKENDS, DEFAULT_RTOL
+from ..discretise.schemes import DEFAULT_SCHEME, SCHEMES
+from ..solve.backends import BACKENDS
 from . import scenario_arm as arm_tables
 from . import scenario_readers as read
 from .scenario_loads import loads as load_tables
@@ -31,11 +32,12 @@ def build(data, ctx, default_name):
     if scenario not in (None, FAILED) and arm is None:
         ctx.add(("scenario",), f"`scenario = {scenario!r}` drives the paper's cables: add `arm = \"paper\"`")
     gravity = ctx.read(data, (), "gravity", read.vector(3, "m/s^2"), (0.0, -9.81, 0.0))
-    n_elements = _discretization(data, ctx)
+    n_elements, scheme = _discretization(data, ctx)
     medium, switches = arm_tables.medium(data, ctx, default="water" if arm == "paper" else "air")
     base = arm_tables.base(data, ctx)
     t_end_default = scenarios.get(scenario).t_end if scenario not in (None, FAILED) else scenario
     solver, t_end = _solver(data, ctx, t_end_default)
+    solver["scheme"] = scheme
     output = _output(data, ctx)
     loads = load_tables(data, ctx)
 
@@ -47,7 +49,7 @@ def build(data, ctx, default_name):
                 ctx.add((key,), f"`{key}` cannot be changed with `arm = \"paper\"` (the paper's arm "
                                 "is fixed); write the arm out in full instead (see examples/bending.toml)")
         tensions = arm_tables.paper_cables(data, ctx, scenario)
-        parts = (gravity, n_elements, medium, base, tensions, loads)
+        parts = (gravity, n_elements, scheme, medium, base, tensions, loads)
         if not failed(loads):
             _check_lengths(ctx, PAPER_LENGTH, [], [], loads)
         build_model = lambda: paper_arm(n_elements, medium=medium, tensions=tensions,  # noqa: E731
@@ -56,7 +58,7 @@ def build(data, ctx, default_name):
         rod = arm_tables.rod(data, ctx)
         cables = arm_tables.cables(data, ctx)
         markers = arm_tables.markers(data, ctx)
-        parts = (gravity, n_elements, medium, base, rod, cables, markers, loads)
+        parts = (gravity, n_elements, scheme, medium, base, rod, cables, markers, loads)
         if not failed(rod, cables, markers, loads):
             _check_lengths(ctx, rod.length, cables, markers, loads)
         build_model = lambda: Model(rod, n_elements, gravity=gravity, medium=medium,  # noqa: E731
@@ -106,7 +108,8 @@ def _entry_name(kind, index, entry):
 def _discretization(data, ctx):
     path = ("discretization",)
     table = ctx.table(data.get("discretization", {}), path, DISCRETIZATION)
-    return ctx.read(table, path, "n_elements", read.integer(2), 100)
+    return (ctx.read(table, path, "n_elements", read.integer(2), 100),
+            ctx.read(table, path, "scheme", read.choice(tuple(SCHEMES)), DEFAULT_SCHEME))
 
 
 def _solver(data, ctx, t_end_default):
@@ -114,7 +117,7 @@ def _solver(data, ctx, t_end_default):
     table = ctx.table(data.get("solver", {}), path, SOLVER)
     options = dict(
         backend=ctx.read(table, path, "backend", read.choice(tuple(BACKENDS)), "cvode"),
-        rtol=ctx.read(table, path, "rtol", read.number("positive"), DEFAULT_RTOL),
+        rtol=ctx.read(table, path, "rtol", read.number("positive")),
         atol=ctx.read(table, path, "atol", read.number("positive")),
         output_dt=ctx.read(table, path, "output_dt", read.number("positive", "s"), 0.01),
         initial=ctx.read(table, path, "initial", read.choice(INITIAL), "equilibrium"),

@@ -10,9 +10,6 @@ from ..errors import ParameterError
 from .cvode import cvode
 from .rk23 import rk23
 
-#: Default relative tolerance, shared by every backend.
-DEFAULT_RTOL = 1e-6
-
 #: Backends by name.
 BACKENDS = {"cvode": cvode, "rk23": rk23}
 

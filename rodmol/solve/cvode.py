@@ -21,7 +21,7 @@ GMRES_MIN_ELEMENTS = 50
 
 
 def cvode(system, y0, t_out, *, rtol, atol, progress=None, linsolver="auto", max_step=0.0,
-          jacobian="auto", max_order=5, max_nonlin_iters=3):
+          jacobian="auto", max_order="auto", max_nonlin_iters=3):
     """SUNDIALS CVODE (BDF) through scikit-sundae.
 
     ``linsolver`` is how the Newton systems (I - gamma J) x = r are solved:
@@ -48,10 +48,13 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, linsolver="auto", max
       (measured fastest with the band solvers, whose ``jacfn`` template is a
       dense (n, n) array; see ``docs/performance.md``).
 
-    ``max_order`` caps the BDF order (1-5) and ``max_nonlin_iters`` the Newton
-    iterations per step (SUNDIALS' defaults, 5 and 3: order 4 and 5 Newton
-    iterations save ~10% on the paper's tests but double the steps of an
-    inviscid oscillation; see ``docs/performance.md``).
+    ``max_order`` caps the BDF order (1-5); ``"auto"`` is 5, or 2 when every
+    mode of the grid oscillates (``system.lightly_damped``): BDF 3-5 are not
+    stable near the imaginary axis, and there they either take many short
+    steps or let the energy grow, while BDF2 is A-stable (see
+    ``docs/performance.md``). ``max_nonlin_iters`` caps the Newton iterations
+    per step (SUNDIALS' default 3: order 4 and 5 Newton iterations save ~10%
+    on the paper's tests but double the steps of an inviscid oscillation).
     """
     from sksundae.cvode import CVODE, CVODEPrecond
 
@@ -70,6 +73,8 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, linsolver="auto", max
     if linsolver == "gmres" and jacobian != "compiled":
         raise ParameterError("linsolver='gmres' is preconditioned with the compiled Jacobian; "
                              "use jacobian='auto' or 'compiled'")
+    if max_order == "auto":
+        max_order = 2 if system.lightly_damped else 5
     options = dict(method="BDF", rtol=rtol, atol=atol, linsolver=linsolver,
                    max_num_steps=1_000_000, max_step=max_step, max_order=int(max_order),
                    max_nonlin_iters=int(max_nonlin_iters))

@@ -16,6 +16,7 @@ from scipy.linalg import solve_banded
 
 from ..discretise import centreline, rotations
 from ..discretise.layout import BlockLayout
+from ..discretise.schemes import DEFAULT_SCHEME
 from ..discretise.system import SemiDiscrete
 from ..errors import EquilibriumError, ParameterError
 from ..model import Model
@@ -34,7 +35,7 @@ def static_dependencies(depends):
     return {**_COMPATIBILITY, "q": at_rest("v"), "k": at_rest("w")}
 
 
-def equilibrium(model, t=0.0, *, tol=1e-10, max_iter=40, system=None):
+def equilibrium(model, t=0.0, *, scheme=DEFAULT_SCHEME, tol=1e-10, max_iter=40, system=None):
     """Static equilibrium of ``model`` under its loads at time ``t``.
 
     Gravity, buoyancy, the cable tensions and the external loads at ``t`` are
@@ -47,12 +48,16 @@ def equilibrium(model, t=0.0, *, tol=1e-10, max_iter=40, system=None):
     model : Model
     t : float
         Time [s] at which the time-dependent inputs are evaluated.
+    scheme : str
+        The spatial scheme (``rodmol.SCHEMES``) whose rest state is sought: a
+        state at rest for one scheme is not at rest for the other.
     tol : float
         Required max-norm of the force and torque residuals, relative to the
         load scale (``Model.load_scale``); raised to the round-off floor of
         the difference quotients on very fine grids.
     system : SemiDiscrete, optional
-        The model's system, if one is built already (``simulate`` passes its own).
+        The model's system, if one is built already (``simulate`` passes its
+        own); it overrides ``scheme``.
 
     Returns
     -------
@@ -66,7 +71,7 @@ def equilibrium(model, t=0.0, *, tol=1e-10, max_iter=40, system=None):
     """
     if not isinstance(model, Model):
         raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
-    system = SemiDiscrete(model) if system is None else system
+    system = SemiDiscrete(model, scheme) if system is None else system
     layout, n, ds = system.layout, model.n_elements, model.ds
     static = BlockLayout(n, dict(STATIC_FIELDS))
     sl = static.slices()

@@ -1,8 +1,8 @@
 """An independent numpy implementation of the semi-discrete right-hand side.
 
-Written from the equations of the paper's upwind scheme (docs/model.md), not
-from rodmol's compiled functions: the sectional data are sampled here from the
-rod, the material and the medium; cables, base motion, Munk moment and every
+Written from the equations of the paper's upwind scheme and of the centred
+scheme (docs/model.md), not from rodmol's compiled functions: the sectional
+data are sampled here from the rod, the material and the medium; cables, base motion, Munk moment and every
 external load kind (point and distributed forces and moments in both frames,
 plane and capsule contact with the C1-smoothed penalty, damping ramp and
 regularised Coulomb friction) are evaluated here, vectorised over the nodes.
@@ -75,16 +75,23 @@ def local_to_global(r, x):
 # ----------------------------------------------------------------------------- model data
 
 class Sampled:
-    """Sectional data of a model on its staggered grid, sampled from the rod."""
+    """Sectional data of a model on its staggered grid, sampled from the rod:
+    the upwind scheme samples the cells at their base-side node, the centred
+    one at their midpoint, where its tip node stands for half a cell."""
 
-    def __init__(self, model):
+    def __init__(self, model, scheme="upwind"):
         rod, mat, med = model.rod, model.rod.material, model.medium
         n = model.n_elements
         self.n, self.ds = n, rod.length / n
+        self.centred = scheme == "centred"
         s = np.linspace(0.0, rod.length, n + 1)
         self.s = s
         s_str, s_vel = s[:-1], s[1:]
-        r_str = np.asarray(rod.radius_at(s_str))
+        self.lengths = np.full(n, self.ds)
+        if self.centred:
+            self.lengths[-1] = self.ds / 2
+        s_cell = s_str + self.ds / 2 if self.centred else s_str
+        r_str = np.asarray(rod.radius_at(s_cell))
         r_vel = np.asarray(rod.radius_at(s_vel))
         a_str, a_vel = np.pi * r_str**2, np.pi * r_vel**2
         j_str, j_vel = np.pi * r_str**4 / 4, np.pi * r_vel**4 / 4
@@ -116,12 +123,15 @@ def unpack(y, n):
 
 # ----------------------------------------------------------------------------- laws
 
-def strain_rates(q, k, v, w, v0, w0, ds):
-    """Compatibility (eq. 2), forward differences; strain node 0 moves with the base."""
+def strain_rates(q, k, v, w, v0, w0, ds, centred=False):
+    """Compatibility (eq. 2), differences across each cell (cell 0 starts at
+    the base); the other terms with the base-side node's velocities
+    (upwind) or the average of both nodes' (centred)."""
     v_str = np.vstack([v0, v[:-1]])
     w_str = np.vstack([w0, w[:-1]])
-    q_t = (v - v_str) / ds + cross(k, v_str) - cross(w_str, q)
-    k_t = (w - w_str) / ds + cross(k, w_str)
+    v_bar, w_bar = ((v + v_str) / 2, (w + w_str) / 2) if centred else (v_str, w_str)
+    q_t = (v - v_str) / ds + cross(k, v_bar) - cross(w_bar, q)
+    k_t = (w - w_str) / ds + cross(k, w_bar)
     return q_t, k_t
 
 
@@ -189,10 +199,11 @@ def contact_loads(obstacle, data, u, r, v, w):
 
 
 def point_shares(s, data):
-    """Weight [1/m] of a point load at s on velocity nodes 1..N (hat functions)."""
+    """Weight [1/m] of a point load at s on velocity nodes 1..N (hat functions
+    over the length each node stands for)."""
     x = s / data.ds
     nodes = np.arange(1, data.n + 1)
-    return np.maximum(0.0, 1.0 - np.abs(x - nodes)) / data.ds
+    return np.maximum(0.0, 1.0 - np.abs(x - nodes)) / data.lengths
 
 
 def external_loads(model, data, t, quat, u, v, w):
@@ -223,9 +234,9 @@ def external_loads(model, data, t, quat, u, v, w):
     return force, moment
 
 
-def rates(model, t, y, tensions=None):
-    """dy/dt of the upwind scheme at (t, y)."""
-    data = Sampled(model)
+def rates(model, t, y, tensions=None, scheme="upwind"):
+    """dy/dt of the upwind or the centred scheme at (t, y)."""
+    data = Sampled(model, scheme)
     n, ds = data.n, data.ds
     fld = unpack(y, n)
     u, quat, q, k, v, w = (fld[f] for f in ("u", "Q", "q", "k", "v", "w"))
@@ -233,24 +244,33 @@ def rates(model, t, y, tensions=None):
     if tensions is None:
         tensions = np.array([c.tension_at(t) for c in model.cables])
 
-    q_t, k_t = strain_rates(q, k, v, w, v0, w0, ds)
+    q_t, k_t = strain_rates(q, k, v, w, v0, w0, ds, data.centred)
     _, _, n_tot, m_tot = stresses(data, q, k, q_t, k_t, tensions)
 
-    # Velocity nodes 1..N: backward differences of the total stress, which
-    # vanishes beyond the tip where the strains are the reference ones.
+    # Velocity nodes 1..N: differences of the total stress of the cells
+    # around them; it vanishes beyond the tip, where the strains are the
+    # reference ones.
     zero = np.zeros((1, 3))
     n_next, m_next = np.vstack([n_tot[1:], zero]), np.vstack([m_tot[1:], zero])
     k_next, q_next = np.vstack([k[1:], zero]), np.vstack([q[1:], Q_STAR])
+    f_cells = cross(k_next, n_next)
+    t_cells = cross(k_next, m_next) + cross(q_next, n_next)
+    if data.centred:
+        f_cells = (f_cells + cross(k, n_tot)) / 2
+        t_cells = (t_cells + cross(k, m_tot) + cross(q, n_tot)) / 2
+        f_cells[-1] *= 2  # the tip node's half cell: its one cell's product
+        t_cells[-1] *= 2
     r = rotation_matrices(quat)
     f_ext, m_ext = external_loads(model, data, t, quat, u, v, w)
+    lengths = data.lengths[:, None]
 
     speed = np.sqrt(dot(v, v) + DRAG_SMOOTHING_SPEED**2)
-    force = ((n_next - n_tot) / ds + cross(k_next, n_next)
+    force = ((n_next - n_tot) / lengths + f_cells
              - cross(w, data.mass * v)
              + data.net_mass[:, None] * global_to_local(r, data.gravity)
              - speed[:, None] * data.drag * v
              + f_ext)
-    torque = ((m_next - m_tot) / ds + cross(k_next, m_next) + cross(q_next, n_next)
+    torque = ((m_next - m_tot) / lengths + t_cells
               - cross(w, data.inertia * w) + m_ext)
     if data.munk:
         torque -= cross(v, data.added * v)

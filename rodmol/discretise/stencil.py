@@ -1,17 +1,30 @@
-"""The paper's upwind scheme (section IV-C): the compiled right-hand side loop.
+"""The compiled right-hand side loop of the staggered grid, for both schemes.
 
-Forward differences (toward the tip) of v and w in the compatibility laws,
-backward differences (toward the base) of the stresses in the balance laws;
-the per-node physics comes from :mod:`rodmol.discretise.physics` and
-:mod:`rodmol.discretise.external`. :data:`DEPENDS` declares the couplings of
-this stencil; the Jacobian's structure is derived from it.
+Strains and stresses live on the cells (strain node i is cell [s_i, s_i+1]),
+velocities and poses on the nodes 1..N. The differences are the same in both
+schemes: v' and w' across a cell in the compatibility laws, N' and M' between
+neighbouring cells in the balance laws. The schemes differ in where the
+non-derivative terms are evaluated (:mod:`rodmol.discretise.schemes` holds
+the definitions, their dependency tables and sampling):
+
+* ``upwind`` (the paper's, section IV-C, ``consts[CENTRED] = 0``): the strain
+  rates use the velocities of the cell's base-side node, a node's balance uses
+  the products k x N, k x M, q x N of the cell on its tip side (zero beyond
+  the tip); first order in ds.
+* ``centred`` (``consts[CENTRED] = 1``): the strain rates use the average of
+  the cell's two node velocities, a node's balance the average of its two
+  cells' products, and the tip node carries half a cell; second order in ds,
+  and the discrete energy is conserved exactly without dissipation.
+
+The per-node physics comes from :mod:`rodmol.discretise.physics` and
+:mod:`rodmol.discretise.external`.
 
 Packing of the sampled model (built once by ``SemiDiscrete``):
 
 * ``params`` (N, 25): per element, the constant sectional data, one row per
   element (columns ``P_*``);
-* ``consts`` (7,): ds, quaternion restoring rate, drag smoothing speed^2,
-  Munk switch (0/1), gravity (3, global);
+* ``consts`` (8,): ds, quaternion restoring rate, drag smoothing speed^2,
+  Munk switch (0/1), gravity (3, global), centred switch (0/1);
 * ``offsets`` (n_c, 3), ``weights`` (n_c, N): cable offsets and their share
   of each strain node's cell;
 * external-load entries: ``kinds``, ``nodes`` (element block of the entry),
@@ -45,19 +58,9 @@ from .physics import (
     to_global,
 )
 
-NAME = "upwind"
-
-#: Which fields of which block (offset -1, 0, +1) each field's rate reads.
-DEPENDS = {
-    "u": {0: ("Q", "v")},
-    "Q": {0: ("Q", "w")},
-    "q": {-1: ("v", "w"), 0: ("q", "k", "v")},
-    "k": {-1: ("w",), 0: ("k", "w")},
-    # The next block's w reaches the force only through the moment, and the
-    # torque sees the previous block only through k_t (its w).
-    "v": {-1: ("v", "w"), 0: ("Q", "q", "k", "v", "w"), 1: ("q", "k", "v")},
-    "w": {-1: ("w",), 0: ("q", "k", "v", "w"), 1: ("q", "k", "v", "w")},
-}
+#: Index of the scheme switch in ``consts`` (0 upwind, 1 centred).
+CENTRED = 7
+N_CONSTS = 8
 
 P_KL, P_KTH, P_VL, P_VTH, P_MASS, P_INERTIA = 0, 3, 6, 9, 12, 15
 P_NET_MASS, P_DRAG, P_ADDED = 18, 19, 22
@@ -100,9 +103,10 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
     n = params.shape[0]
     ds, restoring, smoothing2, munk = consts[0], consts[1], consts[2], consts[3] != 0.0
     gravity = (consts[4], consts[5], consts[6])
+    centred = consts[CENTRED] != 0.0
 
-    # Pass 1, strain nodes i = 0..N-1: compatibility with forward differences
-    # of v, w (strain node 0 moves with the base), and the sectional stress.
+    # Pass 1, cells i = 0..N-1: compatibility with the differences of v, w
+    # across the cell (cell 0 starts at the base), and the sectional stress.
     for i in range(n):
         o = HEADER + BLOCK * i
         q, k, v, w = _vec(y, o + QS), _vec(y, o + K), _vec(y, o + V), _vec(y, o + W)
@@ -110,7 +114,10 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
             v_prev, w_prev = _vec(base, 0), _vec(base, 3)
         else:
             v_prev, w_prev = _vec(y, o - BLOCK + V), _vec(y, o - BLOCK + W)
-        terms_q, terms_k = strain_rate_terms(q, k, v_prev, w_prev)
+        if centred:
+            terms_q, terms_k = strain_rate_terms(q, k, scale(0.5, add(v, v_prev)), scale(0.5, add(w, w_prev)))
+        else:
+            terms_q, terms_k = strain_rate_terms(q, k, v_prev, w_prev)
         q_t = add(scale(1.0 / ds, sub(v, v_prev)), terms_q)
         k_t = add(scale(1.0 / ds, sub(w, w_prev)), terms_k)
         _put(out, o + QS, q_t)
@@ -150,29 +157,42 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
         _put(row, 12, add(_vec(row, 12), scale(entry_weights[e], f)))
         _put(row, 15, add(_vec(row, 15), scale(entry_weights[e], m)))
 
-    # Pass 2, velocity nodes 1..N (element i): balance laws with backward
-    # differences of the total stress; beyond the tip it vanishes and the
-    # strains are the reference ones.
+    # Pass 2, velocity nodes 1..N (element i): balance laws with the
+    # difference of the total stress of the cells around the node; beyond the
+    # tip the stress vanishes. Upwind: the products k x N, k x M, q x N of the
+    # tip-side cell. Centred: their average over both cells, and the tip node
+    # balances half a cell (the cell's full product over half its length).
     zero = (0.0, 0.0, 0.0)
     for i in range(n):
         o = HEADER + BLOCK * i
         row = work[i]
         n_here, m_here = _vec(row, 6), _vec(row, 9)
+        q_here, k_here = _vec(y, o + QS), _vec(y, o + K)
         if i + 1 < n:
             n_next, m_next = _vec(work[i + 1], 6), _vec(work[i + 1], 9)
             k_next, q_next = _vec(y, o + BLOCK + K), _vec(y, o + BLOCK + QS)
         else:
             n_next, m_next, k_next, q_next = zero, zero, zero, (1.0, 0.0, 0.0)
+        f_next, t_next = cross(k_next, n_next), add(cross(k_next, m_next), cross(q_next, n_next))
+        if not centred:
+            length, f_cells, t_cells = ds, f_next, t_next
+        else:
+            f_here = cross(k_here, n_here)
+            t_here = add(cross(k_here, m_here), cross(q_here, n_here))
+            if i + 1 < n:
+                length, f_cells, t_cells = ds, scale(0.5, add(f_here, f_next)), scale(0.5, add(t_here, t_next))
+            else:
+                length, f_cells, t_cells = 0.5 * ds, f_here, t_here
         v, w = _vec(y, o + V), _vec(y, o + W)
         quat = (y[o + QUAT], y[o + QUAT + 1], y[o + QUAT + 2], y[o + QUAT + 3])
         r = rotation(quat)
         pr = params[i]
         mass, inertia = _vec(pr, P_MASS), _vec(pr, P_INERTIA)
 
-        f = add(scale(1.0 / ds, sub(n_next, n_here)), cross(k_next, n_next))
+        f = add(scale(1.0 / length, sub(n_next, n_here)), f_cells)
         f = add(f, body_force(mass, pr[P_NET_MASS], _vec(pr, P_DRAG), r, gravity, v, w, smoothing2))
         f = add(f, _vec(row, 12))
-        t = add(scale(1.0 / ds, sub(m_next, m_here)), add(cross(k_next, m_next), cross(q_next, n_next)))
+        t = add(scale(1.0 / length, sub(m_next, m_here)), t_cells)
         t = add(t, body_torque(inertia, _vec(pr, P_ADDED), munk, v, w))
         t = add(t, _vec(row, 15))
 
