@@ -11,7 +11,7 @@ on the project's synthetic fetching experiment (examples/synthetic_experiment/).
 
     python examples/identify_from_cameras.py [--figures DIR] [--serial] [--workers N] [--quick]
 
-Runs in about a minute and a half on 2 cores (``--quick``: the first 2 s of
+Runs in under a minute on 2 cores (``--quick``: the first 2 s of
 the recording, E and Cy only, no Table V; about 15 s). The true parameters of the synthetic
 "prototype" are in synthetic_experiment/truth.json (the script compares).
 """
@@ -86,7 +86,7 @@ def main():
 
     # 3. The paper's model, driven by the measured tensions.
     text = f'name = "fetching"\narm = "paper"\nscenario = "fetching"\n' \
-           f'[discretization]\nn_elements = {truth["n_elements"]}\n'
+           f'[discretization]\nn_elements = {truth["n_elements"]}\nscheme = "{truth["scheme"]}"\n'
     log = read_tension_log(args.data / "tensions.csv", clip_negative=True)
     spec = apply(parse_scenario(text), log.overrides())
     if args.quick:
