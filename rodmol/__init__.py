@@ -8,7 +8,9 @@ parameters, rod, cables, base motion, loads, markers, model, simulate,
 result, analysis. The machinery sits in folders: ``discretise/`` (state
 layout, the compiled physics and the semi-discrete scheme, its Jacobian),
 ``solve/`` (static equilibrium and the time-integration backends) and
-``io/`` (scenario files, ParaView series, pictures, command line).
+``io/`` (scenario files, ParaView series, pictures, command line) and
+``calibrate/`` (measured data, stereo reconstruction, the paper's error
+study, identification, sweeps, linearisation).
 """
 
 from . import scenarios
@@ -16,6 +18,15 @@ from .analysis import energy, marker_errors
 from .arm import paper_arm
 from .base_motion import Base, BaseMotion
 from .cables import Cable, read_tension_csv
+from .calibrate import (
+    calibrate_dlt,
+    identify,
+    linearize,
+    paper_errors,
+    sweep,
+    triangulate,
+    worsened_models,
+)
 from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
 from .discretise.system import SemiDiscrete, StateView
@@ -50,4 +61,7 @@ __all__ = [
     "default_atol", "energy",
     "equilibrium", "load_result", "load_scenario", "marker_errors", "paper_arm",
     "read_tension_csv", "scenarios", "simulate", "straight_state", "write_series",
+    # rodmol.calibrate: from experiment to model
+    "calibrate_dlt", "identify", "linearize", "paper_errors", "sweep", "triangulate",
+    "worsened_models",
 ]

@@ -7,6 +7,8 @@ and velocities v, w on the *velocity nodes* i = 1..N. The base (node 0) has
 prescribed velocities, the tip (node N) a vanishing total stress.
 """
 
+import pickle
+
 import numpy as np
 
 from . import _checks
@@ -106,6 +108,16 @@ class Model:
         self.marker_offsets = marker_offsets(self.markers, rod)
         self._sample()
 
+    def __reduce__(self):
+        # Rebuilt from its arguments on unpickling: the sampled arrays follow
+        # from them, and the grid loads' time functions are closures.
+        _check_no_inline_functions(self)
+        options = dict(gravity=tuple(self.gravity), medium=self.medium, cables=self.cables,
+                       base=self.base, drag=self.drag, added_mass=self.added_mass,
+                       viscosity=self.viscosity, munk_moment=self.munk_moment,
+                       markers=self.markers, loads=self.loads)
+        return (_rebuild, (type(self), self.rod, self.n_elements, options))
+
     def __repr__(self):
         return (f"Model(L={self.rod.length} m, N={self.n_elements}, medium rho={self.medium.rho} "
                 f"kg/m^3, {len(self.cables)} cables)")
@@ -194,6 +206,37 @@ class Model:
         forces = np.isin(g.kind, (external.FOLLOWER_FORCE, external.DEAD_FORCE))
         moments = np.isin(g.kind, (external.FOLLOWER_MOMENT, external.DEAD_MOMENT))
         return scale + float(np.sum(size[forces]) + np.sum(size[moments]) / self.rod.length)
+
+
+def _rebuild(cls, rod, n_elements, options):
+    return cls(rod, n_elements, **options)
+
+
+def _check_no_inline_functions(model):
+    """Refuse to pickle inputs given as lambdas or local functions, naming them:
+    pickle stores functions by name, so these cannot reach another process."""
+    inputs = [(f"cable {c.name!r} tension", c.tension) for c in model.cables]
+    inputs += [(f"base {k}", getattr(model.base, k)) for k in ("velocity", "angular_velocity")]
+    inputs += [(f"load {getattr(x, 'name', x)!r}", x) for x in model.loads]
+    for label, value in inputs:
+        name = _inline_function(value)
+        if name:
+            raise pickle.PicklingError(
+                f"the model does not pickle: the {label} is an inline Python function ({name}); "
+                "give knots, a CSV table or a module-level function to send the model to "
+                "other processes (sweeps, identification, dask)")
+
+
+def _inline_function(value, depth=3):
+    """The name of a lambda or local function in an input or what it wraps, or None."""
+    name = getattr(value, "__qualname__", "") if callable(value) else ""
+    if "<lambda>" in name or "<locals>" in name:
+        return name
+    for attr in ("function", "signal", "force", "moment") if depth else ():
+        found = _inline_function(getattr(value, attr, None), depth - 1)
+        if found:
+            return found
+    return None
 
 
 def _medium(medium, medium_density):

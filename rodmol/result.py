@@ -1,6 +1,7 @@
 """The result of a simulation: time series on the nodes, and its .npz file format."""
 
 import json
+from functools import partial
 
 import numpy as np
 
@@ -130,63 +131,20 @@ def from_states(system, t, y, success, message, stats):
     Times, tensions and the quaternion drift are filled at once; the strains,
     stresses, loads and poses of every frame are computed on first access
     (most runs need only a few of them, and they cost about half the
-    integration), by the same compiled kernel as the integration.
+    integration), by the same compiled kernel as the integration. Until then
+    the result holds the system and the states, and pickles as them.
     """
     model, layout = system.model, system.layout
     n_t = len(t)
-    q, k, v, w = (layout.field(y, f) for f in ("q", "k", "v", "w"))
     quat_all = layout.quaternions(y)
-    base = [model.base.velocities(ti) for ti in t]
-    v0 = np.array([b[0] for b in base]).reshape(n_t, 3)
-    w0 = np.array([b[1] for b in base]).reshape(n_t, 3)
     tensions = np.array([system.tensions(ti, yi) for ti, yi in zip(t, y)]).reshape(n_t, -1)
-
-    def mechanics():
-        """Strains, velocities, stresses and external loads at all nodes."""
-        stress, loads = system.frames(t, y)
-        # Tip node: the body carries the load concentrated on the tip node (a
-        # point load at s = L; distributed loads give an O(ds) share) minus the
-        # stress of the cables anchored at the tip.
-        tip_length = system.node_lengths[-1]
-        n_tip, m_tip = loads[:, -1, :3] * tip_length, loads[:, -1, 3:] * tip_length
-        for c in range(len(model.cables)):
-            if model.cable_weights[c, -1] != 1.0:
-                continue
-            p = tuple(model.cable_offsets[c])
-            for i in range(n_t):
-                n_a, m_a = physics.cable_stress(tuple(q[i, -1]), tuple(k[i, -1]), p, tensions[i, c])
-                n_tip[i] -= n_a
-                m_tip[i] -= m_a
-        kl_tip, kth_tip = model.rod.stiffness(model.rod.length)
-        rots = rotations.matrices(quat_all[:, 1:])
-        zero = np.zeros((n_t, 1, 3))
-        return dict(
-            linear_strain=np.concatenate([q, (Q_STAR + n_tip / kl_tip)[:, None]], axis=1),
-            curvature=np.concatenate([k, (m_tip / kth_tip)[:, None]], axis=1),
-            velocity=np.concatenate([v0[:, None], v], axis=1),
-            angular_velocity=np.concatenate([w0[:, None], w], axis=1),
-            internal_force=np.concatenate([stress[..., :3], n_tip[:, None]], axis=1),
-            internal_moment=np.concatenate([stress[..., 3:], m_tip[:, None]], axis=1),
-            external_force=np.concatenate([zero, np.einsum("tnij,tnj->tni", rots, loads[..., :3])], axis=1),
-            external_moment=np.concatenate([zero, np.einsum("tnij,tnj->tni", rots, loads[..., 3:])], axis=1),
-        )
-
-    def pose():
-        """Positions rebuilt from the strains, rotations, markers, integrated positions."""
-        positions = centreline.positions(layout.base_position(y), quat_all, q, k, model.ds)
-        rots = rotations.matrices(quat_all)
-        return dict(
-            positions=positions, rotations=rots,
-            integrated_positions=layout.integrated_positions(y),
-            markers=markers.track(model.markers, model.marker_offsets, model.s_nodes, positions, rots),
-        )
-
     arrays = dict(
         t=t, s=model.s_nodes, radius=model.rod.radius_at(model.s_nodes), tensions=tensions,
         node_length=np.concatenate([[0.0], system.node_lengths]),
         quaternion_norm_error=np.max(np.abs(np.linalg.norm(quat_all, axis=-1) - 1.0), axis=-1),
     )
-    deferred = {name: group for group in (mechanics, pose) for name in _GROUPS[group.__name__]}
+    groups = {"mechanics": partial(_mechanics, system, t, y, tensions), "pose": partial(_pose, system, y)}
+    deferred = {name: groups[group] for group, names in _GROUPS.items() for name in names}
     meta = dict(n_elements=model.n_elements, length=model.rod.length, scheme=system.scheme.name,
                 cables=[dict(name=c.name, offset=list(c.offset), anchor=c.anchor)
                         for c in model.cables],
@@ -194,3 +152,55 @@ def from_states(system, t, y, success, message, stats):
                          for i, mk in enumerate(model.markers)],
                 loads=[repr(load) for load in model.loads])
     return Result(arrays, success, message, stats, meta, deferred)
+
+
+def _mechanics(system, t, y, tensions):
+    """Strains, velocities, stresses and external loads at all nodes."""
+    model, layout = system.model, system.layout
+    n_t = len(t)
+    q, k = layout.field(y, "q"), layout.field(y, "k")
+    v, w = layout.field(y, "v"), layout.field(y, "w")
+    base = [model.base.velocities(ti) for ti in t]
+    v0 = np.array([b[0] for b in base]).reshape(n_t, 3)
+    w0 = np.array([b[1] for b in base]).reshape(n_t, 3)
+    stress, loads = system.frames(t, y)
+    # Tip node: the body carries the load concentrated on the tip node (a
+    # point load at s = L; distributed loads give an O(ds) share) minus the
+    # stress of the cables anchored at the tip.
+    tip_length = system.node_lengths[-1]
+    n_tip, m_tip = loads[:, -1, :3] * tip_length, loads[:, -1, 3:] * tip_length
+    for c in range(len(model.cables)):
+        if model.cable_weights[c, -1] != 1.0:
+            continue
+        p = tuple(model.cable_offsets[c])
+        for i in range(n_t):
+            n_a, m_a = physics.cable_stress(tuple(q[i, -1]), tuple(k[i, -1]), p, tensions[i, c])
+            n_tip[i] -= n_a
+            m_tip[i] -= m_a
+    kl_tip, kth_tip = model.rod.stiffness(model.rod.length)
+    rots = rotations.matrices(layout.quaternions(y)[:, 1:])
+    zero = np.zeros((n_t, 1, 3))
+    return dict(
+        linear_strain=np.concatenate([q, (Q_STAR + n_tip / kl_tip)[:, None]], axis=1),
+        curvature=np.concatenate([k, (m_tip / kth_tip)[:, None]], axis=1),
+        velocity=np.concatenate([v0[:, None], v], axis=1),
+        angular_velocity=np.concatenate([w0[:, None], w], axis=1),
+        internal_force=np.concatenate([stress[..., :3], n_tip[:, None]], axis=1),
+        internal_moment=np.concatenate([stress[..., 3:], m_tip[:, None]], axis=1),
+        external_force=np.concatenate([zero, np.einsum("tnij,tnj->tni", rots, loads[..., :3])], axis=1),
+        external_moment=np.concatenate([zero, np.einsum("tnij,tnj->tni", rots, loads[..., 3:])], axis=1),
+    )
+
+
+def _pose(system, y):
+    """Positions rebuilt from the strains, rotations, markers, integrated positions."""
+    model, layout = system.model, system.layout
+    quat_all = layout.quaternions(y)
+    positions = centreline.positions(layout.base_position(y), quat_all, layout.field(y, "q"),
+                                     layout.field(y, "k"), model.ds)
+    rots = rotations.matrices(quat_all)
+    return dict(
+        positions=positions, rotations=rots,
+        integrated_positions=layout.integrated_positions(y),
+        markers=markers.track(model.markers, model.marker_offsets, model.s_nodes, positions, rots),
+    )

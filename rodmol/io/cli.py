@@ -5,6 +5,7 @@
     rodmol run --example fetching [--out DIR] ...
     rodmol render DIR        # last_frame.png and animation.gif from DIR/result.npz
     rodmol plot DIR          # tip_path.png, markers.png, tensions.png
+    rodmol study | identify | sweep ...   # calibration (see rodmol.io.cli_calibrate)
 
 Exit codes: 0 done, 1 the solver failed, 2 bad scenario or arguments (or the
 output directory is in use by another run), 3 outputs could not be written
@@ -68,6 +69,10 @@ def _parser():
     plot = commands.add_parser("plot", help="plot tip path, markers and tensions vs time (PNG)")
     plot.add_argument("directory", type=Path, help="output directory of `rodmol run`")
     plot.set_defaults(command=_plot)
+
+    from .cli_calibrate import add_commands
+
+    add_commands(commands)
     return parser
 
 

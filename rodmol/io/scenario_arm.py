@@ -13,6 +13,7 @@ from .. import scenarios
 from ..arm import CABLE_OFFSETS
 from ..base_motion import BaseMotion
 from ..cables import Cable
+from ..inputs import Constant
 from ..markers import Marker
 from ..parameters import MEDIA, Material, Medium
 from ..rod import Rod
@@ -173,7 +174,8 @@ def markers(data, ctx):
 
 
 def _constant(vector):
-    return lambda t: vector
+    # A bound method of a constant input, not a closure, so that the model pickles.
+    return Constant(vector, 3).value
 
 
 def base(data, ctx):

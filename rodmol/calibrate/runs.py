@@ -1,0 +1,124 @@
+"""One run of a scenario with overrides, as a task a worker executes, and
+what it sends back (:class:`Outcome`). Everything here pickles: the task and
+its extractors are module-level classes holding plain data."""
+
+import time
+import warnings
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import ParameterError, RodmolError
+from .paper_errors import paper_errors
+from .variants import apply
+
+
+@dataclass
+class Outcome:
+    """A run's overrides, whether it reached its end (``success``, ``message``),
+    its wall time [s] and solver statistics, what the task extracted
+    (``value``) and the Result (None if not kept)."""
+
+    overrides: dict
+    success: bool
+    message: str
+    wall: float
+    stats: dict = field(default_factory=dict)
+    value: object = None
+    result: object = None
+
+
+@dataclass(frozen=True)
+class Task:
+    """Run ``spec`` with one set of overrides and apply ``extract(result, spec)``.
+
+    ``keep`` returns the Result too (it pickles as its raw states: the
+    client computes what it reads from it).
+    """
+
+    spec: object
+    extract: object = None
+    keep: bool = True
+
+    def __call__(self, overrides):
+        started = time.perf_counter()
+        spec = apply(self.spec, overrides)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # the outcome carries the message
+                result = spec.simulate()
+        except ParameterError:
+            raise
+        except RodmolError as exc:  # e.g. no initial equilibrium: this run failed, not the batch
+            return Outcome(dict(overrides), False, f"{type(exc).__name__}: {exc}",
+                           time.perf_counter() - started)
+        value = self.extract(result, spec) if self.extract is not None else None
+        return Outcome(dict(overrides), result.success, result.message, time.perf_counter() - started,
+                       dict(result.stats), value, result if self.keep else None)
+
+
+@dataclass(frozen=True)
+class MarkersAt:
+    """The simulated markers (n_t, n_markers, 3) [m] at ``times`` [s], linearly
+    interpolated; NaN after the end of a run that stopped early."""
+
+    times: np.ndarray
+
+    def __call__(self, result, spec):
+        out = np.full((len(self.times),) + result.markers.shape[1:], np.nan)
+        if len(result.t) < 2:
+            return out
+        inside = self.times <= result.t[-1] + 1e-12
+        flat = result.markers.reshape(len(result.t), -1)
+        sim = np.stack([np.interp(self.times[inside], result.t, col) for col in flat.T], axis=1)
+        out[inside] = sim.reshape((int(np.sum(inside)),) + result.markers.shape[1:])
+        return out
+
+
+@dataclass(frozen=True)
+class Errors:
+    """The errors of eq. (15) against ``measured`` (MarkerTracks), named ``name``."""
+
+    measured: object
+    name: str = ""
+
+    def __call__(self, result, spec):
+        return paper_errors(result, self.measured, name=self.name)
+
+
+@dataclass(frozen=True)
+class Summary:
+    """A sweep run's summary row: end time, steps, final tip position [m]
+    (global) and the tip's largest travel [m]; with ``measured``
+    (MarkerTracks), the time averages of eq. (15)."""
+
+    measured: object = None
+
+    def __call__(self, result, spec):
+        row = dict(t_end=float(result.t[-1]) if len(result.t) else 0.0,
+                   steps=int(result.stats.get("steps", 0)))
+        if len(result.t):
+            tip = result.tip
+            row.update(tip_x=float(tip[-1, 0]), tip_y=float(tip[-1, 1]), tip_z=float(tip[-1, 2]),
+                       tip_travel=float(np.max(np.linalg.norm(tip - tip[0], axis=1))))
+        if self.measured is not None:
+            errors = paper_errors(result, self.measured)
+            row.update(mean_error=errors.mean_average, tip_error=errors.tip_average)
+        return row
+
+
+def run_indexed(task, item):
+    """``task(overrides)`` for ``item = (index, overrides, out)``; saves the result
+    to ``out/run_<index>/result.npz`` when ``out`` is set (module level so it pickles)."""
+    index, overrides, out = item
+    outcome = (task if out is None else replace(task, keep=True))(overrides)
+    if out is not None and outcome.result is not None:
+        folder = Path(out) / f"run_{index:04d}"
+        folder.mkdir(parents=True, exist_ok=True)
+        outcome.result.meta.update(overrides={k: repr(v) for k, v in overrides.items()})
+        outcome.result.save(folder / "result.npz")
+        outcome.value = dict(outcome.value or {}, path=str(folder / "result.npz"))
+        if not task.keep:
+            outcome.result = None  # read back from the file when needed
+    return outcome
