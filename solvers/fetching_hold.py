@@ -18,7 +18,6 @@ import os
 import _common as C
 from _common import np, plt, rodmol
 
-
 SCRIPT = "fetching_hold.py"
 
 

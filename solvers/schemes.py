@@ -52,7 +52,7 @@ def main(argv=None):
     sizes = {"centred": C.pick(args, [25, 50, 100, 200], [25, 50, 100], [6, 12]),
              "upwind": C.pick(args, [50, 100, 200, 400, 800, 1600], [50, 100, 400], [6, 12])}
     ref_sizes = C.pick(args, (400, 800), (200, 400), (24, 48))
-    rtols = C.pick(args, [1e-3, 1e-4, 3e-5, 1e-5, 1e-6], [1e-4, 1e-5, 1e-6], [1e-4])
+    rtols = C.pick(args, [1e-3, 1e-4, 3e-5, 1e-5, 1e-6], [1e-3, 1e-4, 3e-5, 1e-5], [1e-4])
     t_cut = C.pick(args, None, None, 0.2)
 
     rows, notes = [], []

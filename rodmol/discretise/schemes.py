@@ -54,8 +54,9 @@ class Scheme:
     order: int
     centred: bool
     depends: dict
-    #: Default relative tolerance: the time error about a tenth of the
-    #: spatial error at N = 100 on the paper's tests (docs/performance.md).
+    #: Default relative tolerance: the time error at most a tenth of the
+    #: spatial error at N = 100 on the paper's tests (docs/model.md,
+    #: docs/performance.md).
     default_rtol: float
 
     def cell_points(self, s_nodes):
@@ -79,7 +80,7 @@ SCHEMES = {
     "upwind": Scheme(
         "upwind",
         "the paper's scheme (section IV-C): one-sided non-derivative terms, first order",
-        1, False, _UPWIND, 1e-3),
+        1, False, _UPWIND, 1e-4),
 }
 DEFAULT_SCHEME = "centred"
 

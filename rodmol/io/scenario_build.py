@@ -11,8 +11,8 @@ from .. import scenarios
 from ..arm import LENGTH as PAPER_LENGTH
 from ..arm import paper_arm
 from ..discretise.layout import StateLayout
-from ..errors import ParameterError
 from ..discretise.schemes import DEFAULT_SCHEME, SCHEMES
+from ..errors import ParameterError
 from ..model import MAX_ELEMENTS, Model
 from ..solve import options as run_options
 from ..solve.backends import BACKENDS

@@ -15,8 +15,8 @@ import scipy.linalg
 import rodmol
 from rodmol.arm import paper_rod
 from rodmol.discretise import external, preconditioner
-from rodmol.discretise.schemes import SCHEMES
 from rodmol.discretise.layout import FIELDS, HEADER, merge
+from rodmol.discretise.schemes import SCHEMES
 
 L = paper_rod().length
 N = 8
