@@ -22,6 +22,8 @@ SCRIPTS = {
     "core_speed.py": ["core_speed.csv", "core_speed.md"],
     "continuum.py": ["continuum.csv", "continuum.md", "continuum.png"],
     "schemes.py": ["schemes.csv", "schemes.md", "schemes.png"],
+    "scheme_targets.py": ["scheme_targets.csv", "scheme_targets.md"],
+    "fetching_hold.py": ["fetching_hold.csv", "fetching_hold.md", "fetching_hold.png"],
 }
 
 
