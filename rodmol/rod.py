@@ -18,10 +18,12 @@ class Rod:
     ----------
     length : float
         Rest length L [m].
-    radius : float, (float, float) or callable
+    radius : float, (float, float), [(s, r), ...] or callable
         Section radius [m]: a constant, a ``(base, tip)`` pair for a linear
-        taper, or a callable ``r(s)`` of the arc length s in [0, L] [m]
-        (it is called with numpy arrays).
+        taper, ``(s, r)`` points [m] spanning s = 0 to L with increasing s
+        (linear between them, as ``radius = [[s, r], ...]`` in a scenario
+        file), or a callable ``r(s)`` of the arc length s in [0, L] [m] (it
+        is called with numpy arrays).
     material : Material
     """
 
@@ -40,13 +42,25 @@ class Rod:
             elif shape == (2,):
                 _checks.positive("radius[0] (base)", self.radius[0], " m")
                 _checks.positive("radius[1] (tip)", self.radius[1], " m")
+            elif len(shape or ()) == 2 and shape[1] == 2 and shape[0] >= 2:
+                object.__setattr__(self, "radius", self._points(r))
             else:
                 raise ParameterError(
-                    "`radius` must be a number, a (base, tip) pair or a callable r(s), "
-                    f"got {_checks.short(self.radius)}"
+                    "`radius` must be a number, a (base, tip) pair, (s, r) points or a callable "
+                    f"r(s), got {_checks.short(self.radius)}"
                 )
         # Callables are checked where they are sampled, on the actual grid.
         self.radius_at(np.linspace(0.0, self.length, 65))
+
+    def _points(self, points):
+        """``(s, r)`` points as a tuple of pairs, checked: increasing s from 0 to L."""
+        s, r = np.asarray(points, dtype=float).T
+        if np.any(np.diff(s) <= 0):
+            raise ParameterError(f"`radius` points must have increasing s, got s = {_checks.short(s.tolist())}")
+        if s[0] != 0.0 or abs(s[-1] - self.length) > 1e-9 * self.length:
+            raise ParameterError(f"`radius` points must span s = 0 to the length {self.length!r} m, "
+                                 f"got s from {s[0].item()!r} to {s[-1].item()!r} m")
+        return tuple((float(a), float(b)) for a, b in zip(s, r))
 
     def radius_at(self, s):
         """Radius [m] at arc lengths ``s`` [m] (array in, array out)."""
@@ -58,6 +72,9 @@ class Rod:
                 raise ParameterError(f"`radius` callable failed on arc lengths: {exc}") from exc
         elif np.ndim(self.radius) == 0:
             r = np.full(s.shape, float(self.radius))
+        elif np.ndim(self.radius) == 2:
+            knots, values = np.asarray(self.radius).T
+            r = np.interp(s, knots, values)
         else:
             base, tip = (float(x) for x in self.radius)
             r = base + (tip - base) * s / self.length

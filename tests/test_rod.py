@@ -27,6 +27,27 @@ def test_taper_and_volume():
     assert rod.mass() == pytest.approx(2.0 * exact, rel=1e-12)
 
 
+def test_radius_points_as_in_a_scenario_file():
+    """Rod(radius=[(s, r), ...]) is the same rod as a scenario file's points."""
+    from rodmol.io.scenario_file import RadiusProfile
+
+    mat = rodmol.Material(E=1e5, nu=0.5, rho=1000.0)
+    points = [(0.0, 0.012), (0.1, 0.01), (0.3, 0.005)]
+    rod = rodmol.Rod(0.3, points, mat)
+    profile = rodmol.Rod(0.3, RadiusProfile((0.0, 0.1, 0.3), (0.012, 0.01, 0.005)), mat)
+    s = np.linspace(0.0, 0.3, 31)
+    np.testing.assert_array_equal(rod.radius_at(s), profile.radius_at(s))
+    np.testing.assert_allclose(rod.radius_at([0.05, 0.2]), [0.011, 0.0075])
+    # two points are a linear taper, the same as a (base, tip) pair
+    np.testing.assert_allclose(rodmol.Rod(0.3, [(0.0, 0.012), (0.3, 0.005)], mat).radius_at(s),
+                               rodmol.Rod(0.3, (0.012, 0.005), mat).radius_at(s))
+    for bad, says in (([(0.0, 0.01), (0.2, 0.005)], "span s = 0 to the length 0.3"),
+                      ([(0.0, 0.01), (0.2, 0.01), (0.1, 0.01), (0.3, 0.01)], "increasing s"),
+                      ([(0.0, 0.01), (0.3, -0.005)], "finite and > 0")):
+        with pytest.raises(rodmol.ParameterError, match=says):
+            rodmol.Rod(0.3, bad, mat)
+
+
 def test_shear_modulus_instead_of_poisson_ratio():
     mat = rodmol.Material(E=1e6, G=1e4, rho=5000.0)
     assert mat.G == 1e4 and mat.nu == pytest.approx(49.0)

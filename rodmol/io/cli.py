@@ -44,8 +44,15 @@ def main(argv=None):
         return EXIT_INTERRUPTED
 
 
+def _version():
+    from .. import __version__
+
+    return __version__
+
+
 def _parser():
     parser = argparse.ArgumentParser(prog="rodmol", description="Soft cable-driven arms as Cosserat rods.")
+    parser.add_argument("--version", action="version", version=f"rodmol {_version()}")
     commands = parser.add_subparsers(required=True, metavar="COMMAND")
 
     run = commands.add_parser("run", help="run a scenario file and write result.npz and a ParaView series")

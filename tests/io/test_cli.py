@@ -36,6 +36,12 @@ def assert_valid_series(directory):
     return times
 
 
+@pytest.mark.subprocess
+def test_version():
+    proc = rodmol_cli("--version")
+    assert proc.returncode == 0 and proc.stdout.strip() == f"rodmol {rodmol.__version__}"
+
+
 def test_examples_are_shipped():
     assert {p.stem for p in SCENARIOS} >= {"bending", "reaching", "fetching", "uniform_arm_air"}
 
