@@ -16,6 +16,7 @@ ARRAYS = {
     "s": "m",
     "radius": "m",
     "node_length": "m",
+    "states": "state vectors (rodmol.StateLayout), for restarts",
     "positions": "m, global",
     "integrated_positions": "m, global",
     "rotations": "local to global",
@@ -141,6 +142,7 @@ def from_states(system, t, y, success, message, stats):
     arrays = dict(
         t=t, s=model.s_nodes, radius=model.rod.radius_at(model.s_nodes), tensions=tensions,
         node_length=np.concatenate([[0.0], system.node_lengths]),
+        states=np.asarray(y),
         quaternion_norm_error=np.max(np.abs(np.linalg.norm(quat_all, axis=-1) - 1.0), axis=-1),
     )
     groups = {"mechanics": partial(_mechanics, system, t, y, tensions), "pose": partial(_pose, system, y)}

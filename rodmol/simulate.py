@@ -11,7 +11,7 @@ from .discretise.schemes import DEFAULT_SCHEME, get_scheme
 from .discretise.system import SemiDiscrete, field_scales
 from .errors import ParameterError
 from .model import Model
-from .result import from_states
+from .result import Result, from_states
 from .solve import options
 from .solve.backends import get_backend
 from .solve.equilibrium import equilibrium
@@ -38,19 +38,20 @@ def straight_state(model):
 
 
 def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, backend="cvode",
-             rtol=None, atol=None, output_dt=0.01, progress=None, max_wall_time=None,
-             **backend_options):
+             rtol=None, atol=None, output_dt=0.01, output_times=None, t0=None, progress=None,
+             max_wall_time=None, **backend_options):
     """Integrate the model from t = 0 to ``t_end``.
 
     Parameters
     ----------
     model : Model
     t_end : float
-        End time [s] (> 0).
-    initial : "equilibrium", "straight" or array
-        Initial state: the static equilibrium under the loads at t = 0 (the
-        paper's choice), the undeformed straight rod at rest, or a state
-        vector (e.g. the last state of an earlier run).
+        End time [s], absolute (> ``t0``).
+    initial : "equilibrium", "straight", Result or array
+        Initial state: the static equilibrium under the loads at ``t0`` (the
+        paper's choice), the undeformed straight rod at rest, an earlier
+        :class:`Result` (the run continues from its last state, at its last
+        time unless ``t0`` is given), or a state vector (``Result.states``).
     scheme : str
         The spatial scheme, a name from ``rodmol.SCHEMES``: ``"centred"``
         (second order in ds, default) or ``"upwind"`` (the paper's, first
@@ -63,7 +64,15 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
         ``default_rtol`` (the time error about a tenth of the spatial error
         at N = 100), ``atol=None`` uses :func:`default_atol`.
     output_dt : float
-        Interval between output frames [s]; ``t_end`` is always an output.
+        Interval between output frames [s], from ``t0``; ``t_end`` is always
+        an output.
+    output_times : sequence of float, optional
+        Output times [s] instead of a uniform ``output_dt`` (e.g. a camera's
+        time stamps): increasing, within [t0, t_end]; ``t0`` and ``t_end``
+        are always outputs.
+    t0 : float, optional
+        Start time [s] (default 0, or the last time of an ``initial``
+        Result). Time-dependent inputs are read at absolute time.
     progress : callable, optional
         ``progress(t, t_end)`` is called at each output time, and between
         them every half second of wall time (``rodmol.solve.watch``).
@@ -84,7 +93,13 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
     """
     if not isinstance(model, Model):
         raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
+    if isinstance(initial, Result):
+        t0 = float(initial.t[-1]) if t0 is None else t0
+        initial = _last_state(initial, model)
+    t0 = 0.0 if t0 is None else _checks.non_negative("t0", t0, " s")
     t_end = _checks.positive("t_end", t_end, " s")
+    if t_end <= t0:
+        raise ParameterError(f"`t_end` must be after the start t0 = {t0!r} s, got {t_end!r} s")
     output_dt = _checks.positive("output_dt", output_dt, " s")
     scheme = get_scheme(scheme)
     rtol = options.rtol(scheme.default_rtol if rtol is None else rtol)
@@ -93,7 +108,7 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
     run = get_backend(backend)
     backend_options = options.backend_options(backend, run, backend_options)
     size = StateLayout(model.n_elements).size
-    n_out = options.output_count(t_end, output_dt, size)
+    t_out = options.output_times(t0, t_end, output_dt, output_times, size)
     if isinstance(initial, str) and initial not in INITIAL:
         raise ParameterError(f"unknown `initial` {_checks.short(initial)}"
                              f"{options.did_you_mean(initial, INITIAL)}; use 'equilibrium', "
@@ -101,11 +116,10 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
     if atol is not None:
         atol = _state_sized("atol", atol, size, positive=True, layout=StateLayout(model.n_elements))
     system = SemiDiscrete(model, scheme)  # the one system of this run
-    y0 = _initial_state(system, initial)
+    y0 = _initial_state(system, initial, t0)
     if atol is None:
         atol = default_atol(model, rtol)
 
-    t_out = np.unique(np.append(np.arange(n_out + 1) * output_dt, t_end))
     raw = run(system, y0, t_out, rtol=rtol, atol=atol, progress=progress,
               max_wall_time=max_wall_time, **backend_options)
     raw.stats["backend"] = backend
@@ -116,14 +130,24 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
     return result
 
 
-def _initial_state(system, initial):
+def _last_state(result, model):
+    states = getattr(result, "states", None)
+    if states is None or len(states) == 0:
+        raise ParameterError("`initial`: this Result holds no states (written by an older rodmol?)")
+    if result.meta.get("n_elements") not in (None, model.n_elements):
+        raise ParameterError(f"`initial`: the Result has N = {result.meta['n_elements']} elements, "
+                             f"the model {model.n_elements}")
+    return states[-1]
+
+
+def _initial_state(system, initial, t0):
     if isinstance(initial, str):
         if initial == "equilibrium":
-            return equilibrium(system.model, 0.0, system=system)
+            return equilibrium(system.model, t0, system=system)
         if initial == "straight":
             return straight_state(system.model)
     y0 = _state_sized("initial", initial, system.size, layout=system.layout)
-    problem = state_problem(system.layout, system.model.ds, 0.0, y0)
+    problem = state_problem(system.layout, system.model.ds, t0, y0)
     if problem:
         raise ParameterError(f"`initial` is not a state of this rod: {problem}")
     return y0

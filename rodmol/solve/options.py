@@ -9,6 +9,8 @@ import difflib
 import inspect
 import math
 
+import numpy as np
+
 from .. import _checks
 from ..errors import ParameterError
 
@@ -20,8 +22,8 @@ MAX_STATE_BYTES = 2 * 1024**3
 #: Arguments every backend takes from simulate itself (not backend options).
 COMMON = ("rtol", "atol", "progress", "max_wall_time")
 #: simulate's own keywords, offered as suggestions for misspelled options.
-SIMULATE_KEYWORDS = ("initial", "scheme", "backend", "rtol", "atol", "output_dt", "progress",
-                     "max_wall_time")
+SIMULATE_KEYWORDS = ("initial", "scheme", "backend", "rtol", "atol", "output_dt", "output_times",
+                     "t0", "progress", "max_wall_time")
 
 
 def _integer_in(low, high):
@@ -107,6 +109,28 @@ def progress(value):
 
 def max_wall_time(value):
     return None if value is None else _checks.positive("max_wall_time", value, " s")
+
+
+def output_times(t0, t_end, output_dt, times, state_size):
+    """The output times [s]: ``times`` (checked: finite, increasing, within
+    [t0, t_end]) or every ``output_dt`` from t0; t0 and t_end always."""
+    if times is None:
+        n_out = output_count(t_end - t0, output_dt, state_size)
+        uniform = t0 + np.arange(n_out + 1) * output_dt
+        return np.unique(np.append(uniform[uniform < t_end], t_end))
+    try:
+        times = np.asarray(times, dtype=float).ravel()
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(f"`output_times` must be numbers [s], got {_checks.short(times)}") from None
+    if not np.all(np.isfinite(times)) or np.any(np.diff(times) <= 0):
+        raise ParameterError(f"`output_times` must be finite and increasing, got {_checks.short(times.tolist())}")
+    if times.size and (times[0] < t0 or times[-1] > t_end):
+        raise ParameterError(f"`output_times` must lie in [t0, t_end] = [{t0!r}, {t_end!r}] s, got "
+                             f"{times[0].item()!r} ... {times[-1].item()!r} s")
+    limit = min(MAX_OUTPUT_FRAMES, MAX_STATE_BYTES // (8 * state_size))
+    if times.size + 2 > limit:
+        raise ParameterError(f"`output_times` asks for {times.size} frames; at most {limit} are allowed")
+    return np.unique(np.concatenate([[t0], times, [t_end]]))
 
 
 def output_count(t_end, output_dt, state_size):

@@ -369,3 +369,38 @@ def test_tip_trajectory_converges_at_the_schemes_order(scheme, order):
     observed = np.log2(d[0] / d[1])
     print(f"\n{scheme}: differences {d} m, observed order {observed:.3f}")
     assert order - 0.3 < observed < order + 0.5
+
+
+# --------------------------------------------------------------------------
+# (f) continuation from a Result, explicit t0, output at given times
+# --------------------------------------------------------------------------
+
+def test_continued_run_matches_an_uninterrupted_one():
+    """0-1 s, then 1-2 s from the first Result, ends where one 0-2 s run ends
+    (the pull ramps through t = 1 s: the inputs are read at absolute time)."""
+    model = rodmol.scenarios.get("bending").model(12)
+    whole = rodmol.simulate(model, 2.0, rtol=1e-9, output_dt=0.1)
+    first = rodmol.simulate(model, 1.0, rtol=1e-9, output_dt=0.1)
+    second = rodmol.simulate(model, 2.0, initial=first, rtol=1e-9, output_dt=0.1)
+    assert second.t[0] == 1.0 and second.t[-1] == 2.0
+    np.testing.assert_array_equal(second.states[0], first.states[-1])
+    np.testing.assert_allclose(second.tensions[-1], whole.tensions[-1])
+    gap = np.max(np.abs(second.positions[-1] - whole.positions[-1]))
+    motion = np.max(np.abs(whole.positions[-1] - whole.positions[0]))
+    print(f"\ncontinued vs whole: {gap:.2e} m of {motion:.2e} m of motion")
+    assert motion > 0.05 and gap < 1e-6 * motion
+
+
+def test_output_at_given_times_and_from_t0():
+    model = rodmol.scenarios.get("bending").model(10)
+    times = [0.13, 0.5, 0.777]
+    res = rodmol.simulate(model, 1.0, output_times=times)
+    np.testing.assert_array_equal(res.t, [0.0, *times, 1.0])
+    late = rodmol.simulate(model, 1.0, t0=0.5, output_dt=0.25)
+    np.testing.assert_allclose(late.t, [0.5, 0.75, 1.0])
+    # started at the equilibrium under the tension at t0 = 0.5 s, not at 0
+    np.testing.assert_allclose(late.tensions[0], model.tensions(0.5))
+    for bad, says in (({"output_times": [0.5, 0.2]}, "increasing"), ({"output_times": [2.0]}, "lie in"),
+                      ({"t0": 1.5}, "after the start")):
+        with pytest.raises(rodmol.ParameterError, match=says):
+            rodmol.simulate(model, 1.0, **bad)
