@@ -1,10 +1,10 @@
 """Centreline positions rebuilt from the strains.
 
-The upwind scheme does not keep the time-integrated positions (u_t = R v)
-consistent with the strains (u' = R q): their gap grows by O(ds) per unit
-time under sustained motion. Positions are therefore rebuilt from the base
-position, the orientations and the strains, which is exact at rest and
-bounded by O(ds) at all times. The static equilibrium imposes the same chords,
+The discrete schemes keep the time-integrated positions (u_t = R v)
+consistent with the strains (u' = R q) only to their order: the gap grows by
+O(ds) (upwind) or O(ds^2) (centred) per unit time under sustained motion.
+Positions are therefore rebuilt from the base position, the orientations and
+the strains (the midpoint rule, second order), which is exact at rest. The static equilibrium imposes the same chords,
 so at rest both positions agree.
 """
 

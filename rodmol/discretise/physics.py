@@ -2,13 +2,13 @@
 
 Small functions of 3-vectors (tuples of floats, so that numba keeps them in
 registers) that every driver calls: the scheme's compiled loop
-(:mod:`rodmol.discretise.upwind`) for integration, and through it the static
+(:mod:`rodmol.discretise.stencil`) for integration, and through it the static
 equilibrium and the post-processing. All vectors are in the local (material)
 frame unless the name says global; ``R`` (a 9-tuple, row major) maps local to
 global. Loads are densities per unit of reference arc length: forces [N/m],
 moments [N m/m].
 
-``tests/oracle.py`` holds an independent numpy implementation of the same
+``tests/discretise/oracle.py`` holds an independent numpy implementation of the same
 equations, used only to test these.
 """
 

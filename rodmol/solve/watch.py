@@ -9,7 +9,7 @@ Every accepted step (not only the output times) goes through
   microsecond): non-finite entries, elements inverted or collapsed
   (axial stretch q1 <= :data:`MIN_STRETCH`), stretched beyond
   :data:`MAX_STRETCH`, or turning by more than :data:`MAX_TURN` rad over one
-  element (the grid no longer resolves the curvature: the upwind scheme and
+  element (the grid no longer resolves the curvature: the schemes and
   the chord formula break down near half a turn per element), and
   orientations whose quaternion norm left 1 (the solution blew up);
 * every :data:`STALL_WINDOW` steps, the time covered by the window is
