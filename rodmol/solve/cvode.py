@@ -130,9 +130,7 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, l
         return info
 
     def stop(reason, error=None):
-        reached = out.t_out[out.next_index - 1]
-        return out.solution(False, f"CVODE stopped after t = {reached:.6g} s (last output frame; "
-                            f"{watch.summary()}): {reason}", error=error, **stats())
+        return out.stopped("CVODE", watch, reason, error, **stats())
 
     t_end = float(t_out[-1])
     sizes, r, t_last = [], None, float(t_out[0])  # sizes of the steps taken [s]

@@ -115,7 +115,7 @@ def output_times(t0, t_end, output_dt, times, state_size):
     """The output times [s]: ``times`` (checked: finite, increasing, within
     [t0, t_end]) or every ``output_dt`` from t0; t0 and t_end always."""
     if times is None:
-        n_out = output_count(t_end - t0, output_dt, state_size)
+        n_out = output_count(t_end - t0, output_dt, state_size, "t_end - t0" if t0 else "t_end")
         uniform = t0 + np.arange(n_out + 1) * output_dt
         return np.unique(np.append(uniform[uniform < t_end], t_end))
     try:
@@ -133,14 +133,14 @@ def output_times(t0, t_end, output_dt, times, state_size):
     return np.unique(np.concatenate([[t0], times, [t_end]]))
 
 
-def output_count(t_end, output_dt, state_size):
+def output_count(t_end, output_dt, state_size, name="t_end"):
     """Number of output intervals, refused before anything is allocated if the
     frames would be too many or their states too large."""
     frames = t_end / output_dt + 1.0
     limit = min(MAX_OUTPUT_FRAMES, MAX_STATE_BYTES // (8 * state_size))
     if frames > limit:
         raise ParameterError(
-            f"t_end = {t_end!r} s with output_dt = {output_dt!r} s asks for {frames:.3g} output "
+            f"{name} = {t_end!r} s with output_dt = {output_dt!r} s asks for {frames:.3g} output "
             f"frames; at most {limit} are allowed (states of {state_size} numbers each): raise "
-            f"`output_dt` to at least {t_end / (limit - 1):.3g} s or shorten `t_end`")
+            f"`output_dt` to at least {t_end / (limit - 1):.3g} s or shorten the run")
     return int(math.floor(t_end / output_dt + 1e-9))

@@ -42,6 +42,13 @@ class Outputs:
         if self.progress is not None:
             self.progress(self.t_out[k], self.t_out[-1])
 
+    def stopped(self, backend, watch, reason, error=None, **stats):
+        """The frames so far, for a run that ended early: the message says the
+        last frame's time, how far ``backend`` got (``watch.summary()``) and why."""
+        reached = self.t_out[self.next_index - 1]
+        return self.solution(False, f"{backend} stopped after t = {reached:.6g} s (last output frame; "
+                             f"{watch.summary()}): {reason}", error=error, **stats)
+
     def solution(self, success, message, error=None, **stats):
         stats["wall_time_s"] = time.perf_counter() - self.start
         n = self.next_index

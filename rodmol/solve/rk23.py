@@ -27,9 +27,7 @@ def rk23(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, ma
         return dict(steps=len(sizes), rhs_evals=evals[0], jac_evals=0, **step_size_stats(sizes))
 
     def stop(reason, error=None):
-        reached = out.t_out[out.next_index - 1]
-        return out.solution(False, f"RK23 stopped after t = {reached:.6g} s (last output frame; "
-                            f"{watch.summary()}): {reason}", error=error, **stats())
+        return out.stopped("RK23", watch, reason, error, **stats())
 
     try:
         solver = RK23(rhs, float(t_out[0]), np.array(y0, dtype=float), float(t_out[-1]),

@@ -400,6 +400,8 @@ def test_output_at_given_times_and_from_t0():
     np.testing.assert_allclose(late.t, [0.5, 0.75, 1.0])
     # started at the equilibrium under the tension at t0 = 0.5 s, not at 0
     np.testing.assert_allclose(late.tensions[0], model.tensions(0.5))
+    np.testing.assert_allclose(late.states[0], rodmol.equilibrium(model, 0.5), atol=1e-12)
+    assert np.max(np.abs(late.states[0] - rodmol.equilibrium(model, 0.0))) > 1e-3
     for bad, says in (({"output_times": [0.5, 0.2]}, "increasing"), ({"output_times": [2.0]}, "lie in"),
                       ({"t0": 1.5}, "after the start")):
         with pytest.raises(rodmol.ParameterError, match=says):

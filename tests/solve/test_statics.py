@@ -5,8 +5,12 @@ The reference is written here from scratch (it shares no code with rodmol):
 the planar static rod, clamped at the origin along +x, free at s = L, loaded by
 its weight minus buoyancy, with the same extensible and shearable linear law
 N = Kl (q - q*), M = Kth k, solved by ``scipy.integrate.solve_bvp``.
-rodmol's scheme is first order in ds (section IV-C of the paper), so its tip
-must approach the reference like C ds: the observed order must be close to 1.
+The paper's upwind scheme (section IV-C) is first order in ds, so its tip
+must approach the reference like C ds (observed order close to 1); the
+centred scheme's like C ds^2 (close to 2). ``solvers/continuum.py`` is a
+second, 3-D reference with cables that reads the model's own parameters
+(``tests/solve/test_continuum_reference.py``); this one restates the paper's
+numbers so that it shares nothing with rodmol.
 """
 
 import numpy as np
