@@ -1,6 +1,8 @@
 """The one entry point: :func:`simulate`."""
 
+import time
 import warnings
+from contextlib import contextmanager, nullcontext
 
 import numpy as np
 
@@ -12,7 +14,7 @@ from .discretise.system import SemiDiscrete, field_scales
 from .errors import ParameterError
 from .model import Model
 from .result import Result, from_states
-from .solve import options
+from .solve import kernels, options
 from .solve.backends import get_backend
 from .solve.equilibrium import equilibrium
 from .solve.watch import state_problem
@@ -73,9 +75,15 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
     t0 : float, optional
         Start time [s] (default 0, or the last time of an ``initial``
         Result). Time-dependent inputs are read at absolute time.
-    progress : callable, optional
+    progress : bool or callable, optional
+        True shows rodmol's progress display on standard error: the
+        preparation of the compiled kernels (first run of a process) and the
+        initial equilibrium, each with its duration, then a bar over the
+        simulated time whose ETA counts integration only. A callable
         ``progress(t, t_end)`` is called at each output time, and between
-        them every half second of wall time (``rodmol.solve.watch``).
+        them every half second of wall time (``rodmol.solve.watch``); if it
+        has a ``stage(text)`` context manager (as ``rodmol._progress.Progress``),
+        the stages are announced through it too.
     max_wall_time : float, optional
         Wall-time budget [s]: the run stops there with ``success=False``.
     **backend_options
@@ -104,6 +112,11 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
     scheme = get_scheme(scheme)
     rtol = options.rtol(scheme.default_rtol if rtol is None else rtol)
     progress = options.progress(progress)
+    owned = progress is True
+    if owned:
+        from ._progress import Progress
+
+        progress = Progress()
     max_wall_time = options.max_wall_time(max_wall_time)
     run = get_backend(backend)
     backend_options = options.backend_options(backend, run, backend_options)
@@ -115,19 +128,38 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
                              "'straight' or a state")
     if atol is not None:
         atol = _state_sized("atol", atol, size, positive=True, layout=StateLayout(model.n_elements))
-    system = SemiDiscrete(model, scheme)  # the one system of this run
-    y0 = _initial_state(system, initial, t0)
+    timings = {}
+    with _stage(progress, "preparing the compiled kernels", timings, "prepare_s", kernels.ready()):
+        system = SemiDiscrete(model, scheme)  # the one system of this run
+        kernels.prepare(system, t0, straight_state(model))
+    with _stage(progress, f"solving the initial equilibrium at t = {t0:g} s", timings, "equilibrium_s",
+                not (isinstance(initial, str) and initial == "equilibrium")):
+        y0 = _initial_state(system, initial, t0)
     if atol is None:
         atol = default_atol(model, rtol)
 
-    raw = run(system, y0, t_out, rtol=rtol, atol=atol, progress=progress,
-              max_wall_time=max_wall_time, **backend_options)
-    raw.stats["backend"] = backend
+    try:
+        raw = run(system, y0, t_out, rtol=rtol, atol=atol, progress=progress,
+                  max_wall_time=max_wall_time, **backend_options)
+    finally:
+        if owned:
+            progress.close()
+    raw.stats.update(timings, backend=backend)
     result = from_states(system, raw.t, raw.y, raw.success, raw.message, raw.stats)
     result.error = raw.error
     if not raw.success:
         warnings.warn(raw.message, RuntimeWarning, stacklevel=2)
     return result
+
+
+@contextmanager
+def _stage(progress, text, timings, key, silent=False):
+    """Time a stage into ``timings[key]`` [s], announced through ``progress.stage``."""
+    start = time.perf_counter()
+    announce = getattr(progress, "stage", None)
+    with nullcontext() if silent or announce is None else announce(text):
+        yield
+    timings[key] = time.perf_counter() - start
 
 
 def _last_state(result, model):

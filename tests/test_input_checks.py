@@ -46,7 +46,7 @@ def test_duplicate_cable_names():
     (dict(max_order=2.5), r"`max_order` must be an integer"),
     (dict(max_step=-1), r"`max_step` must be >= 0"),
     (dict(max_nonlin_iters=0), r"`max_nonlin_iters` must be >= 1"),
-    (dict(progress=5), r"`progress` must be a callable"),
+    (dict(progress=5), r"`progress` must be True, False, None or a callable"),
     (dict(max_wall_time=-1.0), r"`max_wall_time` must be > 0"),
     (dict(linsolvr="band"), r"unknown option `linsolvr` for backend 'cvode'; did you mean 'linsolver'\?"),
     (dict(linsolver="bnd"), r"unknown `linsolver` 'bnd'; did you mean 'band'\?"),

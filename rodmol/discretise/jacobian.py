@@ -80,6 +80,16 @@ def fill_matrix(jb, jh, jj):
                     jj[r0 + i, c0 + f] = jb[row, d, i, f]
 
 
+def read_only(a):
+    """A read-only view of ``a``: CVODE hands its vectors over read-only, and
+    typing every call alike keeps numba at one compilation per kernel."""
+    if not a.flags.writeable:
+        return a
+    view = a.view()
+    view.flags.writeable = False
+    return view
+
+
 def _header_groups(groups, header_pattern):
     """Attach each header column that anything reads to a block group."""
     columns = np.flatnonzero(np.any(header_pattern, axis=0))
@@ -142,7 +152,7 @@ class CompiledJacobian:
         # Jacobian is only an approximation and may use the last good inputs.
         with contextlib.suppress(Exception):
             self.system.update_inputs(t, y)
-        jacobian_blocks(y, fy, self._scale, self._groups, self._header, self._args, self._ybuf,
+        jacobian_blocks(read_only(y), read_only(fy), self._scale, self._groups, self._header, self._args, self._ybuf,
                         self._fbuf, self._jb, self._jh)
 
     def __call__(self, t, y, fy, jj):

@@ -26,6 +26,7 @@ plus a positive second-difference operator.
 
 import numpy as np
 
+from .jacobian import read_only
 from .layout import BLOCK, HEADER
 from .physics import jit
 
@@ -315,11 +316,11 @@ class BlockPreconditioner:
 
     def solve(self, t, y, fy, r, z, gamma, delta, lr):
         """scikit-sundae ``psolve``: z = (I - gamma_setup J)^-1 r."""
-        block_solve(self.gamma, self._head, self._fac, r, z, *self._scratch)
+        block_solve(self.gamma, self._head, self._fac, read_only(r), z, *self._scratch)
         self.solves += 1
 
     def apply(self, r):
         """(I - gamma J)^-1 r with the current factors (for tests)."""
         x = np.empty_like(r)
-        block_solve(self.gamma, self._head, self._fac, r, x, *self._scratch)
+        block_solve(self.gamma, self._head, self._fac, read_only(r), x, *self._scratch)
         return x

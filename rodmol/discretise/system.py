@@ -14,6 +14,7 @@ import numpy as np
 
 from . import centreline, external, rotations, stencil
 from .layout import StateLayout, merge
+from .physics import compile_signatures
 from .schemes import DEFAULT_SCHEME, get_scheme
 
 #: Rate [1/s] at which the quaternion norm is pulled back to 1; the exact
@@ -98,6 +99,7 @@ class SemiDiscrete:
     """
 
     def __init__(self, model, scheme=DEFAULT_SCHEME):
+        compile_signatures()  # the first system of a process waits for the compiler
         self.model = model
         self.scheme = get_scheme(scheme)
         self.layout = StateLayout(model.n_elements)

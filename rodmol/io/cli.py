@@ -20,9 +20,9 @@ import time
 import warnings
 from pathlib import Path
 
+from .._progress import Progress
 from ..errors import ParameterError
 from .lock import OutputLock
-from .progress import Progress
 
 EXIT_FAILED, EXIT_USAGE, EXIT_OUTPUT, EXIT_INTERRUPTED = 1, 2, 3, 130
 #: Exit code of a run stopped by each signal (128 + the signal's number, as a shell reports it).
@@ -134,13 +134,11 @@ def _run_locked(args, spec, out):
     model = spec.model
     say(f"rodmol: {spec.name}: N = {model.n_elements} elements, t_end = {spec.t_end:g} s, "
         f"{spec.solver['scheme']} scheme, backend {spec.solver['backend']} -> {out}")
-    if spec.solver["initial"] == "equilibrium":
-        say("rodmol: finding the initial equilibrium ...")
 
     interrupts = _Interrupts()
     previous = {signum: signal.signal(signum, interrupts) for signum in EXIT_SIGNAL}
     try:
-        progress = None if args.quiet else Progress(spec.t_end)
+        progress = None if args.quiet else Progress(stream=sys.stdout)
         started = time.perf_counter()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)  # the summary gives the message
@@ -243,8 +241,11 @@ def summary(spec, result, wall, written):
              f"{st.get('jac_evals', 0)} Jacobian evaluations"]
     solver_wall = st.get("wall_time_s", wall)
     factor = t_done / solver_wall if solver_wall > 0 else float("inf")
+    stages = "".join(f", {st[key]:.2f} s {what}" for key, what in
+                     (("prepare_s", "preparing kernels"), ("equilibrium_s", "equilibrium"))
+                     if st.get(key, 0.0) >= 0.005)
     lines.append(f"  wall time   {wall:.2f} s run ({solver_wall:.2f} s integrating, {factor:.3g} x real "
-                 f"time) + {written.get('seconds', 0.0):.2f} s writing")
+                 f"time{stages}) + {written.get('seconds', 0.0):.2f} s writing")
     if len(t):
         tip = result.tip[-1]
         lines.append(f"  tip         ({tip[0]:.4f}, {tip[1]:.4f}, {tip[2]:.4f}) m, global, "
@@ -288,7 +289,7 @@ def _render(args):
     from .pictures import render
 
     result = _result_in(args.directory)
-    for path in render(result, args.directory, size, args.frames):
+    for path in render(result, args.directory, size, args.frames, Progress(stream=sys.stdout)):
         print(f"rodmol: wrote {path}")
     return 0
 

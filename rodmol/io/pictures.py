@@ -3,11 +3,12 @@
 from pathlib import Path
 
 
-def render(result, directory, size=(960, 720), frames=60):
+def render(result, directory, size=(960, 720), frames=60, progress=None):
     """Render ``last_frame.png`` and (``frames`` > 0) ``animation.gif`` into ``directory``.
 
     Off-screen pyvista: the body as a tube of the true radius coloured by the
     bending curvature, the cables as lines (red when pulled), the markers as dots.
+    ``progress``: a ``rodmol._progress.Progress`` showing the frames drawn.
     """
     import numpy as np
     import pyvista as pv
@@ -53,7 +54,7 @@ def render(result, directory, size=(960, 720), frames=60):
         every = max(1, int(np.ceil(len(result.t) / frames)))
         indices = frame_indices(len(result.t), every)
         images = []
-        for k in indices:
+        for k in progress.frames(indices, len(indices), "rendering") if progress else indices:
             draw(k)
             plotter.render()
             images.append(Image.fromarray(plotter.screenshot(return_img=True)))

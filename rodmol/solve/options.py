@@ -101,8 +101,10 @@ def rtol(value):
 
 
 def progress(value):
-    if value is not None and not callable(value):
-        raise ParameterError(f"`progress` must be a callable progress(t, t_end) or None, "
+    if value is None or value is False:
+        return None
+    if value is not True and not callable(value):
+        raise ParameterError(f"`progress` must be True, False, None or a callable progress(t, t_end), "
                              f"got {_checks.short(value)}")
     return value
 

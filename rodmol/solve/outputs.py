@@ -30,6 +30,8 @@ class Outputs:
         self.ys = np.empty((len(t_out), len(y0)))
         self.ys[0] = y0
         self.next_index = 1
+        if progress is not None:  # the start, so a display measures from here
+            progress(t_out[0], t_out[-1])
 
     @property
     def done(self):

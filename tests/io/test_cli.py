@@ -102,7 +102,7 @@ def test_ctrl_c_keeps_a_valid_partial_run(tmp_path):
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         line = ""
-        while not line.startswith("t ="):  # the first progress line: output frames exist
+        while "integrating:" not in line or "  0%" in line:  # output frames exist
             line = process.stdout.readline()
             assert line or process.poll() is None, process.stderr.read()
         time.sleep(1.0)
@@ -127,6 +127,7 @@ def test_render_and_plot(tmp_path):
                       "--t-end", 0.1, "--quiet").returncode == 0
     render = rodmol_cli("render", out, "--frames", 3, "--size", "320x240")
     assert render.returncode == 0, render.stderr
+    assert "rendering: 100%" in render.stdout  # not silent while it draws
     plot = rodmol_cli("plot", out)
     assert plot.returncode == 0, plot.stderr
     for name in ("last_frame.png", "animation.gif", "tip_path.png", "markers.png", "tensions.png"):
@@ -157,12 +158,35 @@ def test_ctrl_c_while_writing_stops_between_frames(tmp_path, monkeypatch):
 def test_progress_plain_lines_when_not_a_terminal():
     import io
 
-    from rodmol.io.cli import Progress
+    from rodmol._progress import Progress
 
     stream = io.StringIO()
-    progress = Progress(1.0, stream)
-    for t in (0.01, 0.02, 0.05, 0.1, 0.15, 0.5, 1.0):
+    progress = Progress(stream=stream)
+    with progress.stage("preparing"):
+        pass
+    for t in (0.0, 0.01, 0.02, 0.05, 0.1, 0.15, 0.5, 1.0):
         progress(t, 1.0)
+    progress.close()
     lines = stream.getvalue().splitlines()
-    assert len(lines) == 4 and all(line.startswith("t =") and "ETA" in line for line in lines)
-    assert "\r" not in stream.getvalue()
+    assert lines[0] == "rodmol: preparing ..." and lines[1].startswith("rodmol: preparing: ")
+    bar = lines[2:]  # every tenth: 0, 10 % (0.1), 50 % (0.5: past 20-40 at once), 100 %
+    assert [line.split("%")[0].split()[-1] for line in bar] == ["0", "10", "50", "100"]
+    assert all("ETA" in line for line in bar) and "\r" not in stream.getvalue()
+
+
+def test_progress_eta_counts_integration_only(monkeypatch):
+    """A long stage before the first progress call does not enter the rate."""
+    import io
+
+    import rodmol._progress as display
+
+    clock = [100.0]
+    monkeypatch.setattr(display.time, "perf_counter", lambda: clock[0])
+    stream = io.StringIO()
+    progress = display.Progress(stream=stream)
+    with progress.stage("compiling"):
+        clock[0] += 50.0  # a long compilation
+    progress(0.0, 10.0)
+    clock[0] += 2.0
+    progress(1.0, 10.0)  # 10 % in 2 s: 18 s to go
+    assert stream.getvalue().splitlines()[-1].endswith("ETA 00:18")

@@ -36,7 +36,7 @@ def slow_run(out):
                "--backend", "rk23", "--n-elements", "60", "--out", str(out)]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     line = ""
-    while not line.startswith("t ="):  # the first progress line: the solver is running
+    while "integrating:" not in line:  # the first progress line: the solver is running
         line = process.stdout.readline()
         if not line and process.poll() is not None:
             raise AssertionError(process.stderr.read())
