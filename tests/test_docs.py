@@ -1,0 +1,80 @@
+"""Every shell and Python block of the README and of docs/ runs as written.
+
+Each page runs in a fresh directory holding a link to ``examples/``, block
+after block in the page's order, so a block may use what an earlier one
+wrote. Python blocks share one namespace per page (as in one session);
+shell blocks run line by line through bash with this environment's scripts
+first on the PATH. Three kinds of command are left out, because the suite
+itself stands for them: creating the virtual environment and installing
+rodmol (``python3 -m venv``, ``pip install``; ``.ci/run`` runs them as
+written on a fresh machine), the ``.venv/bin/`` prefix (this environment is
+that one), and running the test suite. A block after an HTML comment
+``<!-- file: NAME -->`` is a file the page asks the reader to save (e.g. a
+ParaView script): it is written under that name, not run. ``pvpython`` gets a
+virtual display when there is none (``xvfb-run``), and a page that needs it is
+skipped where ParaView is not installed.
+"""
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+FENCE = re.compile(r"(?:<!-- file: (?P<file>[\w.-]+) -->\s*\n)?^```(?P<lang>python|bash)\n(?P<code>.*?)^```$",
+                   re.M | re.S)
+SET_UP = re.compile(r"python3? -m venv|pip install|-m pytest")
+XVFB = ["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24"]
+
+
+def blocks(page):
+    """(kind, code, line) of each block: kind is "python", "bash" or "file:NAME"."""
+    text = page.read_text()
+    for match in FENCE.finditer(text):
+        kind = f"file:{match['file']}" if match["file"] else match["lang"]
+        yield kind, match["code"], text.count("\n", 0, match.start("code")) + 1
+
+
+def commands(code):
+    """The shell block's commands, continuation lines joined, set-up left out."""
+    for line in code.replace("\\\n", " ").splitlines():
+        line = line.split(" #")[0].strip()
+        if not line or line.startswith("#"):
+            continue
+        kept = [part.strip().removeprefix(".venv/bin/") for part in line.split("&&")
+                if not SET_UP.search(part)]
+        if kept:
+            yield " && ".join(kept)
+
+
+@pytest.mark.subprocess
+@pytest.mark.parametrize("page", [p for p in PAGES if any(blocks(p))], ids=lambda p: p.name)
+def test_page_runs_as_written(page, tmp_path, monkeypatch):
+    needs_paraview = any("pvpython" in code for kind, code, _ in blocks(page) if kind == "bash")
+    if needs_paraview and not shutil.which("pvpython"):
+        pytest.skip("ParaView (pvpython) is not installed")
+    (tmp_path / "examples").symlink_to(ROOT / "examples")
+    monkeypatch.chdir(tmp_path)
+    env = dict(os.environ, PATH=f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",
+               MPLBACKEND="Agg")
+    namespace = {"__name__": "__main__"}
+    for kind, code, line in blocks(page):
+        where = f"{page.relative_to(ROOT)}:{line}"
+        if kind.startswith("file:"):
+            (tmp_path / kind[5:]).write_text(code)
+        elif kind == "python":
+            exec(compile(code, where, "exec"), namespace)  # noqa: S102 (the page's own code)
+        else:
+            for command in commands(code):
+                argv = ["bash", "-c", command]
+                if command.startswith("pvpython") and not os.environ.get("DISPLAY"):
+                    argv = XVFB + argv
+                if command.startswith("xvfb-run") and not shutil.which("xvfb-run"):
+                    pytest.skip("xvfb-run is not installed")
+                done = subprocess.run(argv, env=env, capture_output=True, text=True, timeout=600)
+                assert done.returncode == 0, f"{where}: `{command}` failed:\n{done.stdout}\n{done.stderr}"
