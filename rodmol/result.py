@@ -140,20 +140,31 @@ def from_states(system, t, y, success, message, stats):
     quat_all = layout.quaternions(y)
     tensions = np.array([system.tensions(ti, yi) for ti, yi in zip(t, y)]).reshape(n_t, -1)
     arrays = dict(
-        t=t, s=model.s_nodes, radius=model.rod.radius_at(model.s_nodes), tensions=tensions,
-        node_length=np.concatenate([[0.0], system.node_lengths]),
+        t=t, tensions=tensions, **static_arrays(system),
         states=np.asarray(y),
         quaternion_norm_error=np.max(np.abs(np.linalg.norm(quat_all, axis=-1) - 1.0), axis=-1),
     )
     groups = {"mechanics": partial(_mechanics, system, t, y, tensions), "pose": partial(_pose, system, y)}
     deferred = {name: groups[group] for group, names in _GROUPS.items() for name in names}
-    meta = dict(n_elements=model.n_elements, length=model.rod.length, scheme=system.scheme.name,
+    return Result(arrays, success, message, stats, run_meta(system), deferred)
+
+
+def static_arrays(system):
+    """The arrays of a Result that do not change in time."""
+    model = system.model
+    return dict(s=model.s_nodes, radius=model.rod.radius_at(model.s_nodes),
+                node_length=np.concatenate([[0.0], system.node_lengths]))
+
+
+def run_meta(system):
+    """The ``meta`` of a Result of ``system``: sizes, scheme, cables, markers and loads."""
+    model = system.model
+    return dict(n_elements=model.n_elements, length=model.rod.length, scheme=system.scheme.name,
                 cables=[dict(name=c.name, offset=list(c.offset), anchor=c.anchor)
                         for c in model.cables],
                 markers=[dict(name=mk.name, s=mk.s, offset=list(model.marker_offsets[i, 1:]))
                          for i, mk in enumerate(model.markers)],
                 loads=[repr(load) for load in model.loads])
-    return Result(arrays, success, message, stats, meta, deferred)
 
 
 def _mechanics(system, t, y, tensions):

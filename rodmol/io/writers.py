@@ -102,21 +102,29 @@ def rod_mesh(result, k):
 
 
 def cable_paths(result, k):
-    """Each cable's points at frame ``k``: a list of (s [m] (n,), points [m] (n, 3), global).
+    """Each cable's points at frame ``k``: a list of (s [m] (n,), points [m] (n, 3), global)."""
+    frame = slice(k, k + 1)
+    return [(s, points[0]) for s, points in
+            cable_points(result.s, result.positions[frame], result.rotations[frame], result.meta)]
+
+
+def cable_points(s_nodes, positions, rotations, meta):
+    """Each cable's points at every frame given: a list of (s [m] (n,), points [m] (n_t, n, 3), global).
 
     The nodes with s below the anchor, then the anchor itself, with ``u + R p``
     interpolated linearly in s between the nodes around it.
     """
-    s_nodes, u, rotation = result.s, result.positions[k], result.rotations[k]
     paths = []
-    for cable in result.meta.get("cables", []):
+    for cable in meta.get("cables", []):
         p = np.array([0.0, *cable["offset"]])
         anchor = min(float(cable["anchor"]), float(s_nodes[-1]))
         on_path = s_nodes < anchor
         s = np.append(s_nodes[on_path], anchor)
-        points = u + rotation @ p
-        at_anchor = [np.interp(anchor, s_nodes, points[:, i]) for i in range(3)]
-        paths.append((s, np.vstack([points[on_path], at_anchor])))
+        points = positions + rotations @ p
+        j = min(int(np.searchsorted(s_nodes, anchor, side="right")) - 1, len(s_nodes) - 2)
+        w = (anchor - s_nodes[j]) / (s_nodes[j + 1] - s_nodes[j])
+        at_anchor = (1.0 - w) * points[:, j] + w * points[:, j + 1]
+        paths.append((s, np.concatenate([points[:, on_path], at_anchor[:, None]], axis=1)))
     return paths
 
 
