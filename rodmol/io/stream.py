@@ -98,7 +98,8 @@ class RunWriter:
         if self.last is not None and self.views:
             name, t, start = self.last
             frames = self._shown(start, len(t), last=True)
-            self._fragment(name, t, frames, len(t))
+            if frames != self._shown(start, len(t)):  # the run's last frame was not shown yet
+                self._fragment(name, t, frames, len(t))
         if self.previous is not None:  # a resumed run: the statistics of both parts
             stats = merge_stats([self.previous.get("stats", {}), stats])
         self._index(dict(success=bool(success), message=str(message), stats=dict(stats),
@@ -122,7 +123,7 @@ class RunWriter:
         if self.views:
             self._fragment(name, arrays["t"], self._shown(start, n), n)
             fragments = [c[:-3] + ".xmf" for c in self.chunks]
-            for view in self._view_names():
+            for view in self.view_names():
                 xdmf.write_view(self.directory / f"{view}.xdmf", view, fragments)
         self._index(dict(success=True, message="running", stats={}, complete=False))
 
@@ -155,7 +156,7 @@ class RunWriter:
         if not path.is_file():
             raise ParameterError(f"nothing to resume in {str(self.directory)!r}: no {INDEX}")
         index = h5result.read_index(path)
-        if index["info"].get("complete", True):
+        if index["info"].get("complete", True) and index["info"].get("success"):
             raise ParameterError(f"nothing to resume in {str(self.directory)!r}: the run there finished "
                                  f"({index['info']['message']})")
         self.chunks, self.t, self.t_out = dict(index["chunks"]), index["t"].tolist(), index["t_out"]
@@ -164,15 +165,11 @@ class RunWriter:
         self.previous = index["info"]
 
     def _clear(self):
-        """Remove the outputs of an earlier run here, so nothing stale is listed or read."""
-        for name in (INDEX, *(f"{v}.xdmf" for v in xdmf.VIEWS)):
-            (self.directory / name).unlink(missing_ok=True)
-        frames = self.directory / h5result.FRAMES
-        if frames.is_dir():
-            for file in frames.glob("chunk_*"):
-                file.unlink()
+        clear_outputs(self.directory)
+        (self.directory / "result.npz").unlink(missing_ok=True)
 
-    def _view_names(self):
+    def view_names(self):
+        """The views this run has: the rod, and the cables and markers if any."""
         names = ["rod"]
         if self.meta.get("cables"):
             names.append("cables")
@@ -236,3 +233,14 @@ class RunWriter:
         info["meta"] = self.meta or {}
         h5result.write_index(self.directory, self.static, self.t_out if self.t_out is not None else self.t,
                              self.t, self.chunks, info)
+
+
+def clear_outputs(directory):
+    """Remove the streamed outputs of an earlier run in ``directory``, so nothing stale is listed or read."""
+    directory = Path(directory)
+    for name in (INDEX, *(f"{v}.xdmf" for v in xdmf.VIEWS)):
+        (directory / name).unlink(missing_ok=True)
+    frames = directory / h5result.FRAMES
+    if frames.is_dir():
+        for file in frames.glob("chunk_*"):
+            file.unlink()

@@ -283,12 +283,27 @@ def frame_indices(n_frames, every=1):
     return sorted(set(range(0, n_frames, int(every))) | {n_frames - 1})
 
 
-def write_series(result, directory, every=1):
-    """Write a finished :class:`rodmol.Result` as ParaView series in ``directory``.
+def write_series(result, directory, every=1, format="xdmf"):
+    """Write a finished :class:`rodmol.Result` for ParaView into ``directory``.
 
-    Returns the path of ``rod.pvd``. ``every``: write every n-th output frame
-    (and the last).
+    ``format="xdmf"`` (default): ``result.h5`` and the XDMF views
+    (:class:`rodmol.io.stream.RunWriter`), returns the path of ``rod.xdmf``;
+    ``"vtp"``: ``result.npz`` and the ``.pvd``/``.vtp`` series, returns the
+    path of ``rod.pvd``. Either directory is read back by
+    :func:`rodmol.load_result`, ``rodmol render`` and ``rodmol plot``.
+    ``every``: show every n-th output frame (and the last).
     """
+    if format == "xdmf":
+        from .stream import RunWriter
+
+        return RunWriter(directory, every=every).write_result(result)
+    if format != "vtp":
+        raise ParameterError(f"unknown `format` {format!r}; use 'xdmf' or 'vtp'")
+    from .stream import clear_outputs
+
+    Path(directory).mkdir(parents=True, exist_ok=True)
+    clear_outputs(directory)  # load_result would read a stale result.h5 first
+    result.save(Path(directory) / "result.npz")
     with SeriesWriter.for_result(result, directory) as writer:
         for k in frame_indices(len(result.t), every):
             writer.write(result, k)

@@ -30,13 +30,21 @@ FOOTER = "</Domain>\n</Xdmf>\n"
 XI = ' xmlns:xi="http://www.w3.org/2001/XInclude"'
 
 
-def _item(h5, name, dims, k=None, full=None, rank_tail=None, integer=False):
+#: Placeholders of a grid's frame index and time in a grid template.
+K, T = "@K@", "@T@"
+
+
+def _frames(template, t, frames):
+    """The grid ``template`` (one text for all frames) at each chunk frame ``frames``."""
+    return [template.replace(K, str(k)).replace(T, repr(float(t[k]))) for k in frames]
+
+
+def _item(h5, name, dims, k=None, full=None, integer=False):
     """A DataItem of dataset ``name`` in ``h5``; with ``k``, the frame k of a time-first dataset."""
     kind = 'NumberType="Int" Precision="8"' if integer else 'NumberType="Float" Precision="8"'
     where = f"{h5}:/{name}"
     if k is not None:
-        tail = rank_tail if rank_tail is not None else dims
-        rank = len(full)
+        tail, rank = dims, len(full)
         start = " ".join([str(k)] + ["0"] * (rank - 1))
         stride = " ".join(["1"] * rank)
         count = " ".join(["1"] + [str(c) for c in tail])
@@ -52,45 +60,39 @@ def _attribute(name, item, vector=False, center="Node"):
 def rod_grids(h5, t, frames, n_nodes, n_frames):
     """Grids of the rod at chunk frames ``frames`` (indices into the chunk of ``n_frames`` frames)."""
     n, full3 = n_nodes, (n_frames, n_nodes, 3)
-    static = (f'<Topology TopologyType="Polyline" NodesPerElement="{n}" NumberOfElements="1">'
-              f'{_item(h5, "rod_cells", (1, n), integer=True)}</Topology>')
-    fixed = _attribute("s [m]", _item(h5, "s", (n,))) + _attribute("radius [m]", _item(h5, "radius", (n,)))
-    grids = []
-    for k in frames:
-        parts = [f'<Grid Name="rod" GridType="Uniform"><Time Value="{float(t[k])!r}"/>', static,
-                 f'<Geometry GeometryType="XYZ">{_item(h5, "positions", (n, 3), k, full3)}</Geometry>', fixed]
-        for label, (attribute, _) in ROD_ARRAYS.items():
-            parts.append(_attribute(label, _item(h5, attribute, (n, 3), k, full3), vector=True))
-        parts.append(_attribute("velocity (global) [m/s]",
-                                _item(h5, "velocity_global", (n, 3), k, full3), vector=True))
-        for i, axis in enumerate("xyz"):  # column i of the rotation: a one-wide hyperslab
-            item = (f'<DataItem Dimensions="{n} 3" NumberType="Float" Precision="8" Format="HDF">'
-                    f"{h5}:/rotations|{k} 0 0 {i}:1 1 1 1:1 {n} 3 1:{n_frames} {n} 3 3</DataItem>")
-            parts.append(_attribute(f"frame {axis} [-]", item, vector=True))
-        parts.append("</Grid>")
-        grids.append("".join(parts))
-    return grids
+    parts = [f'<Grid Name="rod" GridType="Uniform"><Time Value="{T}"/>',
+             f'<Topology TopologyType="Polyline" NodesPerElement="{n}" NumberOfElements="1">'
+             f'{_item(h5, "rod_cells", (1, n), integer=True)}</Topology>',
+             f'<Geometry GeometryType="XYZ">{_item(h5, "positions", (n, 3), K, full3)}</Geometry>',
+             _attribute("s [m]", _item(h5, "s", (n,))), _attribute("radius [m]", _item(h5, "radius", (n,)))]
+    for label, (attribute, _) in ROD_ARRAYS.items():
+        parts.append(_attribute(label, _item(h5, attribute, (n, 3), K, full3), vector=True))
+    parts.append(_attribute("velocity (global) [m/s]", _item(h5, "velocity_global", (n, 3), K, full3),
+                            vector=True))
+    for i, axis in enumerate("xyz"):  # column i of the rotation: a one-wide hyperslab
+        item = (f'<DataItem Dimensions="{n} 3" NumberType="Float" Precision="8" Format="HDF">'
+                f"{h5}:/rotations|{K} 0 0 {i}:1 1 1 1:1 {n} 3 1:{n_frames} {n} 3 3</DataItem>")
+        parts.append(_attribute(f"frame {axis} [-]", item, vector=True))
+    parts.append("</Grid>")
+    return _frames("".join(parts), t, frames)
 
 
 def cable_grids(h5, t, frames, n_points, n_segments, n_frames):
     """Grids of the cables (two-point segments) at chunk frames ``frames``."""
-    static = (f'<Topology TopologyType="Polyline" NodesPerElement="2" NumberOfElements="{n_segments}">'
-              f'{_item(h5, "cable_cells", (n_segments, 2), integer=True)}</Topology>'
-              + _attribute("s [m]", _item(h5, "cable_s", (n_points,)))
-              + _attribute("cable index [-]", _item(h5, "cable_index", (n_points,), integer=True))
-              + _attribute("cable index [-]", _item(h5, "cable_cell_index", (n_segments,), integer=True),
-                           center="Cell"))
-    grids = []
-    for k in frames:
-        grids.append(
-            f'<Grid Name="cables" GridType="Uniform"><Time Value="{float(t[k])!r}"/>{static}'
+    grid = (f'<Grid Name="cables" GridType="Uniform"><Time Value="{T}"/>'
+            f'<Topology TopologyType="Polyline" NodesPerElement="2" NumberOfElements="{n_segments}">'
+            f'{_item(h5, "cable_cells", (n_segments, 2), integer=True)}</Topology>'
             f'<Geometry GeometryType="XYZ">'
-            f'{_item(h5, "cable_points", (n_points, 3), k, (n_frames, n_points, 3))}</Geometry>'
-            + _attribute("tension [N]", _item(h5, "cable_point_tension", (n_points,), k, (n_frames, n_points)))
-            + _attribute("tension [N]", _item(h5, "cable_cell_tension", (n_segments,), k,
+            f'{_item(h5, "cable_points", (n_points, 3), K, (n_frames, n_points, 3))}</Geometry>'
+            + _attribute("s [m]", _item(h5, "cable_s", (n_points,)))
+            + _attribute("cable index [-]", _item(h5, "cable_index", (n_points,), integer=True))
+            + _attribute("cable index [-]", _item(h5, "cable_cell_index", (n_segments,), integer=True),
+                         center="Cell")
+            + _attribute("tension [N]", _item(h5, "cable_point_tension", (n_points,), K, (n_frames, n_points)))
+            + _attribute("tension [N]", _item(h5, "cable_cell_tension", (n_segments,), K,
                                               (n_frames, n_segments)), center="Cell")
             + "</Grid>")
-    return grids
+    return _frames(grid, t, frames)
 
 
 def marker_grids(h5, t, frames, n_markers, n_frames):
@@ -99,9 +101,9 @@ def marker_grids(h5, t, frames, n_markers, n_frames):
               f'{_item(h5, "marker_cells", (n_markers, 1), integer=True)}</Topology>'
               + _attribute("s [m]", _item(h5, "marker_s", (n_markers,)))
               + _attribute("marker index [-]", _item(h5, "marker_index", (n_markers,), integer=True)))
-    return [f'<Grid Name="markers" GridType="Uniform"><Time Value="{float(t[k])!r}"/>{static}<Geometry GeometryType="XYZ">'
-            f'{_item(h5, "markers", (n_markers, 3), k, (n_frames, n_markers, 3))}</Geometry></Grid>'
-            for k in frames]
+    grid = (f'<Grid Name="markers" GridType="Uniform"><Time Value="{T}"/>{static}<Geometry GeometryType="XYZ">'
+            f'{_item(h5, "markers", (n_markers, 3), K, (n_frames, n_markers, 3))}</Geometry></Grid>')
+    return _frames(grid, t, frames)
 
 
 def write_fragment(path, views):

@@ -41,6 +41,14 @@ def run_chunked(run, system, y0, t_out, sink, first=0, *, progress=None, max_wal
     report = None if progress is None else (lambda t, _segment_end: progress(t, t_end))
     started, parts, k, y = time.perf_counter(), [], int(first), np.asarray(y0, dtype=float)
     sink.begin(system, t_out)
+    try:
+        return _chunks(run, system, y, t_out, sink, k, size, report, started, parts, max_wall_time,
+                       options)
+    except KeyboardInterrupt:  # landed while a chunk was being stored: the chunks before it are kept
+        return False, "interrupted while storing the frames", merge_stats(parts), None
+
+
+def _chunks(run, system, y, t_out, sink, k, size, report, started, parts, max_wall_time, options):
     while k < len(t_out) - 1:
         stop = min((k // size + 1) * size, len(t_out) - 1)
         budget = None
