@@ -127,7 +127,7 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
     t_out = options.output_times(t0, t_end, output_dt, output_times, size)
     if plan is not None:
         if t_end != plan[-1]:
-            raise ParameterError(f"`t_end` = {t_end!r} s: the run being resumed ends at {plan[-1]!r} s")
+            raise ParameterError(f"`t_end` = {t_end!r} s: the run being resumed ends at {float(plan[-1])!r} s")
         t_out = plan
     if isinstance(initial, str) and initial not in INITIAL:
         raise ParameterError(f"unknown `initial` {_checks.short(initial)}"

@@ -94,6 +94,8 @@ def _run_options(parser):
                         help="wall-time budget [s]: stop the run there (the frames done are kept)")
     parser.add_argument("--format", choices=("xdmf", "vtp"), help="outputs: streamed result.h5 and XDMF "
                         "views (xdmf, default) or result.npz and a .pvd/.vtp series after the run (vtp)")
+    parser.add_argument("--chunk-frames", type=int, metavar="N", help="output frames per chunk file, "
+                        "the restart points of --resume (default: [output] chunk_frames, else 2000)")
     parser.add_argument("--resume", action="store_true", help="continue the unfinished run in the output "
                         "directory from its last complete chunk (xdmf format)")
     parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
@@ -163,6 +165,11 @@ def _run_locked(args, spec, out):
             say(f"rodmol: writing {len(result.t)} frames to {out} (Ctrl-C stops between frames) ...")
             written = _write_outputs(result, spec.output, out, interrupts)
             written["seconds"] = time.perf_counter() - started - wall
+    except OSError as exc:  # the streamed index could not be replaced: the previous one is valid
+        if writer is None:
+            raise
+        print(f"rodmol: {_cannot_write(out / 'result.h5', exc)}", file=sys.stderr)
+        return EXIT_OUTPUT
     except KeyboardInterrupt:
         print("\nrodmol: interrupted before the first frame; nothing written", file=sys.stderr)
         return EXIT_SIGNAL.get(interrupts.signal, EXIT_INTERRUPTED)
@@ -210,14 +217,18 @@ def _stream_writer(args, spec, out):
     from .stream import RunWriter
 
     options = spec.output
-    return RunWriter(out, views=options.vtk, every=options.every, chunk_frames=options.chunk_frames,
+    chunk_frames = options.chunk_frames if args.chunk_frames is None else args.chunk_frames
+    return RunWriter(out, views=options.vtk, every=options.every, chunk_frames=chunk_frames,
                      resume=args.resume, meta=dict(scenario=spec.source, name=spec.name))
 
 
 def _streamed(writer, result):
     views = [writer.directory / f"{v}.xdmf" for v in writer.view_names()] if writer.views else []
-    return dict(result=writer.directory / "result.h5", views=views, seconds=writer.seconds,
-                frames=len(result.t))
+    written = dict(result=writer.directory / "result.h5", views=views, seconds=writer.seconds,
+                   frames=len(result.t))
+    if isinstance(result.error, OSError):
+        written["error"] = _cannot_write(writer.directory / "frames", result.error)
+    return written
 
 
 def _write_outputs(result, options, out, interrupts):

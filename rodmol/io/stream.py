@@ -48,7 +48,8 @@ class RunWriter:
         solver also restarts at every chunk boundary (the restart points),
         so a resumed run repeats the uninterrupted one exactly.
     resume : bool
-        Continue the unfinished run in ``directory`` (see :meth:`resume_point`).
+        Continue the unfinished run in ``directory`` (see :meth:`resume_point`),
+        with its own ``chunk_frames`` and ``every``.
     meta : dict, optional
         Added to the Result's ``meta`` (e.g. the scenario's name).
     """
@@ -162,6 +163,9 @@ class RunWriter:
         self.chunks, self.t, self.t_out = dict(index["chunks"]), index["t"].tolist(), index["t_out"]
         self.static = {key: index[key] for key in STATIC}
         self.meta = dict(index["info"].get("meta") or {}, **self.extra_meta)
+        # The restart points of the run being resumed, whatever this writer was given.
+        self.chunk_frames = int(index["info"].get("chunk_frames", self.chunk_frames))
+        self.every = int(index["info"].get("every", self.every))
         self.previous = index["info"]
 
     def _clear(self):
@@ -230,7 +234,7 @@ class RunWriter:
     def _index(self, info):
         if self.previous is not None and not info.get("complete"):
             info["stats"] = self.previous.get("stats", {})
-        info["meta"] = self.meta or {}
+        info.update(meta=self.meta or {}, chunk_frames=self.chunk_frames, every=self.every)
         h5result.write_index(self.directory, self.static, self.t_out if self.t_out is not None else self.t,
                              self.t, self.chunks, info)
 

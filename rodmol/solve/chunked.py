@@ -51,8 +51,8 @@ def run_chunked(run, system, y0, t_out, sink, first=0, *, progress=None, max_wal
 def _chunks(run, system, y, t_out, sink, k, size, report, started, parts, max_wall_time, options):
     while k < len(t_out) - 1:
         stop = min((k // size + 1) * size, len(t_out) - 1)
-        budget = None
-        if max_wall_time is not None:
+        budget = max_wall_time
+        if max_wall_time is not None and parts:
             budget = max_wall_time - (time.perf_counter() - started)
             if budget <= 0:
                 return False, (f"stopped after t = {t_out[k]:.6g} s: the wall-time budget "
@@ -61,7 +61,11 @@ def _chunks(run, system, y, t_out, sink, k, size, report, started, parts, max_wa
         parts.append(raw.stats)
         keep = 0 if k == 0 else 1  # a chunk's first frame is the previous chunk's last
         if len(raw.t) > keep:
-            sink.frames(raw.t[keep:], raw.y[keep:])
+            try:
+                sink.frames(raw.t[keep:], raw.y[keep:])
+            except OSError as exc:  # a full disk: the chunks stored before stay valid
+                return False, f"cannot store the frames after t = {t_out[k]:.6g} s: {exc}", \
+                    merge_stats(parts), exc
         if not raw.success:
             return False, raw.message, merge_stats(parts), raw.error
         k, y = stop, raw.y[-1]
