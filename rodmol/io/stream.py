@@ -27,6 +27,9 @@ from .h5result import INDEX, SERIES, STATIC
 from ..solve.chunked import merge_stats
 from .writers import cable_points
 
+#: Number type of the arrays only the views use (the Result's own stay float64):
+#: single precision halves the largest of them, the cables' points.
+VIEW = np.float32
 #: Output frames per chunk by default: bounded memory (about 50 kB a frame at
 #: N = 100), fewer than 100 files for 600 s at 100 frames/s.
 CHUNK_FRAMES = 2000
@@ -209,16 +212,16 @@ class RunWriter:
         rotations = np.asarray(arrays["rotations"])
         extras = {"s": self.static["s"], "radius": self.static["radius"],
                   "rod_cells": np.arange(n_nodes, dtype=np.int64)[None],
-                  "velocity_global": np.einsum("tnij,tnj->tni", rotations, arrays["velocity"])}
+                  "velocity_global": np.einsum("tnij,tnj->tni", rotations, arrays["velocity"]).astype(VIEW)}
         paths = cable_points(self.static["s"], np.asarray(arrays["positions"]), rotations, self.meta)
         if paths:
             sizes = [len(s) for s, _ in paths]
             starts = np.concatenate([[0], np.cumsum(sizes)])
             cells = np.concatenate([np.stack([np.arange(a, b - 1), np.arange(a + 1, b)], axis=1)
                                     for a, b in zip(starts[:-1], starts[1:])])
-            tension = np.asarray(arrays["tensions"]).reshape(len(arrays["t"]), -1)
+            tension = np.asarray(arrays["tensions"], dtype=VIEW).reshape(len(arrays["t"]), -1)
             cell_cable = np.concatenate([np.full(n - 1, i) for i, n in enumerate(sizes)])
-            extras.update(cable_points=np.concatenate([p for _, p in paths], axis=1),
+            extras.update(cable_points=np.concatenate([p.astype(VIEW) for _, p in paths], axis=1),
                           cable_s=np.concatenate([s for s, _ in paths]),
                           cable_index=np.repeat(np.arange(len(paths)), sizes),
                           cable_cells=cells, cable_cell_index=cell_cable,

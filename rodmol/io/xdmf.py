@@ -39,9 +39,11 @@ def _frames(template, t, frames):
     return [template.replace(K, str(k)).replace(T, repr(float(t[k]))) for k in frames]
 
 
-def _item(h5, name, dims, k=None, full=None, integer=False):
-    """A DataItem of dataset ``name`` in ``h5``; with ``k``, the frame k of a time-first dataset."""
-    kind = 'NumberType="Int" Precision="8"' if integer else 'NumberType="Float" Precision="8"'
+def _item(h5, name, dims, k=None, full=None, integer=False, single=False):
+    """A DataItem of dataset ``name`` in ``h5``; with ``k``, the frame k of a time-first dataset
+    (``single``: float32, the views' own arrays, see :data:`rodmol.io.stream.VIEW`)."""
+    kind = 'NumberType="Int" Precision="8"' if integer else \
+        f'NumberType="Float" Precision="{4 if single else 8}"'
     where = f"{h5}:/{name}"
     if k is not None:
         tail, rank = dims, len(full)
@@ -67,7 +69,7 @@ def rod_grids(h5, t, frames, n_nodes, n_frames):
              _attribute("s [m]", _item(h5, "s", (n,))), _attribute("radius [m]", _item(h5, "radius", (n,)))]
     for label, (attribute, _) in ROD_ARRAYS.items():
         parts.append(_attribute(label, _item(h5, attribute, (n, 3), K, full3), vector=True))
-    parts.append(_attribute("velocity (global) [m/s]", _item(h5, "velocity_global", (n, 3), K, full3),
+    parts.append(_attribute("velocity (global) [m/s]", _item(h5, "velocity_global", (n, 3), K, full3, single=True),
                             vector=True))
     for i, axis in enumerate("xyz"):  # column i of the rotation: a one-wide hyperslab
         item = (f'<DataItem Dimensions="{n} 3" NumberType="Float" Precision="8" Format="HDF">'
@@ -83,14 +85,14 @@ def cable_grids(h5, t, frames, n_points, n_segments, n_frames):
             f'<Topology TopologyType="Polyline" NodesPerElement="2" NumberOfElements="{n_segments}">'
             f'{_item(h5, "cable_cells", (n_segments, 2), integer=True)}</Topology>'
             f'<Geometry GeometryType="XYZ">'
-            f'{_item(h5, "cable_points", (n_points, 3), K, (n_frames, n_points, 3))}</Geometry>'
+            f'{_item(h5, "cable_points", (n_points, 3), K, (n_frames, n_points, 3), single=True)}</Geometry>'
             + _attribute("s [m]", _item(h5, "cable_s", (n_points,)))
             + _attribute("cable index [-]", _item(h5, "cable_index", (n_points,), integer=True))
             + _attribute("cable index [-]", _item(h5, "cable_cell_index", (n_segments,), integer=True),
                          center="Cell")
-            + _attribute("tension [N]", _item(h5, "cable_point_tension", (n_points,), K, (n_frames, n_points)))
+            + _attribute("tension [N]", _item(h5, "cable_point_tension", (n_points,), K, (n_frames, n_points), single=True))
             + _attribute("tension [N]", _item(h5, "cable_cell_tension", (n_segments,), K,
-                                              (n_frames, n_segments)), center="Cell")
+                                              (n_frames, n_segments), single=True), center="Cell")
             + "</Grid>")
     return _frames(grid, t, frames)
 
