@@ -223,7 +223,8 @@ def _stream_writer(args, spec, out):
 
 
 def _streamed(writer, result):
-    views = [writer.directory / f"{v}.xdmf" for v in writer.view_names()] if writer.views else []
+    # Absolute: given a bare file name, ParaView 5.11 looks for the included files in the wrong place.
+    views = [(writer.directory / f"{v}.xdmf").resolve() for v in writer.view_names()] if writer.views else []
     written = dict(result=writer.directory / "result.h5", views=views, seconds=writer.seconds,
                    frames=len(result.t))
     if isinstance(result.error, OSError):

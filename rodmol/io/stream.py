@@ -118,7 +118,7 @@ class RunWriter:
         if self.static is None:
             self.static, self.meta = static, dict(meta, **self.extra_meta)
         index = len(self.chunks)
-        name = h5result.write_chunk(self.directory, index, arrays, self._extras(arrays))
+        name = h5result.write_chunk(self.directory, index, arrays, self._extras(arrays) if self.views else None)
         n = len(arrays["t"])
         start = len(self.t)
         self.chunks[name] = n
