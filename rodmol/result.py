@@ -2,6 +2,7 @@
 
 import json
 from functools import partial
+from pathlib import Path
 
 import numpy as np
 
@@ -110,7 +111,20 @@ class Result:
 
 
 def load_result(path):
-    """Read a :class:`Result` written by :meth:`Result.save`."""
+    """Read a :class:`Result`: a run directory (its ``result.h5``, else ``result.npz``), a
+    streamed run's ``result.h5`` or one of its views (``rod.xdmf``, ...; arrays read on first
+    access), or a ``.npz`` written by :meth:`Result.save`."""
+    path = Path(path)
+    if path.is_dir() or path.suffix == ".xdmf":
+        folder = path if path.is_dir() else path.parent
+        found = [folder / name for name in ("result.h5", "result.npz") if (folder / name).is_file()]
+        if not found:
+            raise FileNotFoundError(f"no result.h5 or result.npz in {str(folder)!r}")
+        path = found[0]
+    if path.suffix == ".h5":
+        from .io.h5result import read_result
+
+        return read_result(path)
     with np.load(path, allow_pickle=False) as data:
         info = json.loads(str(data["info"]))
         # Files written before a key existed load without it.
@@ -135,25 +149,36 @@ def from_states(system, t, y, success, message, stats):
     integration), by the same compiled kernel as the integration. Until then
     the result holds the system and the states, and pickles as them.
     """
-    model, layout = system.model, system.layout
+    layout = system.layout
     n_t = len(t)
     quat_all = layout.quaternions(y)
     tensions = np.array([system.tensions(ti, yi) for ti, yi in zip(t, y)]).reshape(n_t, -1)
     arrays = dict(
-        t=t, s=model.s_nodes, radius=model.rod.radius_at(model.s_nodes), tensions=tensions,
-        node_length=np.concatenate([[0.0], system.node_lengths]),
+        t=t, tensions=tensions, **static_arrays(system),
         states=np.asarray(y),
         quaternion_norm_error=np.max(np.abs(np.linalg.norm(quat_all, axis=-1) - 1.0), axis=-1),
     )
     groups = {"mechanics": partial(_mechanics, system, t, y, tensions), "pose": partial(_pose, system, y)}
     deferred = {name: groups[group] for group, names in _GROUPS.items() for name in names}
-    meta = dict(n_elements=model.n_elements, length=model.rod.length, scheme=system.scheme.name,
+    return Result(arrays, success, message, stats, run_meta(system), deferred)
+
+
+def static_arrays(system):
+    """The arrays of a Result that do not change in time."""
+    model = system.model
+    return dict(s=model.s_nodes, radius=model.rod.radius_at(model.s_nodes),
+                node_length=np.concatenate([[0.0], system.node_lengths]))
+
+
+def run_meta(system):
+    """The ``meta`` of a Result of ``system``: sizes, scheme, cables, markers and loads."""
+    model = system.model
+    return dict(n_elements=model.n_elements, length=model.rod.length, scheme=system.scheme.name,
                 cables=[dict(name=c.name, offset=list(c.offset), anchor=c.anchor)
                         for c in model.cables],
                 markers=[dict(name=mk.name, s=mk.s, offset=list(model.marker_offsets[i, 1:]))
                          for i, mk in enumerate(model.markers)],
                 loads=[repr(load) for load in model.loads])
-    return Result(arrays, success, message, stats, meta, deferred)
 
 
 def _mechanics(system, t, y, tensions):

@@ -41,7 +41,7 @@ def straight_state(model):
 
 def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, backend="cvode",
              rtol=None, atol=None, output_dt=0.01, output_times=None, t0=None, progress=None,
-             max_wall_time=None, **backend_options):
+             max_wall_time=None, out=None, resume=False, **backend_options):
     """Integrate the model from t = 0 to ``t_end``.
 
     Parameters
@@ -86,6 +86,18 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
         the stages are announced through it too.
     max_wall_time : float, optional
         Wall-time budget [s]: the run stops there with ``success=False``.
+    out : path or sink, optional
+        Stream the frames while the run goes into this directory
+        (:class:`rodmol.io.stream.RunWriter`: ``result.h5`` and ParaView's
+        ``rod.xdmf``, see ``docs/paraview.md``) or into a sink object with the
+        same protocol; memory then stays bounded by one chunk, the solver
+        restarts at every chunk boundary, and the Result returned reads its
+        arrays from the files.
+    resume : bool
+        With ``out``: continue the unfinished (killed) run in that directory
+        from its last complete chunk, on its planned output times; ``t_end``
+        must be the planned end; ``initial``, ``t0``, ``output_dt`` and
+        ``output_times`` are taken from the directory.
     **backend_options
         Passed to the backend (e.g. ``linsolver="sparse"`` for CVODE);
         unknown names and bad values are refused before any work.
@@ -101,6 +113,10 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
     """
     if not isinstance(model, Model):
         raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
+    sink, first, plan = _sink(out, resume), 0, None
+    if resume:
+        plan, first, initial = sink.resume_point()
+        t0, output_times = float(plan[first]), plan[first:]
     if isinstance(initial, Result):
         t0 = float(initial.t[-1]) if t0 is None else t0
         initial = _last_state(initial, model)
@@ -122,6 +138,10 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
     backend_options = options.backend_options(backend, run, backend_options)
     size = StateLayout(model.n_elements).size
     t_out = options.output_times(t0, t_end, output_dt, output_times, size)
+    if plan is not None:
+        if t_end != plan[-1]:
+            raise ParameterError(f"`t_end` = {t_end!r} s: the run being resumed ends at {float(plan[-1])!r} s")
+        t_out = plan
     if isinstance(initial, str) and initial not in INITIAL:
         raise ParameterError(f"unknown `initial` {_checks.short(initial)}"
                              f"{options.did_you_mean(initial, INITIAL)}; use 'equilibrium', "
@@ -139,6 +159,9 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
         atol = default_atol(model, rtol)
 
     try:
+        if sink is not None:
+            return _streamed(run, system, y0, t_out, sink, first, backend, timings, rtol=rtol, atol=atol,
+                             progress=progress, max_wall_time=max_wall_time, **backend_options)
         raw = run(system, y0, t_out, rtol=rtol, atol=atol, progress=progress,
                   max_wall_time=max_wall_time, **backend_options)
     finally:
@@ -160,6 +183,33 @@ def _stage(progress, text, timings, key, silent=False):
     with nullcontext() if silent or announce is None else announce(text):
         yield
     timings[key] = time.perf_counter() - start
+
+
+def _sink(out, resume):
+    if out is None:
+        if resume:
+            raise ParameterError("`resume=True` needs `out`, the directory of the run to resume")
+        return None
+    if all(hasattr(out, name) for name in ("begin", "frames", "end", "chunk_frames")):
+        if resume and not hasattr(out, "resume_point"):
+            raise ParameterError("`resume=True`: this sink cannot resume (no resume_point)")
+        return out
+    from .io.stream import RunWriter
+
+    return RunWriter(out, resume=resume)
+
+
+def _streamed(run, system, y0, t_out, sink, first, backend, timings, **options):
+    """The run in chunks into ``sink`` (rodmol.solve.chunked); the Result is the sink's."""
+    from .solve.chunked import run_chunked
+
+    success, message, stats, error = run_chunked(run, system, y0, t_out, sink, first, **options)
+    stats.update(timings, backend=backend)
+    result = sink.end(success, message, stats)
+    result.error = error
+    if not success:
+        warnings.warn(message, RuntimeWarning, stacklevel=3)
+    return result
 
 
 def _last_state(result, model):

@@ -1,9 +1,9 @@
 """The ``rodmol`` command line: run scenario files, render and plot results.
 
     rodmol run SCENARIO.toml [--out DIR] [--backend NAME] [--n-elements N] [--scheme NAME]
-               [--t-end T] [--quiet]
+               [--t-end T] [--format xdmf|vtp] [--resume] [--quiet]
     rodmol run --example fetching [--out DIR] ...
-    rodmol render DIR        # last_frame.png and animation.gif from DIR/result.npz
+    rodmol render DIR        # last_frame.png and animation.gif from DIR (result.h5 or result.npz)
     rodmol plot DIR          # tip_path.png, markers.png, tensions.png
     rodmol study | identify | sweep ...   # calibration (see rodmol.io.cli_calibrate)
 
@@ -55,7 +55,7 @@ def _parser():
     parser.add_argument("--version", action="version", version=f"rodmol {_version()}")
     commands = parser.add_subparsers(required=True, metavar="COMMAND")
 
-    run = commands.add_parser("run", help="run a scenario file and write result.npz and a ParaView series")
+    run = commands.add_parser("run", help="run a scenario file, streaming result.h5 and ParaView views")
     run.add_argument("scenario", nargs="?", help="TOML scenario file (see docs/scenario-reference.md)")
     run.add_argument("--example", choices=EXAMPLES, metavar="NAME", help="run one of the paper's tests instead of a file: "
                                                                   + ", ".join(EXAMPLES))
@@ -68,13 +68,13 @@ def _parser():
     example.set_defaults(command=_run, scenario=None)
 
     render = commands.add_parser("render", help="render the last frame (PNG) and an animation (GIF)")
-    render.add_argument("directory", type=Path, help="output directory of `rodmol run`")
+    render.add_argument("directory", type=Path, help="output directory of `rodmol run` (or its result file)")
     render.add_argument("--frames", type=int, default=60, help="animation frames (default 60; 0: none)")
     render.add_argument("--size", default="960x720", help="picture size in pixels, WxH (default 960x720)")
     render.set_defaults(command=_render)
 
     plot = commands.add_parser("plot", help="plot tip path, markers and tensions vs time (PNG)")
-    plot.add_argument("directory", type=Path, help="output directory of `rodmol run`")
+    plot.add_argument("directory", type=Path, help="output directory of `rodmol run` (or its result file)")
     plot.set_defaults(command=_plot)
 
     from .cli_calibrate import add_commands
@@ -92,6 +92,12 @@ def _run_options(parser):
     parser.add_argument("--t-end", type=float, metavar="T", help="end time [s]")
     parser.add_argument("--max-wall-time", type=float, metavar="S",
                         help="wall-time budget [s]: stop the run there (the frames done are kept)")
+    parser.add_argument("--format", choices=("xdmf", "vtp"), help="outputs: streamed result.h5 and XDMF "
+                        "views (xdmf, default) or result.npz and a .pvd/.vtp series after the run (vtp)")
+    parser.add_argument("--chunk-frames", type=int, metavar="N", help="output frames per chunk file, "
+                        "the restart points of --resume (default: [output] chunk_frames, else 2000)")
+    parser.add_argument("--resume", action="store_true", help="continue the unfinished run in the output "
+                        "directory from its last complete chunk (xdmf format)")
     parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
 
 
@@ -132,6 +138,7 @@ def _run(args):
 def _run_locked(args, spec, out):
     say = (lambda *a, **k: None) if args.quiet else print
     model = spec.model
+    writer = _stream_writer(args, spec, out)
     say(f"rodmol: {spec.name}: N = {model.n_elements} elements, t_end = {spec.t_end:g} s, "
         f"{spec.solver['scheme']} scheme, backend {spec.solver['backend']} -> {out}")
 
@@ -142,15 +149,25 @@ def _run_locked(args, spec, out):
         started = time.perf_counter()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)  # the summary gives the message
-            result = spec.simulate(progress=progress)
+            result = spec.simulate(progress=progress, **({} if writer is None else
+                                                         dict(out=writer, resume=args.resume)))
         wall = time.perf_counter() - started
         if progress:
             progress.close()
         interrupts.raising = False  # from here, Ctrl-C stops writing between frames
-        result.meta.update(scenario=spec.source, name=spec.name)
-        say(f"rodmol: writing {len(result.t)} frames to {out} (Ctrl-C stops between frames) ...")
-        written = _write_outputs(result, spec.output, out, interrupts)
-        written["seconds"] = time.perf_counter() - started - wall
+        if writer is not None:  # written while the run went
+            wall -= writer.seconds
+            written = _streamed(writer, result)
+        else:
+            result.meta.update(scenario=spec.source, name=spec.name)
+            say(f"rodmol: writing {len(result.t)} frames to {out} (Ctrl-C stops between frames) ...")
+            written = _write_outputs(result, spec.output, out, interrupts)
+            written["seconds"] = time.perf_counter() - started - wall
+    except OSError as exc:  # the streamed index could not be replaced: the previous one is valid
+        if writer is None:
+            raise
+        print(f"rodmol: {_cannot_write(out / 'result.h5', exc)}", file=sys.stderr)
+        return EXIT_OUTPUT
     except KeyboardInterrupt:
         print("\nrodmol: interrupted before the first frame; nothing written", file=sys.stderr)
         return EXIT_SIGNAL.get(interrupts.signal, EXIT_INTERRUPTED)
@@ -185,6 +202,34 @@ class _Interrupts:
             raise KeyboardInterrupt
 
 
+def _stream_writer(args, spec, out):
+    """The sink of a streamed run (format xdmf, or --format xdmf), else None."""
+    fmt = args.format or spec.output.format
+    if fmt != "xdmf":
+        if args.resume:
+            raise ParameterError("`--resume` needs the streamed output (--format xdmf)")
+        from .stream import clear_outputs
+
+        clear_outputs(out)  # a result.h5 of an earlier run would be read instead of result.npz
+        return None
+    from .stream import RunWriter
+
+    options = spec.output
+    chunk_frames = options.chunk_frames if args.chunk_frames is None else args.chunk_frames
+    return RunWriter(out, views=options.vtk, every=options.every, chunk_frames=chunk_frames,
+                     resume=args.resume, meta=dict(scenario=spec.source, name=spec.name))
+
+
+def _streamed(writer, result):
+    # Absolute: given a bare file name, ParaView 5.11 looks for the included files in the wrong place.
+    views = [(writer.directory / f"{v}.xdmf").resolve() for v in writer.view_names()] if writer.views else []
+    written = dict(result=writer.directory / "result.h5", views=views, seconds=writer.seconds,
+                   frames=len(result.t))
+    if isinstance(result.error, OSError):
+        written["error"] = _cannot_write(writer.directory / "frames", result.error)
+    return written
+
+
 def _write_outputs(result, options, out, interrupts):
     """Write result.npz, then the VTK frames; stop between frames on a new Ctrl-C.
 
@@ -200,7 +245,7 @@ def _write_outputs(result, options, out, interrupts):
     if options.npz:
         try:
             result.save(out / "result.npz")
-            written["npz"] = out / "result.npz"
+            written["result"] = out / "result.npz"
         except OSError as exc:  # the series may still fit (a directory in its place)
             written["error"] = _cannot_write(out / "result.npz", exc)
     if options.vtk:
@@ -250,15 +295,20 @@ def summary(spec, result, wall, written):
         tip = result.tip[-1]
         lines.append(f"  tip         ({tip[0]:.4f}, {tip[1]:.4f}, {tip[2]:.4f}) m, global, "
                      f"at t = {t_done:g} s")
-    if "npz" in written:
-        lines.append(f"  result      {written['npz']}")
+    if "result" in written:
+        lines.append(f"  result      {written['result']}")
+    if written.get("views"):
+        others = ", ".join(v.name for v in written["views"][1:])
+        lines.append(f"  ParaView    {written['views'][0]}" + (f" (+ {others})" if others else "")
+                     + f", {written['frames']} frame" + ("" if written["frames"] == 1 else "s")
+                     + " (open it by its absolute path)")
     if "pvd" in written:
         others = ", ".join(f"{p}.pvd" for p in written["parts"][1:])
         partial = "" if written["frames"] == written["all_frames"] else f" of {written['all_frames']}"
         lines.append(f"  ParaView    {written['pvd']}" + (f" (+ {others})" if others else "")
                      + f", {written['frames']}{partial} frame" + ("" if written["all_frames"] == 1 else "s"))
-    if "npz" in written:
-        folder = written["npz"].parent
+    if "result" in written:
+        folder = written["result"].parent
         lines.append(f"  next        rodmol render {folder}   |   rodmol plot {folder}")
     return "\n".join(lines)
 
@@ -266,11 +316,18 @@ def summary(spec, result, wall, written):
 # --------------------------------------------------------------------------- render, plot
 
 def _result_in(directory):
+    """The result in a run directory (result.h5, else result.npz), or in the file given."""
     from ..result import load_result
 
-    path = Path(directory) / "result.npz"
-    if not path.is_file():
-        raise ParameterError(f"no result.npz in {str(directory)!r}; run `rodmol run ... --out DIR` first")
+    path = Path(directory)
+    if path.is_dir():
+        found = [path / name for name in ("result.h5", "result.npz") if (path / name).is_file()]
+        if not found:
+            raise ParameterError(f"no result.h5 or result.npz in {str(directory)!r}; run "
+                                 "`rodmol run ... --out DIR` first")
+        path = found[0]
+    elif not path.is_file():
+        raise ParameterError(f"no such run directory or result file: {str(directory)!r}")
     try:
         return load_result(path)
     except (OSError, KeyError, ValueError) as exc:

@@ -21,7 +21,8 @@ from . import scenario_readers as read
 from .scenario_loads import loads as load_tables
 from .scenario_problems import FAILED, failed
 from .scenario_schema import ARMS, DISCRETIZATION, INITIAL, OUTPUT, SOLVER, TOP
-from .scenario_spec import OutputOptions, RunSpec
+from .scenario_spec import FORMATS, OutputOptions, RunSpec
+from .stream import CHUNK_FRAMES
 
 
 def build(data, ctx, default_name):
@@ -143,9 +144,11 @@ def _output(data, ctx):
     path = ("output",)
     table = ctx.table(data.get("output", {}), path, OUTPUT)
     directory = ctx.read(table, path, "directory", read.path)
-    values = dict(vtk=ctx.read(table, path, "vtk", read.boolean, True),
+    values = dict(format=ctx.read(table, path, "format", read.choice(FORMATS), "xdmf"),
+                  vtk=ctx.read(table, path, "vtk", read.boolean, True),
                   npz=ctx.read(table, path, "npz", read.boolean, True),
-                  every=ctx.read(table, path, "every", read.integer(1), 1))
+                  every=ctx.read(table, path, "every", read.integer(1), 1),
+                  chunk_frames=ctx.read(table, path, "chunk_frames", read.integer(1), CHUNK_FRAMES))
     if failed(directory, *values.values()):
         return None
     if directory is not None:

@@ -102,21 +102,30 @@ def rod_mesh(result, k):
 
 
 def cable_paths(result, k):
-    """Each cable's points at frame ``k``: a list of (s [m] (n,), points [m] (n, 3), global).
+    """Each cable's points at frame ``k``: a list of (s [m] (n,), points [m] (n, 3), global)."""
+    frame = slice(k, k + 1)
+    return [(s, points[0]) for s, points in
+            cable_points(result.s, result.positions[frame], result.rotations[frame], result.meta)]
+
+
+def cable_points(s_nodes, positions, rotations, meta):
+    """Each cable's points at every frame given: a list of (s [m] (n,), points [m] (n_t, n, 3), global).
 
     The nodes with s below the anchor, then the anchor itself, with ``u + R p``
     interpolated linearly in s between the nodes around it.
     """
-    s_nodes, u, rotation = result.s, result.positions[k], result.rotations[k]
     paths = []
-    for cable in result.meta.get("cables", []):
-        p = np.array([0.0, *cable["offset"]])
+    for cable in meta.get("cables", []):
+        offset = [float(x) for x in cable["offset"]]  # local y, z of the cable; local x is 0
         anchor = min(float(cable["anchor"]), float(s_nodes[-1]))
-        on_path = s_nodes < anchor
-        s = np.append(s_nodes[on_path], anchor)
-        points = u + rotation @ p
-        at_anchor = [np.interp(anchor, s_nodes, points[:, i]) for i in range(3)]
-        paths.append((s, np.vstack([points[on_path], at_anchor])))
+        on_path = int(np.count_nonzero(s_nodes < anchor))  # the nodes below the anchor come first
+        s = np.append(s_nodes[:on_path], anchor)
+        j = min(int(np.searchsorted(s_nodes, anchor, side="right")) - 1, len(s_nodes) - 2)
+        used = slice(0, max(on_path, j + 2))
+        points = positions[:, used] + offset[0] * rotations[:, used, :, 1] + offset[1] * rotations[:, used, :, 2]
+        w = (anchor - s_nodes[j]) / (s_nodes[j + 1] - s_nodes[j])
+        at_anchor = (1.0 - w) * points[:, j] + w * points[:, j + 1]
+        paths.append((s, np.concatenate([points[:, :on_path], at_anchor[:, None]], axis=1)))
     return paths
 
 
@@ -275,12 +284,27 @@ def frame_indices(n_frames, every=1):
     return sorted(set(range(0, n_frames, int(every))) | {n_frames - 1})
 
 
-def write_series(result, directory, every=1):
-    """Write a finished :class:`rodmol.Result` as ParaView series in ``directory``.
+def write_series(result, directory, every=1, format="xdmf"):
+    """Write a finished :class:`rodmol.Result` for ParaView into ``directory``.
 
-    Returns the path of ``rod.pvd``. ``every``: write every n-th output frame
-    (and the last).
+    ``format="xdmf"`` (default): ``result.h5`` and the XDMF views
+    (:class:`rodmol.io.stream.RunWriter`), returns the path of ``rod.xdmf``;
+    ``"vtp"``: ``result.npz`` and the ``.pvd``/``.vtp`` series, returns the
+    path of ``rod.pvd``. Either directory is read back by
+    :func:`rodmol.load_result`, ``rodmol render`` and ``rodmol plot``.
+    ``every``: show every n-th output frame (and the last).
     """
+    if format == "xdmf":
+        from .stream import RunWriter
+
+        return RunWriter(directory, every=every).write_result(result)
+    if format != "vtp":
+        raise ParameterError(f"unknown `format` {format!r}; use 'xdmf' or 'vtp'")
+    from .stream import clear_outputs
+
+    Path(directory).mkdir(parents=True, exist_ok=True)
+    clear_outputs(directory)  # load_result would read a stale result.h5 first
+    result.save(Path(directory) / "result.npz")
     with SeriesWriter.for_result(result, directory) as writer:
         for k in frame_indices(len(result.t), every):
             writer.write(result, k)

@@ -8,6 +8,7 @@ import time
 from pathlib import Path
 
 import pytest
+from views import assert_valid_views
 
 import rodmol
 from rodmol.io.writers import read_pvd
@@ -52,10 +53,10 @@ def test_run_each_example_coarse(scenario, tmp_path):
     out = tmp_path / "out"
     run = rodmol_cli("run", scenario, "--out", out, "--n-elements", 8, "--t-end", 0.3)
     assert run.returncode == 0, run.stderr
-    result = rodmol.load_result(out / "result.npz")
+    result = rodmol.load_result(out)
     assert result.success and result.t[-1] == pytest.approx(0.3) and len(result.s) == 9
-    assert assert_valid_series(out) == pytest.approx(list(result.t))
-    assert str(out / "rod.pvd") in run.stdout and "Jacobian evaluations" in run.stdout
+    assert assert_valid_views(out) == pytest.approx(list(result.t))
+    assert str(out / "rod.xdmf") in run.stdout and "Jacobian evaluations" in run.stdout
     assert "x real time" in run.stdout and "tip" in run.stdout
 
 
@@ -65,7 +66,22 @@ def test_builtin_example_quiet(tmp_path):
     run = rodmol_cli("example", "fetching", "--out", out, "--n-elements", 6, "--t-end", 0.05, "--quiet")
     assert run.returncode == 0, run.stderr
     assert run.stdout == ""
-    assert rodmol.load_result(out / "result.npz").meta["name"] == "fetching"
+    assert rodmol.load_result(out / "result.h5").meta["name"] == "fetching"
+
+
+@pytest.mark.subprocess
+def test_vtp_format_writes_the_series_and_result_npz(tmp_path):
+    out = tmp_path / "vtp"
+    streamed = rodmol_cli("run", EXAMPLES / "bending.toml", "--out", out, "--n-elements", 6, "--t-end", 0.05,
+                          "--quiet")
+    assert streamed.returncode == 0 and (out / "result.h5").is_file()
+    run = rodmol_cli("run", EXAMPLES / "bending.toml", "--out", out, "--n-elements", 6, "--t-end", 0.05,
+                     "--format", "vtp")
+    assert run.returncode == 0, run.stderr
+    assert not (out / "result.h5").exists()  # the streamed run's files are not left to be read instead
+    result = rodmol.load_result(out)
+    assert assert_valid_series(out) == pytest.approx(list(result.t))
+    assert str(out / "rod.pvd") in run.stdout and str(out / "result.npz") in run.stdout
 
 
 @pytest.mark.subprocess
@@ -113,10 +129,10 @@ def test_ctrl_c_keeps_a_valid_partial_run(tmp_path):
             process.kill()
     assert process.returncode == 130, stderr
     assert "STOPPED" in stdout and "interrupted" in stdout
-    result = rodmol.load_result(out / "result.npz")
+    result = rodmol.load_result(out)
     assert not result.success and "interrupted" in result.message
     assert 2 <= len(result.t) < 801
-    assert assert_valid_series(out) == pytest.approx(list(result.t))
+    assert assert_valid_views(out) == pytest.approx(list(result.t))
 
 
 @pytest.mark.subprocess

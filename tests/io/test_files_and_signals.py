@@ -15,6 +15,7 @@ import threading
 import numpy as np
 import pytest
 from test_cli import EXAMPLES, assert_valid_series
+from views import assert_valid_views
 
 import rodmol
 from rodmol.io import cli, writers
@@ -61,10 +62,10 @@ def test_sigterm_keeps_a_valid_partial_run_and_a_second_run_is_refused(tmp_path)
             process.kill()
     assert process.returncode == 143, stderr
     assert "STOPPED" in stdout and "interrupted" in stdout
-    result = rodmol.load_result(out / "result.npz")
+    result = rodmol.load_result(out)
     assert not result.success and "interrupted" in result.message
     assert 2 <= len(result.t) < 801
-    assert assert_valid_series(out) == pytest.approx(list(result.t))
+    assert assert_valid_views(out) == pytest.approx(list(result.t))
     assert not (out / LOCK_NAME).exists()
 
 
@@ -72,7 +73,7 @@ def test_lock_held_by_a_live_process_is_refused(tmp_path, capsys):
     (tmp_path / LOCK_NAME).write_text(json.dumps({"host": socket.gethostname(), "pid": os.getppid()}))
     code, err = run_cli(capsys, "--out", tmp_path)
     assert code == 2 and f"pid {os.getppid()}" in err and "choose another --out" in err
-    assert not (tmp_path / "result.npz").exists()
+    assert not (tmp_path / "result.npz").exists() and not (tmp_path / "result.h5").exists()
 
 
 def test_stale_lock_of_a_dead_process_is_taken_over(tmp_path, capsys):
@@ -81,7 +82,7 @@ def test_stale_lock_of_a_dead_process_is_taken_over(tmp_path, capsys):
     (tmp_path / LOCK_NAME).write_text(json.dumps({"host": socket.gethostname(), "pid": dead.pid}))
     code, err = run_cli(capsys, "--out", tmp_path)
     assert code == 0, err
-    assert rodmol.load_result(tmp_path / "result.npz").success
+    assert rodmol.load_result(tmp_path).success
     assert not (tmp_path / LOCK_NAME).exists()
 
 
@@ -95,7 +96,7 @@ def test_lock_is_exclusive_and_released(tmp_path):
 
 def test_result_npz_being_a_directory(tmp_path, capsys):
     (tmp_path / "result.npz").mkdir()
-    code, err = run_cli(capsys, "--out", tmp_path)
+    code, err = run_cli(capsys, "--out", tmp_path, "--format", "vtp")
     assert code == cli.EXIT_OUTPUT
     assert "cannot write" in err and "result.npz" in err
     assert assert_valid_series(tmp_path) == pytest.approx([0.0, 0.02, 0.04, 0.05])  # written all the same
@@ -103,7 +104,7 @@ def test_result_npz_being_a_directory(tmp_path, capsys):
 
 def test_vtk_being_a_file(tmp_path, capsys):
     (tmp_path / "vtk").write_text("not a directory")
-    code, err = run_cli(capsys, "--out", tmp_path)
+    code, err = run_cli(capsys, "--out", tmp_path, "--format", "vtp")
     assert code == cli.EXIT_OUTPUT and "cannot write" in err
     assert rodmol.load_result(tmp_path / "result.npz").success
 
@@ -123,11 +124,36 @@ def test_full_disk_while_writing_frames(tmp_path, capsys, monkeypatch):
         original(mesh, path)
 
     monkeypatch.setattr(writers, "save_vtp", save_vtp)
-    code, err = run_cli(capsys, "--out", tmp_path)
+    code, err = run_cli(capsys, "--out", tmp_path, "--format", "vtp")
     assert code == cli.EXIT_OUTPUT
     assert "No space left on device" in err and "outputs written before it are valid" in err
     assert assert_valid_series(tmp_path) == pytest.approx([0.0, 0.02])
     assert rodmol.load_result(tmp_path / "result.npz").success
+
+
+def test_full_disk_while_streaming_keeps_the_chunks_before(tmp_path, capsys, monkeypatch):
+    from rodmol.io import h5result
+
+    original, calls = h5result.write_chunk, []
+
+    def write_chunk(*args, **kwargs):
+        calls.append(args)
+        if len(calls) > 1:
+            _full_disk()
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(h5result, "write_chunk", write_chunk)
+    text = (EXAMPLES / "uniform_arm_air.toml").read_text()
+    (tmp_path / "s.toml").write_text(text.replace("[output]", "[output]\nchunk_frames = 2", 1))
+    (tmp_path / "tension_ramp.csv").write_text((EXAMPLES / "tension_ramp.csv").read_text())
+    code = cli.main(["run", str(tmp_path / "s.toml"), "--n-elements", "6", "--t-end", "0.05", "--quiet",
+                     "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert code == cli.EXIT_OUTPUT and "Traceback" not in err
+    assert "No space left on device" in err and "outputs written before it are valid" in err
+    result = rodmol.load_result(tmp_path / "out")
+    assert list(result.t) == pytest.approx([0.0, 0.02, 0.04]) and not result.success
+    assert assert_valid_views(tmp_path / "out") == pytest.approx([0.0, 0.02, 0.04])
 
 
 def test_full_disk_while_saving_keeps_the_previous_result(tmp_path, monkeypatch):
@@ -187,5 +213,5 @@ def test_unwritable_output_directory(tmp_path, capsys):
 def test_max_wall_time_option(tmp_path, capsys):
     code, err = run_cli(capsys, "--out", tmp_path, "--max-wall-time", "1e-9")
     assert code == cli.EXIT_FAILED and "wall-time budget" in err
-    result = rodmol.load_result(tmp_path / "result.npz")
+    result = rodmol.load_result(tmp_path)
     assert not result.success and "max_wall_time = 1e-09 s" in result.message

@@ -1,4 +1,6 @@
-"""ParaView itself opens the series and draws the tapered body (pvpython under xvfb-run).
+"""ParaView itself opens the outputs and draws the tapered body (pvpython under xvfb-run):
+the streamed XDMF views (moving geometry across chunk files, all arrays) and the
+.pvd/.vtp series.
 
 Skipped when ``pvpython`` or ``xvfb-run`` is missing (Debian: ``apt-get install
 paraview xvfb xauth``). ParaView 5.11 needs an X display to render; its
@@ -52,7 +54,7 @@ SCRIPT = textwrap.dedent("""
 def test_paraview_loads_the_series_and_renders_the_tube(tmp_path):
     model = rodmol.scenarios.get("bending").model(12)
     result = rodmol.simulate(model, 0.1, output_dt=0.05)
-    write_series(result, tmp_path)
+    write_series(result, tmp_path, format="vtp")
     script, png = tmp_path / "render.py", tmp_path / "frame.png"
     script.write_text(SCRIPT)
     run = subprocess.run([XVFB, "-a", "-s", "-screen 0 1280x1024x24", PVPYTHON, str(script),
@@ -71,4 +73,80 @@ def test_paraview_loads_the_series_and_renders_the_tube(tmp_path):
     pixels = np.asarray(Image.open(png).convert("RGB"), dtype=float)
     background = pixels[0, 0]
     drawn = np.any(np.abs(pixels - background) > 30, axis=-1).mean()
+    assert 0.01 < drawn < 0.9, f"fraction of pixels drawn: {drawn}"
+
+
+XDMF_SCRIPT = textwrap.dedent("""
+    import json, sys
+    import numpy as np
+    from paraview import servermanager
+    from paraview.simple import (CreateView, ExtractSurface, Render, SaveScreenshot, Show, Tube,
+                                 Xdmf3ReaderS)
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    directory, png = sys.argv[1], sys.argv[2]
+    report = {}
+    for name in ("rod", "cables", "markers"):
+        reader = Xdmf3ReaderS(FileName=[directory + "/" + name + ".xdmf"])
+        times = list(reader.TimestepValues)
+        frames = []
+        for t in (times[0], times[-1]):
+            reader.UpdatePipeline(t)
+            data = servermanager.Fetch(reader)
+            frames.append(vtk_to_numpy(data.GetPoints().GetData()).tolist())
+        tension = data.GetCellData().GetArray("tension [N]")
+        report[name] = dict(times=times, first=frames[0], last=frames[-1], cells=data.GetNumberOfCells(),
+                            arrays=list(reader.PointData.keys()), cell_arrays=list(reader.CellData.keys()),
+                            tension=vtk_to_numpy(tension).tolist() if tension else None)
+        if name == "rod":
+            rod = reader
+    tube = Tube(Input=ExtractSurface(Input=rod))
+    tube.Scalars = ["POINTS", "radius [m]"]
+    tube.VaryRadius = "By Absolute Scalar"
+    tube.NumberofSides = 24
+    view = CreateView("RenderView")
+    view.ViewSize = [640, 400]
+    view.ViewTime = report["rod"]["times"][-1]
+    display = Show(tube, view)
+    display.ColorArrayName = ["POINTS", ""]
+    view.ResetCamera()
+    Render(view)
+    SaveScreenshot(png, view, ImageResolution=[640, 400])
+    report["tube_points"] = tube.GetDataInformation().GetNumberOfPoints()
+    print(json.dumps(report))
+""")
+
+
+def test_paraview_opens_the_streamed_views_with_moving_geometry(tmp_path):
+    from rodmol.io.stream import RunWriter
+
+    model = rodmol.scenarios.get("fetching").model(12)
+    out = tmp_path / "run"  # chunks of 4 frames: the views include several fragment files
+    result = rodmol.simulate(model, 0.5, output_dt=0.05, out=RunWriter(out, chunk_frames=4))
+    script, png = tmp_path / "open.py", tmp_path / "frame.png"
+    script.write_text(XDMF_SCRIPT)
+    run = subprocess.run([XVFB, "-a", "-s", "-screen 0 1280x1024x24", PVPYTHON, str(script),
+                          str(out.resolve()), str(png)], capture_output=True, text=True, timeout=180)
+    assert run.returncode == 0, run.stderr[-2000:]
+    report = json.loads(run.stdout.strip().splitlines()[-1])
+    rod, cables, markers = report["rod"], report["cables"], report["markers"]
+    for view in (rod, cables, markers):
+        np.testing.assert_allclose(view["times"], result.t)
+    # The geometry moves, and is the result's at the first and the last time.
+    np.testing.assert_allclose(rod["first"], result.positions[0], atol=1e-12)
+    np.testing.assert_allclose(rod["last"], result.positions[-1], atol=1e-12)
+    assert np.abs(result.positions[-1] - result.positions[0]).max() > 0.01
+    np.testing.assert_allclose(markers["last"], result.markers[-1], atol=1e-12)
+    assert rod["cells"] == 1 and set(rod["arrays"]) >= {
+        "radius [m]", "s [m]", "curvature [1/m]", "internal force [N]", "external force [N/m]",
+        "velocity (global) [m/s]", "frame x [-]"}
+    assert {"tension [N]", "s [m]", "cable index [-]"} <= set(cables["arrays"])
+    # Each cable's segments carry its tension at the last time.
+    n_cables = result.tensions.shape[1]
+    assert set(np.round(cables["tension"], 12)) == set(np.round(result.tensions[-1], 12)) and n_cables > 1
+    assert report["tube_points"] >= 13 * 24
+
+    from PIL import Image
+
+    pixels = np.asarray(Image.open(png).convert("RGB"), dtype=float)
+    drawn = np.any(np.abs(pixels - pixels[0, 0]) > 30, axis=-1).mean()
     assert 0.01 < drawn < 0.9, f"fraction of pixels drawn: {drawn}"

@@ -20,7 +20,7 @@ def result():
 
 
 def test_series_round_trip(result, tmp_path):
-    pvd = write_series(result, tmp_path)
+    pvd = write_series(result, tmp_path, format="vtp")
     assert pvd == tmp_path / "rod.pvd"
     root = ET.parse(pvd).getroot()
     assert root.get("type") == "Collection"
@@ -38,7 +38,7 @@ def test_series_round_trip(result, tmp_path):
 
 
 def test_every_array_name_carries_its_unit(result, tmp_path):
-    write_series(result, tmp_path)
+    write_series(result, tmp_path, format="vtp")
     for part in ("rod", "cables", "markers"):
         mesh = pv.read(read_pvd(tmp_path / f"{part}.pvd")[-1][1])
         names = [n for n in (*mesh.point_data.keys(), *mesh.cell_data.keys()) if n != "vtkOriginalIds"]
@@ -54,7 +54,7 @@ def test_every_array_name_carries_its_unit(result, tmp_path):
 
 
 def test_cables_end_at_their_anchor_at_u_plus_R_p(result, tmp_path):
-    write_series(result, tmp_path)
+    write_series(result, tmp_path, format="vtp")
     k = len(result.t) - 1
     cables = pv.read(read_pvd(tmp_path / "cables.pvd")[k][1])
     assert cables.n_cells == len(result.meta["cables"]) == 12
@@ -74,7 +74,7 @@ def test_cables_end_at_their_anchor_at_u_plus_R_p(result, tmp_path):
 
 def test_every_nth_frame_and_the_last(result, tmp_path):
     assert frame_indices(6, 2) == [0, 2, 4, 5] and frame_indices(0, 3) == []
-    write_series(result, tmp_path, every=4)
+    write_series(result, tmp_path, every=4, format="vtp")
     times = [t for t, _ in read_pvd(tmp_path / "rod.pvd")]
     np.testing.assert_array_equal(times, result.t[frame_indices(len(result.t), 4)])
 
@@ -92,7 +92,7 @@ def test_incremental_writer_lists_only_complete_frames(result, tmp_path):
 
 
 def test_tube_of_radius_is_the_tapered_body(result, tmp_path):
-    write_series(result, tmp_path, every=10)
+    write_series(result, tmp_path, every=10, format="vtp")
     rod = pv.read(read_pvd(tmp_path / "rod.pvd")[0][1])
     tube = rod.tube(scalars="radius [m]", absolute=True, n_sides=24)
     base = tube.points[np.abs(tube.points[:, 0]) < 1e-9]
@@ -110,7 +110,7 @@ def loaded():
 
 
 def test_external_loads_are_written_as_in_the_result(loaded, tmp_path):
-    write_series(loaded, tmp_path)
+    write_series(loaded, tmp_path, format="vtp")
     entries = read_pvd(tmp_path / "rod.pvd")
     assert len(entries) == len(loaded.t) == 5
     for k, (_, path) in enumerate(entries):

@@ -1,0 +1,156 @@
+"""The streamed result file: an HDF5 index (``result.h5``) and chunk files.
+
+A run directory holds
+
+* ``result.h5``: the index, small, replaced atomically after every chunk:
+  the static arrays (``s``, ``radius``, ``node_length``), the planned output
+  times ``t_out`` (so a resumed run keeps the same grid), the times reached
+  ``t``, the chunk files in order and, as JSON in the attribute ``info``,
+  ``success``, ``message``, ``stats``, ``meta`` and ``complete`` (False while
+  the run goes or after it was killed);
+* ``frames/chunk_NNNNNN.h5``: the frames of one chunk: every time-series
+  array of :data:`rodmol.result.ARRAYS` (``states`` included, so each chunk's
+  last frame is a restart point) and the extra arrays the ParaView views
+  reference (:mod:`rodmol.io.xdmf`). Each is written under a temporary name
+  and renamed when complete, and never changed after.
+
+HDF5 files are not crash-safe while open for writing; here no file is ever
+open for writing under its real name, so a killed run leaves an index that
+lists only complete chunks. :func:`read_result` reads the arrays lazily (on
+first access) and concatenates the chunks.
+"""
+
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from ..result import ARRAYS, Result
+
+INDEX = "result.h5"
+FRAMES = "frames"
+FORMAT = "rodmol-result"
+#: Arrays of a Result that do not change in time (stored in the index).
+STATIC = ("s", "radius", "node_length")
+#: The time-series arrays of a Result (stored in the chunks).
+SERIES = tuple(name for name in ARRAYS if name not in STATIC)
+#: HDF5 format versions readable by the HDF5 1.10 of ParaView 5.11 (Debian).
+LIBVER = ("earliest", "v110")
+
+
+def atomic_h5(path, fill):
+    """Write an HDF5 file with ``fill(h5py.File)`` under a temporary name, then rename it to ``path``."""
+    import h5py
+
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
+    os.close(fd)
+    try:
+        with h5py.File(tmp, "w", libver=LIBVER) as handle:
+            fill(handle)
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def chunk_name(index):
+    return f"{FRAMES}/chunk_{index:06d}.h5"
+
+
+def write_chunk(directory, index, arrays, extras=None):
+    """Write chunk ``index``: ``arrays`` (name -> time-first array) and ``extras``; returns its relative name."""
+    name = chunk_name(index)
+    (Path(directory) / FRAMES).mkdir(parents=True, exist_ok=True)
+
+    def fill(handle):
+        for key, value in {**arrays, **(extras or {})}.items():
+            handle.create_dataset(key, data=np.asarray(value))
+
+    atomic_h5(Path(directory) / name, fill)
+    return name
+
+
+def write_index(directory, static, t_out, t, chunks, info):
+    """Replace ``result.h5``: static arrays, planned and reached times, chunk list, ``info`` (JSON)."""
+    import h5py
+
+    def fill(handle):
+        handle.attrs["format"] = FORMAT
+        handle.attrs["info"] = json.dumps(dict(info, units=ARRAYS))
+        for key in STATIC:
+            handle.create_dataset(key, data=np.asarray(static[key]))
+        handle.create_dataset("t_out", data=np.asarray(t_out, dtype=float))
+        handle.create_dataset("t", data=np.asarray(t, dtype=float))
+        handle.create_dataset("chunks", data=[c.encode() for c in chunks], dtype=h5py.string_dtype())
+        handle.create_dataset("chunk_frames", data=np.asarray(list(chunks.values()), dtype=np.int64))
+
+    atomic_h5(Path(directory) / INDEX, fill)
+
+
+def read_index(path):
+    """The index at ``path``: dict with the static arrays, ``t_out``, ``t``, ``chunks`` (name -> frames), ``info``."""
+    import h5py
+
+    with h5py.File(path, "r") as handle:
+        if handle.attrs.get("format") != FORMAT:
+            raise ValueError(f"{str(path)!r} is not a rodmol result index")
+        index = {key: handle[key][()] for key in (*STATIC, "t_out", "t")}
+        names = [c.decode() if isinstance(c, bytes) else str(c) for c in handle["chunks"][()]]
+        index["chunks"] = dict(zip(names, handle["chunk_frames"][()].tolist()))
+        index["info"] = json.loads(handle.attrs["info"])
+    return index
+
+
+def read_series(directory, chunks, name):
+    """Array ``name`` of all ``chunks`` of a run directory, concatenated in time."""
+    import h5py
+
+    parts = []
+    for chunk in chunks:
+        with h5py.File(Path(directory) / chunk, "r") as handle:
+            parts.append(handle[name][()])
+    return np.concatenate(parts) if parts else np.zeros((0,))
+
+
+def last_state(directory, chunks):
+    """(time [s], state) of the last frame of the last chunk: the restart point."""
+    import h5py
+
+    with h5py.File(Path(directory) / list(chunks)[-1], "r") as handle:
+        return float(handle["t"][-1]), handle["states"][-1]
+
+
+def read_result(path):
+    """A :class:`rodmol.Result` from an index file; the time series load on first access."""
+    path = Path(path)
+    index = read_index(path)
+    info, chunks, folder = index["info"], list(index["chunks"]), path.parent
+    arrays = {key: index[key] for key in STATIC}
+    arrays["t"] = index["t"]
+
+    def loader(name):
+        if not chunks:  # nothing was written: empty arrays of the right rank
+            return lambda: {name: np.zeros((0,) + _empty_shape(name, len(arrays["s"]), info))}
+        return lambda: {name: read_series(folder, chunks, name)}
+
+    deferred = {name: loader(name) for name in SERIES if name != "t"}
+    message = info["message"]
+    if not info.get("complete", True):
+        message = (f"the run was stopped before it finished (killed?): {len(arrays['t'])} frames up to "
+                   f"t = {arrays['t'][-1] if len(arrays['t']) else 0.0:.6g} s were kept; resume it with "
+                   "`rodmol run ... --resume` or simulate(..., out=DIR, resume=True)")
+    result = Result(arrays, info["success"] and info.get("complete", True), message, info["stats"],
+                    info.get("meta"), deferred)
+    return result
+
+
+def _empty_shape(name, n_nodes, info):
+    meta = info.get("meta") or {}
+    shapes = {"tensions": (len(meta.get("cables", [])),), "quaternion_norm_error": (),
+              "markers": (len(meta.get("markers", [])), 3), "rotations": (n_nodes, 3, 3),
+              "states": (0,)}
+    return shapes.get(name, (n_nodes, 3))

@@ -1,0 +1,72 @@
+"""Integration in chunks of output frames, handed to a frame sink as they are done.
+
+The backend is restarted at every chunk boundary (frame indices that are
+multiples of ``sink.chunk_frames``, counted from the first planned output),
+so the boundaries are restart points: a run resumed from the last frame of a
+chunk integrates exactly what the uninterrupted run did. Memory is bounded by
+one chunk's states. Any sink with ``chunk_frames``, ``begin(system, t_out)``,
+``frames(t, y)`` and ``end(success, message, stats)`` works
+(:class:`rodmol.io.stream.RunWriter` is the one rodmol ships).
+"""
+
+import time
+
+import numpy as np
+
+#: Statistics that add up over chunks (the others: smallest, largest, median of medians, last).
+_SUMMED = ("steps", "rhs_evals", "jac_evals", "prec_setups", "prec_solves", "wall_time_s")
+
+
+def merge_stats(parts):
+    """One run's statistics from those of its chunks."""
+    parts = [p for p in parts if p]
+    merged = dict(parts[-1]) if parts else {}
+    for key in _SUMMED:
+        if any(key in p for p in parts):
+            merged[key] = sum(p.get(key, 0) for p in parts)
+    for key, pick in (("h_min", min), ("h_max", max), ("h_median", np.median)):
+        values = [p[key] for p in parts if key in p and p.get("steps", 1)]
+        if values:
+            merged[key] = float(pick(values))
+    return merged
+
+
+def run_chunked(run, system, y0, t_out, sink, first=0, *, progress=None, max_wall_time=None, **options):
+    """Integrate from ``t_out[first]`` (state ``y0``) to ``t_out[-1]`` chunk by chunk.
+
+    Returns (success, message, stats, error) of the whole run; the frames
+    went to ``sink.frames`` (the first frame too, unless resuming).
+    """
+    size, t_end = int(sink.chunk_frames), float(t_out[-1])
+    report = None if progress is None else (lambda t, _segment_end: progress(t, t_end))
+    started, parts, k, y = time.perf_counter(), [], int(first), np.asarray(y0, dtype=float)
+    sink.begin(system, t_out)
+    try:
+        return _chunks(run, system, y, t_out, sink, k, size, report, started, parts, max_wall_time,
+                       options)
+    except KeyboardInterrupt:  # landed while a chunk was being stored: the chunks before it are kept
+        return False, "interrupted while storing the frames", merge_stats(parts), None
+
+
+def _chunks(run, system, y, t_out, sink, k, size, report, started, parts, max_wall_time, options):
+    while k < len(t_out) - 1:
+        stop = min((k // size + 1) * size, len(t_out) - 1)
+        budget = max_wall_time
+        if max_wall_time is not None and parts:
+            budget = max_wall_time - (time.perf_counter() - started)
+            if budget <= 0:
+                return False, (f"stopped after t = {t_out[k]:.6g} s: the wall-time budget "
+                               f"max_wall_time = {max_wall_time:g} s is used up"), merge_stats(parts), None
+        raw = run(system, y, t_out[k:stop + 1], progress=report, max_wall_time=budget, **options)
+        parts.append(raw.stats)
+        keep = 0 if k == 0 else 1  # a chunk's first frame is the previous chunk's last
+        if len(raw.t) > keep:
+            try:
+                sink.frames(raw.t[keep:], raw.y[keep:])
+            except OSError as exc:  # a full disk: the chunks stored before stay valid
+                return False, f"cannot store the frames after t = {t_out[k]:.6g} s: {exc}", \
+                    merge_stats(parts), exc
+        if not raw.success:
+            return False, raw.message, merge_stats(parts), raw.error
+        k, y = stop, raw.y[-1]
+    return True, "The solver reached the end time.", merge_stats(parts), None

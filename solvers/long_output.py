@@ -1,0 +1,94 @@
+"""Output cost of long runs: the README's fetching run and a 600 s run, streamed.
+
+Each case runs ``examples/fetching.toml`` (N = 100, default settings, output
+every 10 ms) in a fresh subprocess as ``rodmol run`` does (the scenario's
+``simulate`` with a :class:`rodmol.io.stream.RunWriter`), after a short
+warm-up run there (numba's cache). It reports the solver's own wall time
+(``stats["wall_time_s"]``), the writer's (deriving the Result's arrays of each
+chunk and writing the chunk files, views and index), the peak resident memory
+of the subprocess and the files and bytes left. ``--format vtp`` cases (the
+old path: the whole Result in memory, then result.npz and one .vtp per frame
+and part) are timed for the README run only.
+
+    python solvers/long_output.py [--quick | --smoke] [--out DIR]
+"""
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import textwrap
+
+import _common as C
+
+SCRIPT = "long_output.py"
+FETCHING = os.path.join(os.path.dirname(C.HERE), "examples", "fetching.toml")
+
+CHILD = textwrap.dedent("""
+    import json, resource, sys, time
+    sys.path.insert(0, sys.argv[1])
+    import rodmol
+    from rodmol.io.scenario_file import Override, load_scenario
+    from rodmol.io.stream import RunWriter
+    scenario, t_end, out, fmt = sys.argv[2], float(sys.argv[3]), sys.argv[4], sys.argv[5]
+    overrides = {"solver.t_end": Override(t_end, "--t-end")}
+    if sys.argv[6] != "0":
+        overrides["discretization.n_elements"] = Override(int(sys.argv[6]), "--n-elements")
+    spec = load_scenario(scenario, overrides=overrides)
+    rodmol.simulate(spec.model, 0.02)  # compile or load the kernels: not part of the run
+    started = time.perf_counter()
+    if fmt == "xdmf":
+        writer = RunWriter(out)
+        result = spec.simulate(out=writer)
+        writing = writer.seconds
+    else:
+        from rodmol.io.writers import write_series
+        result = spec.simulate()
+        begun = time.perf_counter()
+        write_series(result, out, format="vtp")
+        writing = time.perf_counter() - begun
+    total = time.perf_counter() - started
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # kB -> MB (Linux)
+    print(json.dumps(dict(frames=len(result.t), success=result.success, solver_s=result.stats["wall_time_s"],
+                          writing_s=writing, total_s=total, peak_rss_mb=peak)))
+""")
+
+
+def run_case(t_end, fmt, n_elements=0):
+    with tempfile.TemporaryDirectory(prefix="rodmol_long_") as tmp:
+        out = os.path.join(tmp, "out")
+        proc = subprocess.run([sys.executable, "-c", CHILD, os.path.dirname(C.HERE), FETCHING, str(t_end), out,
+                               fmt, str(n_elements)], capture_output=True, text=True, timeout=7200)
+        if proc.returncode != 0:
+            raise RuntimeError(proc.stderr[-3000:])
+        row = json.loads(proc.stdout.strip().splitlines()[-1])
+        files = [os.path.join(d, f) for d, _, names in os.walk(out) for f in names]
+        row.update(files=len(files), megabytes=sum(os.path.getsize(f) for f in files) / 1e6)
+    return row
+
+
+def main(argv=None):
+    args = C.parse_args(__doc__.splitlines()[0], argv)
+    header = C.header_lines(args, SCRIPT)
+    n = C.pick(args, 0, 0, 10)  # 0: the file's N = 100
+    cases = C.pick(args, [(8.0, "vtp"), (8.0, "xdmf"), (600.0, "xdmf")],
+                   [(8.0, "vtp"), (8.0, "xdmf"), (60.0, "xdmf")],
+                   [(0.5, "vtp"), (0.5, "xdmf"), (2.0, "xdmf")])
+    rows = []
+    for t_end, fmt in cases:
+        row = dict(t_end_s=t_end, format=fmt, N=n or 100, **run_case(t_end, fmt, n))
+        row["writing_over_solver"] = row["writing_s"] / row["solver_s"]
+        rows.append(row)
+        print(f"t_end = {t_end:g} s, {fmt}: solver {row['solver_s']:.2f} s, writing {row['writing_s']:.2f} s "
+              f"({row['writing_over_solver']:.2f}x), peak {row['peak_rss_mb']:.0f} MB, {row['files']} files, "
+              f"{row['megabytes']:.0f} MB", flush=True)
+    base = os.path.join(args.out, "long_output")
+    C.write_csv(base + ".csv", rows, header)
+    C.write_markdown(base + ".md", "Long runs and output (examples/fetching.toml)", header,
+                     [("Solver and writing wall time, peak memory, files", C.markdown_table(rows))])
+    print(f"wrote {base}.{{csv,md}}")
+
+
+if __name__ == "__main__":
+    main()

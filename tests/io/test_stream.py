@@ -1,0 +1,140 @@
+"""Streamed output: the result file and views written while the run goes, read
+back as the in-memory run; restart points; a run killed (SIGKILL) and resumed
+ends in the same state as the uninterrupted one."""
+
+import signal
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+from views import assert_valid_views
+
+import rodmol
+from rodmol.io import h5result
+from rodmol.io.stream import RunWriter
+
+SERIES = ("t", "states", "positions", "rotations", "tensions", "markers", "curvature", "external_force",
+          "integrated_positions", "quaternion_norm_error")
+
+
+@pytest.fixture(scope="module")
+def model():
+    return rodmol.scenarios.get("fetching").model(10)
+
+
+def assert_same(a, b, names=SERIES):
+    for name in names:
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name), err_msg=name)
+
+
+def test_one_chunk_is_the_in_memory_run_and_reads_back_from_any_path(model, tmp_path):
+    memory = rodmol.simulate(model, 0.3)
+    streamed = rodmol.simulate(model, 0.3, out=tmp_path)
+    assert streamed.success and streamed.stats["steps"] == memory.stats["steps"]
+    assert_same(streamed, memory)
+    for path in (tmp_path, tmp_path / "result.h5", tmp_path / "rod.xdmf"):
+        assert_same(rodmol.load_result(path), memory)
+    assert assert_valid_views(tmp_path) == pytest.approx(memory.t)
+    np.testing.assert_array_equal(rodmol.energy(model, streamed)["kinetic"], rodmol.energy(model, memory)["kinetic"])
+
+
+def test_chunks_restart_the_solver_within_its_tolerance(model, tmp_path):
+    memory = rodmol.simulate(model, 0.6)
+    chunked = rodmol.simulate(model, 0.6, out=RunWriter(tmp_path, chunk_frames=7))
+    assert len(list((tmp_path / "frames").glob("chunk_*.h5"))) == 9  # 61 frames: 8 of 7 + the first
+    np.testing.assert_array_equal(chunked.t, memory.t)
+    # A restart forgets the step history, not the state: the tip moves by the solver's error only.
+    assert np.abs(chunked.tip - memory.tip).max() < 1e-4 * model.rod.length * 10
+    assert assert_valid_views(tmp_path) == pytest.approx(memory.t)
+
+
+def test_write_series_leaves_a_directory_load_result_reads(model, tmp_path):
+    memory = rodmol.simulate(model, 0.2)
+    view = rodmol.write_series(memory, tmp_path / "x", every=3)
+    assert view == tmp_path / "x" / "rod.xdmf"
+    assert_same(rodmol.load_result(tmp_path / "x"), memory)
+    shown = assert_valid_views(tmp_path / "x")
+    assert shown == pytest.approx(list(memory.t[::3]) + [memory.t[-1]])  # every 3rd and the last
+    pvd = rodmol.write_series(memory, tmp_path / "y", format="vtp")
+    assert pvd.name == "rod.pvd"
+    np.testing.assert_allclose(rodmol.load_result(tmp_path / "y").positions, memory.positions)
+
+
+class Killed(BaseException):
+    """Stands for a SIGKILL between two chunks."""
+
+
+class DiesAfter(RunWriter):
+    def __init__(self, directory, chunks, **options):
+        super().__init__(directory, **options)
+        self.left = chunks
+
+    def frames(self, t, y):
+        if self.left == 0:
+            raise Killed
+        self.left -= 1
+        super().frames(t, y)
+
+
+def test_resume_after_a_kill_repeats_the_uninterrupted_run(model, tmp_path):
+    whole = rodmol.simulate(model, 0.5, out=RunWriter(tmp_path / "whole", chunk_frames=8))
+    with pytest.raises(Killed):
+        rodmol.simulate(model, 0.5, out=DiesAfter(tmp_path / "cut", 3, chunk_frames=8))
+    cut = rodmol.load_result(tmp_path / "cut")
+    assert not cut.success and "resume" in cut.message and len(cut.t) == 25
+    assert assert_valid_views(tmp_path / "cut") == pytest.approx(cut.t)
+    resumed = rodmol.simulate(model, 0.5, out=tmp_path / "cut", resume=True)
+    assert resumed.success
+    assert_same(resumed, whole)
+    assert assert_valid_views(tmp_path / "cut") == pytest.approx(whole.t)
+    with pytest.raises(rodmol.ParameterError, match="nothing to resume.*finished"):
+        rodmol.simulate(model, 0.5, out=tmp_path / "cut", resume=True)
+
+
+def test_resume_refuses_another_end_time_and_an_empty_directory(model, tmp_path):
+    with pytest.raises(Killed):
+        rodmol.simulate(model, 0.3, out=DiesAfter(tmp_path, 1, chunk_frames=5))
+    with pytest.raises(rodmol.ParameterError, match="resumed ends at 0.3 s"):
+        rodmol.simulate(model, 0.4, out=tmp_path, resume=True)
+    with pytest.raises(rodmol.ParameterError, match="nothing to resume"):
+        rodmol.simulate(model, 0.3, out=tmp_path / "empty", resume=True)
+
+
+@pytest.mark.subprocess
+def test_sigkill_then_resume_ends_in_the_uninterrupted_state(tmp_path):
+    # The explicit backend on N = 30 takes a few seconds for 2 s: time to kill it mid-way.
+    command = [sys.executable, "-m", "rodmol.io.cli", "run", "--example", "fetching", "--backend", "rk23",
+               "--n-elements", "30", "--t-end", "2", "--chunk-frames", "10", "--quiet"]
+    whole = subprocess.run([*command, "--out", str(tmp_path / "whole")], capture_output=True, text=True,
+                           timeout=300)
+    assert whole.returncode == 0, whole.stderr
+    out = tmp_path / "killed"
+    process = subprocess.Popen([*command, "--out", str(out)], stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and process.poll() is None:
+            try:  # the index is only ever replaced whole, so it can be read at any moment
+                if len(h5result.read_index(out / "result.h5")["chunks"]) >= 3:
+                    break
+            except (OSError, KeyError):
+                pass
+            time.sleep(0.02)
+        process.send_signal(signal.SIGKILL)
+        process.wait(timeout=60)
+    finally:
+        if process.poll() is None:
+            process.kill()
+    assert process.returncode == -signal.SIGKILL, "the run ended before it was killed"
+    killed = rodmol.load_result(out)
+    assert not killed.success and 30 <= len(killed.t) < 201
+    assert assert_valid_views(out) == pytest.approx(killed.t)
+    resumed = subprocess.run([*command, "--out", str(out), "--resume"], capture_output=True, text=True,
+                             timeout=300)
+    assert resumed.returncode == 0, resumed.stderr
+    final, reference = rodmol.load_result(out), rodmol.load_result(tmp_path / "whole")
+    assert final.success
+    np.testing.assert_array_equal(final.t, reference.t)
+    np.testing.assert_array_equal(final.states[-1], reference.states[-1])
+    np.testing.assert_array_equal(final.positions, reference.positions)
