@@ -24,6 +24,7 @@ SCRIPTS = {
     "schemes.py": ["schemes.csv", "schemes.md", "schemes.png"],
     "scheme_targets.py": ["scheme_targets.csv", "scheme_targets.md"],
     "fetching_hold.py": ["fetching_hold.csv", "fetching_hold.md", "fetching_hold.png"],
+    "stiff_cantilever.py": ["stiff_cantilever.csv", "stiff_cantilever.md"],
 }
 
 
