@@ -39,18 +39,19 @@ def converged(size, rate, tolerance):
 
 
 @jit
-def block_newton(y, b, g, f, r, x, weight, tolerance, max_iters, max_rate, rate, decay,
+def block_newton(y, b, g, f, r, x, weight, tolerance, max_iters, max_rate, decay,
                  gamma, head, fac, s_x, s_p, s_h, args):
     """Modified Newton iterations for y - g rhs(y) = b, in place, with the
-    block factors of I - gamma J; the same test as :func:`converged`.
-    Returns (outcome, iterations, convergence rate)."""
+    block factors of I - gamma J; the same test as :func:`converged`, the
+    rate estimated from 1 by max(decay rate, size / previous size).
+    Returns (outcome, iterations)."""
     n = y.size
-    previous = -1.0
+    previous, rate = -1.0, 1.0
     for k in range(1, max_iters + 1):
         rhs(y, f, *args)
         for i in range(n):
             if not np.isfinite(f[i]):
-                return NOT_FINITE, k, rate
+                return NOT_FINITE, k
             r[i] = b[i] + g * f[i] - y[i]
         block_solve(gamma, head, fac, r, x, s_x, s_p, s_h)
         total = 0.0
@@ -64,11 +65,11 @@ def block_newton(y, b, g, f, r, x, weight, tolerance, max_iters, max_rate, rate,
         elif previous == 0.0:
             rate = decay * rate
         if size * (min(1.0, rate / (1.0 - rate)) if rate < 1.0 else 1.0) <= tolerance:
-            return CONVERGED, k, rate
+            return CONVERGED, k
         if previous >= 0.0 and size > max_rate * previous:
-            return DIVERGED, k, rate
+            return DIVERGED, k
         previous = size
-    return SLOW, max_iters, rate
+    return SLOW, max_iters
 
 
 class BlockNewton:
@@ -93,11 +94,11 @@ class BlockNewton:
     def solve(self, r):
         return self._block.apply(r)
 
-    def iterate(self, y, b, g, f, weight, tolerance, max_iters, max_rate, rate, decay):
+    def iterate(self, y, b, g, f, weight, tolerance, max_iters, max_rate, decay):
         """:func:`block_newton` with the current factors; the caller has set the inputs."""
         gamma, head, fac, (s_x, s_p, s_h) = self._block.factors
         return block_newton(y, b, g, f, self._r, self._x, weight, tolerance, max_iters, max_rate,
-                            rate, decay, gamma, head, fac, s_x, s_p, s_h, self._args)
+                            decay, gamma, head, fac, s_x, s_p, s_h, self._args)
 
 
 class SparseNewton:
