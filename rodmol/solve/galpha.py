@@ -45,6 +45,8 @@ NEWTON_TOLERANCE = 0.1
 #: cantilever: fewer refreshes cost more iterations than they save).
 MAX_NEWTON_ITERATIONS = 6
 SLOW_ITERATIONS = 3
+#: Most halvings of a step whose Newton iterations fail (down to dt / 1024).
+MAX_HALVINGS = 10
 #: Factor by which the estimated convergence rate may fall per iteration (CVODE's).
 RATE_DECAY = 0.3
 #: Convergence rate above which the iteration is abandoned as diverging.
@@ -87,7 +89,6 @@ def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_
                              f"{t_end - t0:.6g} s; at most {1.0 / STALL_STEP:.3g} are allowed")
     h = (t_end - t0) / n_steps
     alpha_m, alpha_f, gamma = coefficients(float(rho_inf))
-    g = gamma * alpha_f * h / alpha_m
     kappa = alpha_m * (1.0 - gamma) / gamma - (1.0 - alpha_m)  # weight of ydot_n in b
 
     out = Outputs(t_out, y0, progress)
@@ -95,7 +96,8 @@ def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_
     scale = np.broadcast_to(atol, (system.size,)) / rtol
     matrix = newton_matrix(system, scale)
     weight = np.empty(system.size)
-    count = dict(rhs_evals=0, newton_iters=0, retries=0)
+    count = dict(rhs_evals=0, newton_iters=0, retries=0, halvings=0)
+    sizes = []
 
     def rates(t, y, into):
         count["rhs_evals"] += 1
@@ -103,15 +105,15 @@ def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_
         return into
 
     def stats():
-        return dict(steps=n, rhs_evals=count["rhs_evals"], jac_evals=matrix.jac_evals,
+        return dict(steps=len(sizes), rhs_evals=count["rhs_evals"], jac_evals=matrix.jac_evals,
                     newton_iters=count["newton_iters"], retried_steps=count["retries"],
-                    linear_solver=matrix.name, dt=h, rho_inf=float(rho_inf),
-                    **step_size_stats([h] if n else []))
+                    halved_steps=count["halvings"], linear_solver=matrix.name, dt=h,
+                    rho_inf=float(rho_inf), **step_size_stats(sizes))
 
     def stop(reason, error=None):
         return out.stopped("generalized-alpha", watch, reason, error, **stats())
 
-    def newton(t_star, y_n, b, Y, f):
+    def newton(t_star, g, y_n, b, Y, f):
         """Solve Y - g f(t*, Y) = b in place from the guess Y: (outcome, iterations).
 
         The convergence rate is estimated within the step only: carried over
@@ -146,42 +148,59 @@ def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_
         return SLOW, MAX_NEWTON_ITERATIONS
 
     y = np.array(y0, dtype=float)
-    n, t = 0, t0
+    t = t0
     f_start, f_end = np.empty_like(y), np.empty_like(y)  # rates at the step ends, for outputs
     try:
         ydot = rates(t0, y, np.empty_like(y))
+        g = gamma * alpha_f * h / alpha_m  # the Newton matrix's I - g J, for the step h
         matrix.refresh(t0, y, ydot, g)
         a_previous = ydot.copy()
         stale = False
         Y, f = np.empty_like(y), np.empty_like(y)
-        while n < n_steps:
-            t_next = t0 + (n + 1) * h
-            t_star = t + alpha_f * h
+        # Position on the grid t0 + (k + j / 2^level) h: a step whose Newton
+        # iterations fail even with a fresh Jacobian is halved (level + 1),
+        # and the full step is resumed on the next full-step boundary.
+        k, j, level = 0, 0, 0
+        while k < n_steps:
+            h_now = h / 2**level
+            t_next = t0 + (k + (j + 1) / 2**level) * h
+            if gamma * alpha_f * h_now / alpha_m != g:
+                g = gamma * alpha_f * h_now / alpha_m
+                matrix.refactor(g)
             b = y + (g * kappa) * ydot
             for attempt in (0, 1):
                 if stale or attempt:
                     matrix.refresh(t, y, rates(t, y, f_end), g)
                     stale = False
                 # guess: the rate extrapolated linearly from the last two steps
-                Y[:] = y + (alpha_f * h) * ((1.0 + gamma) * ydot - gamma * a_previous)
-                outcome, iters = newton(t_star, y, b, Y, f)
+                Y[:] = y + (alpha_f * h_now) * ((1.0 + gamma) * ydot - gamma * a_previous)
+                outcome, iters = newton(t + alpha_f * h_now, g, y, b, Y, f)
                 if outcome == CONVERGED:
                     break
                 count["retries"] += 1
             else:
-                return stop(_failure(outcome, t, h))
+                if level == MAX_HALVINGS:
+                    return stop(_failure(outcome, t, h_now))
+                count["halvings"] += 1
+                level, j = level + 1, 2 * j
+                continue
             stale = iters > SLOW_ITERATIONS
             y_new = y + (Y - y) / alpha_f
             a_previous = ydot
-            ydot = ((Y - y) / (alpha_f * h) - (1.0 - gamma) * ydot) / gamma
-            n += 1
-            broken = watch.state(t_next, h, y_new)
+            ydot = ((Y - y) / (alpha_f * h_now) - (1.0 - gamma) * ydot) / gamma
+            sizes.append(h_now)
+            j += 1
+            while level and j % 2 == 0:
+                level, j = level - 1, j // 2
+            if j == 2**level:
+                k, j = k + 1, 0
+            broken = watch.state(t_next, h_now, y_new)
             if broken:
                 return stop(broken)
-            if out.t_out[out.next_index] <= t_next + 1e-9 * h:
+            if out.t_out[out.next_index] <= t_next + 1e-9 * h_now:
                 f0, f1 = rates(t, y, f_start), rates(t_next, y_new, f_end)
-                while not out.done and out.t_out[out.next_index] <= t_next + 1e-9 * h:
-                    out.add(_hermite(out.t_out[out.next_index], t, h, y, y_new, f0, f1))
+                while not out.done and out.t_out[out.next_index] <= t_next + 1e-9 * h_now:
+                    out.add(_hermite(out.t_out[out.next_index], t, h_now, y, y_new, f0, f1))
             y, t = y_new, t_next
             slow = watch.pace(t, y)
             if slow and not out.done:
@@ -196,8 +215,8 @@ def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_
 def _failure(outcome, t, h):
     what = {NOT_FINITE: "met non-finite rates", DIVERGED: "diverged",
             SLOW: f"did not converge in {MAX_NEWTON_ITERATIONS} iterations"}[outcome]
-    return (f"the Newton iterations of the step from t = {t:.6g} s {what} with a fresh Jacobian "
-            f"(dt = {h:.3g} s): the load may be beyond what the rod can carry, or the step too "
+    return (f"the Newton iterations of the step from t = {t:.6g} s {what} with a fresh Jacobian, "
+            f"even with the step halved {MAX_HALVINGS} times to {h:.3g} s: the load may be beyond what the rod can carry, or the step too "
             "long for the motion; use a smaller `dt` or a lower `rho_inf`")
 
 

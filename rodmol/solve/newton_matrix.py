@@ -91,6 +91,10 @@ class BlockNewton:
         """Evaluate J at (t, y) (``fy`` = f(t, y)) and factor I - g J."""
         self._block.setup(t, y, fy, False, self._jnew, g)
 
+    def refactor(self, g):
+        """Factor I - g J with the Jacobian of the last refresh."""
+        self._block.factor(g)
+
     def solve(self, r):
         return self._block.apply(r)
 
@@ -115,6 +119,9 @@ class SparseNewton:
     def refresh(self, t, y, fy, g):
         self._jacobian(t, y, fy, self._matrix.data)
         self.jac_evals += 1
+        self.refactor(g)
+
+    def refactor(self, g):
         self._lu = splu((self._identity - g * self._matrix).tocsc())
 
     def solve(self, r):

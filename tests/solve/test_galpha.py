@@ -165,3 +165,24 @@ def test_bad_options_are_refused(option, value, words):
     with pytest.raises(rodmol.ParameterError) as info:
         rodmol.simulate(model, 1.0, initial="straight", backend="galpha", **{option: value})
     assert words in str(info.value)
+
+
+def test_cvode_at_high_order_stalls_on_the_steel_rod_and_points_to_galpha():
+    free, loaded = steel_models(n=20)
+    with pytest.warns(RuntimeWarning, match="stalled"):
+        run = rodmol.simulate(free, 1.0, initial=rodmol.equilibrium(loaded), max_order=5)
+    assert not run.success and run.t[-1] < 0.05
+    assert "backend='galpha'" in run.message and "stiff and lightly damped" in run.message
+
+
+def test_a_step_whose_newton_iterations_fail_is_halved():
+    # The paper's arm released from straight in water: the first 40 ms steps
+    # (dt="auto", a hundredth of its first period) do not converge while the
+    # drag switches on; they are halved, and the full step resumes after.
+    model = rodmol.paper_arm(10, tensions={11: 0.5})
+    run = rodmol.simulate(model, 0.2, initial="straight", backend="galpha")
+    ref = rodmol.simulate(model, 0.2, initial="straight", rtol=1e-8)
+    assert run.success and run.stats["halved_steps"] >= 1
+    assert run.stats["h_min"] == pytest.approx(run.stats["dt"] / 2)
+    assert run.stats["h_max"] == pytest.approx(run.stats["dt"])
+    assert np.max(np.linalg.norm(run.tip - ref.tip, axis=1)) < 5e-3  # 1.2 mm at 40 ms steps
