@@ -75,7 +75,8 @@ def measure(free, y0, t_end, budget, backend, e_rest, **options):
     energy = rodmol.energy(free, res)["total"]
     return dict(success=res.success, t_reached=float(res.t[-1]), cpu_s=cpu,
                 cpu_over_till=cpu / TILL_CPU * 25.0 / t_end, steps=res.stats.get("steps"),
-                rhs_evals=res.stats.get("rhs_evals"), period_s=period,
+                rhs_evals=res.stats.get("rhs_evals"), jac_evals=res.stats.get("jac_evals"),
+                newton_iters=res.stats.get("newton_iters", ""), period_s=period,
                 period_error_pct=float(100 * (period / PERIOD_EB - 1)),
                 amplitude_start_mm=float(1e3 * np.ptp(tip[res.t <= 0.5]) / 2),
                 amplitude_end_mm=float(1e3 * np.ptp(tip[late]) / 2),
