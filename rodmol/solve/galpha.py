@@ -20,10 +20,13 @@ O((omega dt)^3) per step; rho_inf = 0 is BDF2-like (L-stable).
 
 In the unknown Y = y_n+alpha_f the step is Y - g f(t*, Y) = b with
 g = gamma alpha_f dt / alpha_m: a Newton matrix I - g J of the same form as
-CVODE's, with g fixed for the whole run. It is factored once and reused
+CVODE's, with g fixed while the step is. It is factored once and reused
 (modified Newton) until the iterations slow down; the factorisation is the
 system's exact block solve (``system.preconditioner``), or a sparse LU where
-the structure does not fit it.
+the structure does not fit it (:mod:`rodmol.solve.newton_matrix`). A step
+whose iterations fail even with a fresh Jacobian is halved, up to
+``MAX_HALVINGS`` times, and the full step resumes on the next full-step
+boundary.
 """
 
 import numpy as np
@@ -73,7 +76,8 @@ def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_
     """Fixed-step implicit generalized-alpha (see the module docstring).
 
     ``dt`` [s] is the step, shortened to fit a whole number of steps into
-    the run; ``"auto"`` is the rod's first bending period / 100.
+    the run (and halved where the Newton iterations fail); ``"auto"`` is
+    the rod's first bending period / 100.
     ``rho_inf`` in [0, 1] is the numerical damping at high frequency: 1 none
     (energy kept), 0 the most. ``rtol``/``atol`` set the accuracy of the
     Newton solve of each step, not the step (there is no error control).
