@@ -211,7 +211,7 @@ def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_
                 return stop(slow)
     except KeyboardInterrupt:
         return stop("interrupted")
-    except Exception as exc:
+    except Exception as exc:  # noqa: BLE001 (a user callback's too: the frames so far are kept)
         return stop(cause(exc, t), exc)
     return out.solution(True, "The solver reached the end time.", **stats())
 

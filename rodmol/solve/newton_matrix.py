@@ -17,7 +17,9 @@ from scipy.sparse.linalg import splu
 
 from ..discretise.physics import jit
 from ..discretise.preconditioner import block_solve
-# A global, not an argument, so that numba caches the loop (see discretise/jacobian.py).
+
+# The right-hand side is a global, not an argument, so that numba caches the
+# loop (see rodmol/discretise/jacobian.py).
 from ..discretise.stencil import rhs
 
 #: Outcomes of a Newton iteration.
