@@ -59,8 +59,9 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
         (second order in ds, default) or ``"upwind"`` (the paper's, first
         order); see ``docs/model.md``.
     backend : str
-        A name from ``rodmol.BACKENDS``: ``"cvode"`` (implicit BDF, default)
-        or ``"rk23"`` (explicit, cross-check).
+        A name from ``rodmol.BACKENDS``: ``"cvode"`` (implicit BDF, default),
+        ``"galpha"`` (fixed-step generalized-alpha for stiff, lightly damped
+        rods; options ``dt``, ``rho_inf``) or ``"rk23"`` (explicit, cross-check).
     rtol, atol : float, float or array
         Tolerances shared by all backends; ``rtol=None`` is the scheme's
         ``default_rtol`` (the time error about a tenth of the spatial error

@@ -173,7 +173,7 @@ def negative_after_failure(t):
     return 0.5 if t <= T_FAIL else -1.0
 
 
-@pytest.mark.parametrize("backend", ["cvode", "rk23"])
+@pytest.mark.parametrize("backend", ["cvode", "rk23", "galpha"])
 @pytest.mark.parametrize("tension, reason", [
     (lost_sensor, "RuntimeError: tension sensor lost"),
     (negative_after_failure, "tension must be >= 0 N, got -1.0"),

@@ -25,6 +25,7 @@ SCRIPTS = {
     "scheme_targets.py": ["scheme_targets.csv", "scheme_targets.md"],
     "fetching_hold.py": ["fetching_hold.csv", "fetching_hold.md", "fetching_hold.png"],
     "long_output.py": ["long_output.csv", "long_output.md"],
+    "stiff_cantilever.py": ["stiff_cantilever.csv", "stiff_cantilever.md"],
 }
 
 

@@ -314,6 +314,12 @@ class BlockPreconditioner:
         self.gamma = gamma
         self.setups += 1
 
+    @property
+    def factors(self):
+        """(gamma, head, fac, (y_x, y_p, h)): the last factorisation and the
+        scratch of :func:`block_solve`, for solves inside compiled loops."""
+        return self.gamma, self._head, self._fac, self._scratch
+
     def solve(self, t, y, fy, r, z, gamma, delta, lr):
         """scikit-sundae ``psolve``: z = (I - gamma_setup J)^-1 r."""
         block_solve(self.gamma, self._head, self._fac, read_only(r), z, *self._scratch)

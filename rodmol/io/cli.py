@@ -86,7 +86,7 @@ def _parser():
 def _run_options(parser):
     parser.add_argument("--out", type=Path, metavar="DIR", help="output directory (default: [output] directory, "
                                                  "else out/NAME)")
-    parser.add_argument("--backend", metavar="NAME", help="solver backend (cvode, rk23)")
+    parser.add_argument("--backend", metavar="NAME", help="solver backend (cvode, galpha, rk23)")
     parser.add_argument("--n-elements", type=int, metavar="N", help="number of elements N")
     parser.add_argument("--scheme", metavar="NAME", help="spatial scheme (centred, upwind)")
     parser.add_argument("--t-end", type=float, metavar="T", help="end time [s]")

@@ -8,10 +8,11 @@ times reached. A backend sees only the system's narrow interface (see
 
 from ..errors import ParameterError
 from .cvode import cvode
+from .galpha import generalized_alpha
 from .rk23 import rk23
 
 #: Backends by name.
-BACKENDS = {"cvode": cvode, "rk23": rk23}
+BACKENDS = {"cvode": cvode, "rk23": rk23, "galpha": generalized_alpha}
 
 
 def get_backend(name):

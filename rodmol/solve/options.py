@@ -47,6 +47,19 @@ def _max_step(name, value):
     return _checks.non_negative(name, value, " s (0: no limit)")
 
 
+def _unit_interval(name, value):
+    value = _checks.finite(name, value)
+    if not 0.0 <= value <= 1.0:
+        raise ParameterError(f"`{name}` must lie in [0, 1], got {value!r}")
+    return value
+
+
+def _flag(name, value):
+    if not isinstance(value, (bool, np.bool_)):
+        raise ParameterError(f"`{name}` must be True or False, got {_checks.short(value)}")
+    return bool(value)
+
+
 def _choice(options):
     def check(name, value):
         if value not in options:
@@ -65,6 +78,9 @@ def _values():
         "max_step": _max_step,
         "linsolver": _choice(("auto", *LINEAR_SOLVERS)),
         "jacobian": _choice(("auto", *JACOBIANS)),
+        "dt": _auto_or(lambda name, value: _checks.positive(name, value, " s")),
+        "rho_inf": _unit_interval,
+        "python_loop": _flag,
     }
 
 

@@ -191,7 +191,13 @@ class Watch:
                 f"{covered:.3g} s (mean step {mean:.3g} s, about {to_go:.3g} more steps to go). "
                 f"Most compressed element {worst} (q1 = {q1:.3g}), largest turn {turns[b]:.3g} rad "
                 f"over element {b}: the load may be beyond what the rod can carry (collapse, "
-                "buckling, whirling), or the grid too coarse for the motion")
+                "buckling, whirling), or the grid too coarse for the motion" + self._stiff_hint())
+
+    def _stiff_hint(self):
+        if not getattr(self.system, "lightly_damped", False):
+            return ""
+        return ("; or the rod is stiff and lightly damped (no mode of the grid is damped): try "
+                "max_order=2 with CVODE or backend='galpha' (docs/troubleshooting.md)")
 
     def summary(self):
         """How far the solver got: time reached, step count and last step size."""
