@@ -149,15 +149,16 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
                              "'straight' or a state")
     if atol is not None:
         atol = _state_sized("atol", atol, size, positive=True, layout=StateLayout(model.n_elements))
+    if atol is None:
+        atol = default_atol(model, rtol)
     timings = {}
-    with _stage(progress, "preparing the compiled kernels", timings, "prepare_s", kernels.ready()):
+    with _stage(progress, "preparing the compiled kernels", timings, "prepare_s",
+                kernels.ready(run, backend_options)):
         system = SemiDiscrete(model, scheme)  # the one system of this run
-        kernels.prepare(system, t0, straight_state(model))
+        kernels.prepare(system, t0, straight_state(model), run, rtol, atol, backend_options)
     with _stage(progress, f"solving the initial equilibrium at t = {t0:g} s", timings, "equilibrium_s",
                 not (isinstance(initial, str) and initial == "equilibrium")):
         y0 = _initial_state(system, initial, t0)
-    if atol is None:
-        atol = default_atol(model, rtol)
 
     try:
         if sink is not None:

@@ -3,38 +3,43 @@ and not booked as integration time.
 
 numba compiles each kernel on its first call (several seconds in a fresh
 install) and later processes load the machine code from the disk cache
-(well under a second). :func:`prepare` makes those first calls on the run's
-own system, once per process.
+(well under a second). :func:`prepare` makes those first calls with a run
+of a microsecond by the run's own backend and options, so every kernel it
+will use (right-hand side, Jacobian, preconditioner, Newton loop, state
+scan) is ready; once per backend and options in a process. (User inputs are
+read at the preparing run's times too, as the initial equilibrium reads them.)
 """
 
 import contextlib
 
 import numpy as np
 
-from .watch import state_problem
-
-_prepared = False
-
-
-def ready():
-    """True once :func:`prepare` has run in this process."""
-    return _prepared
+#: Span [s] of the preparing run.
+SPAN = 1e-6
+_prepared = set()
 
 
-def prepare(system, t, y):
-    """Call every kernel a run uses once (right-hand side, Jacobian,
-    preconditioner, state scan) at state ``y``, time ``t`` [s]."""
-    global _prepared
-    if _prepared:
+def _key(run, options):
+    return run, repr(sorted(options.items()))
+
+
+def ready(run, options):
+    """True once :func:`prepare` has run for this backend and options in this process."""
+    return _key(run, options) in _prepared
+
+
+def prepare(system, t, y, run, rtol, atol, options):
+    """A run of :data:`SPAN` from state ``y`` at time ``t`` [s]; its result is dropped."""
+    key = _key(run, options)
+    if key in _prepared:
         return
     y = np.array(y, dtype=float)
-    scale = np.ones(system.size)
-    fy = system(t, y)
-    jacobian = system.jacobian(scale)
-    jacobian(t, y, fy, np.zeros((system.size, system.size)))
-    with contextlib.suppress(ValueError):  # structures the preconditioner does not take
-        preconditioner = system.preconditioner(scale)
+    run(system, y, np.array([t, t + SPAN]), rtol=rtol, atol=atol, **options)
+    # A run that short may not need a linear solve (the Newton residual of a
+    # rod at rest can vanish): call the preconditioner's kernels directly.
+    with contextlib.suppress(ValueError):  # structures the block elimination does not take
+        preconditioner = system.preconditioner(np.ones(system.size))
+        fy = system(t, y)
         preconditioner.setup(t, y, fy, False, np.zeros(1, dtype=int), 1e-3)
         preconditioner.apply(fy)
-    state_problem(system.layout, system.model.ds, t, y)
-    _prepared = True
+    _prepared.add(key)
