@@ -40,6 +40,16 @@ def blocks(page):
         yield kind, match["code"], text.count("\n", 0, match.start("code")) + 1
 
 
+def _run(argv, env, attempts=3):
+    """Run a command; a virtual X server that lost the race for its display
+    number (``xvfb-run -a`` beside another one starting) is tried again."""
+    for _ in range(attempts):
+        done = subprocess.run(argv, env=env, capture_output=True, text=True, timeout=600)
+        if done.returncode == 0 or "bad X server connection" not in done.stderr:
+            return done
+    return done
+
+
 def commands(code):
     """The shell block's commands, continuation lines joined, set-up left out."""
     for line in code.replace("\\\n", " ").splitlines():
@@ -76,5 +86,5 @@ def test_page_runs_as_written(page, tmp_path, monkeypatch):
                     argv = XVFB + argv
                 if command.startswith("xvfb-run") and not shutil.which("xvfb-run"):
                     pytest.skip("xvfb-run is not installed")
-                done = subprocess.run(argv, env=env, capture_output=True, text=True, timeout=600)
+                done = _run(argv, env)
                 assert done.returncode == 0, f"{where}: `{command}` failed:\n{done.stdout}\n{done.stderr}"
