@@ -35,14 +35,6 @@ TIP_FORCE = 0.196  # N: the weight of Till's 20 g tip mass
 N, T_END = 40, 25.0
 
 
-def first_mode_period(t, x):
-    """Mean spacing [s] of the upward crossings of x through its mean."""
-    x = x - x.mean()
-    i = np.flatnonzero((x[:-1] < 0) & (x[1:] >= 0))
-    crossings = t[i] - x[i] * (t[i + 1] - t[i]) / (x[i + 1] - x[i])
-    return (crossings[-1] - crossings[0]) / (len(crossings) - 1)
-
-
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--backend", default="galpha", choices=["galpha", "cvode"])
@@ -66,7 +58,7 @@ def main():
     period_eb = 2 * np.pi * L**2 / (1.8751**2 * np.sqrt(ei / rho_a))
     tip = result.tip[:, 1]
     first = result.t <= 2.0
-    period = first_mode_period(result.t[first], tip[first])
+    period = rodmol.oscillation_period(result.t[first], tip[first])
     swing = [np.ptp(tip[window]) / 2 * 1e3 for window in (result.t <= 0.5, result.t >= T_END - 0.5)]
     print(f"steel cantilever N = {N}, mu = {args.mu:g} Pa s, {T_END:g} s with {args.backend} "
           f"{options}: {cpu:.2f} s CPU, {result.stats['steps']} steps")

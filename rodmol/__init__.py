@@ -14,7 +14,7 @@ study, identification, sweeps, linearisation).
 """
 
 from . import scenarios
-from .analysis import energy, marker_errors
+from .analysis import energy, marker_errors, oscillation_period
 from .arm import paper_arm
 from .base_motion import Base, BaseMotion
 from .cables import Cable, read_tension_csv
@@ -59,7 +59,7 @@ __all__ = [
     "Marker", "Material", "Medium", "Model", "ParameterError", "Result", "Rod", "RodmolError",
     "SCHEMES", "ScenarioError", "SemiDiscrete", "StateLayout", "StateView", "UserFunctionError",
     "default_atol", "energy",
-    "equilibrium", "load_result", "load_scenario", "marker_errors", "paper_arm",
+    "equilibrium", "load_result", "load_scenario", "marker_errors", "oscillation_period", "paper_arm",
     "read_tension_csv", "scenarios", "simulate", "straight_state", "write_series",
     # rodmol.calibrate: from experiment to model
     "calibrate_dlt", "identify", "linearize", "paper_errors", "sweep", "triangulate",

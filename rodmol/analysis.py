@@ -1,4 +1,4 @@
-"""Post-processing: discrete energies and the paper's marker errors (eq. 15)."""
+"""Post-processing: discrete energies, oscillation periods and the paper's marker errors (eq. 15)."""
 
 import os
 from dataclasses import dataclass
@@ -73,6 +73,22 @@ class MarkerErrors:
     @property
     def mean_average(self):
         return float(np.mean(self.mean))
+
+
+def oscillation_period(t, x):
+    """Period [s] of an oscillation ``x`` sampled at times ``t`` [s].
+
+    The mean spacing of the upward crossings of ``x`` through its mean, each
+    placed by linear interpolation between samples (second-order accurate
+    where a sine crosses, at its inflection). Needs two upward crossings.
+    """
+    t, x = np.asarray(t, dtype=float), np.asarray(x, dtype=float)
+    x = x - x.mean()
+    i = np.flatnonzero((x[:-1] < 0) & (x[1:] >= 0))
+    if len(i) < 2:
+        raise ParameterError(f"`x` crosses its mean upwards {len(i)} time(s); a period needs two")
+    crossings = t[i] - x[i] * (t[i + 1] - t[i]) / (x[i + 1] - x[i])
+    return (crossings[-1] - crossings[0]) / (len(crossings) - 1)
 
 
 def read_markers_csv(path, n_markers=4):

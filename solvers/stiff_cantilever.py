@@ -47,16 +47,6 @@ def output_times(t_end):
     return np.unique(np.concatenate([dense_start, middle, dense_end, [t_end]]))
 
 
-def tip_period(t, x):
-    """Mean spacing [s] of the upward crossings of x through its mean, or NaN."""
-    x = x - x.mean()
-    i = np.flatnonzero((x[:-1] < 0) & (x[1:] >= 0))
-    if len(i) < 2:
-        return float("nan")
-    crossings = t[i] - x[i] * (t[i + 1] - t[i]) / (x[i + 1] - x[i])
-    return float((crossings[-1] - crossings[0]) / (len(crossings) - 1))
-
-
 def rest_energy(free):
     """Total energy [J] of the unloaded rod at rest in its gravity equilibrium."""
     rest = rodmol.simulate(free, 1e-6, initial="equilibrium", output_dt=1e-6)
@@ -75,7 +65,10 @@ def measure(free, y0, t_end, budget, backend, e_rest, reps, **options):
     cpu = float(np.median(cpus))
     tip = res.tip[:, 1]
     early, late = res.t <= min(2.0, t_end), res.t >= res.t[-1] - 0.5
-    period = tip_period(res.t[early], tip[early])
+    try:
+        period = rodmol.oscillation_period(res.t[early], tip[early])
+    except rodmol.ParameterError:  # a run that stopped before two swings
+        period = float("nan")
     energy = rodmol.energy(free, res)["total"]
     return dict(success=res.success, t_reached=float(res.t[-1]), cpu_s=cpu,
                 cpu_over_till=cpu / TILL_CPU * 25.0 / t_end, steps=res.stats.get("steps"),
