@@ -45,9 +45,17 @@ def grid_damping_ratio(model):
     """Kelvin-Voigt damping ratio zeta = omega tau / 2 of the fastest axial
     wave the grid carries, omega = (pi / ds) sqrt(E / rho), with the
     relaxation time tau = 3 mu / E of the sectional law. Below 1 every mode
-    of the grid is underdamped; the paper's arm at N = 100 has about 30."""
+    of the grid is underdamped; the paper's arm at N = 100 has about 30.
+    With per-component viscosities (``Material(viscosity=...)``) tau is the
+    shortest relaxation time of the six components: one undamped component
+    (e.g. no extension-shear damping, Bse = 0) leaves its modes undamped."""
     mat = model.rod.material
-    tau = 3.0 * mat.mu / mat.E if model.viscosity else 0.0
+    if not model.viscosity:
+        tau = 0.0
+    elif mat.viscosity is None:
+        tau = 3.0 * mat.mu / mat.E
+    else:
+        tau = float(np.min(mat.relaxation_times()))
     return 0.5 * tau * np.pi / model.ds * np.sqrt(mat.E / mat.rho)
 
 

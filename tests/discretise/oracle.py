@@ -100,6 +100,12 @@ class Sampled:
         mu = mat.mu if model.viscosity else 0.0
         self.vl = mu * a_str[:, None] * np.array([3.0, 1.0, 1.0])
         self.vth = mu * j_str[:, None] * np.array([2.0, 3.0, 3.0])
+        given = mat.viscosity if model.viscosity and mat.viscosity is not None else None
+        if given is not None:  # per-component viscosities [Pa s]: Vl = A eta, Vth = J eta
+            eta_l = np.asarray(given.get("shear_extension", (3 * mu, mu, mu)))
+            eta_th = np.asarray(given.get("bending_torsion", (mu, 3 * mu, 3 * mu)))
+            self.vl = a_str[:, None] * eta_l
+            self.vth = j_str[:, None] * np.array([2.0, 1.0, 1.0]) * eta_th
         added = (med.rho * a_vel[:, None] * np.array([0.0, med.By, med.Bz]) if model.added_mass
                  else np.zeros((n, 3)))
         self.added = added
