@@ -60,6 +60,14 @@ class Model:
         Add the Munk moment of the added-mass model (off in the paper).
     markers : sequence of Marker
         Surface points whose trajectories the result carries.
+    drag_law : str
+        ``"morison"`` (default): the paper's -rho_w |v| D v from the medium's
+        coefficients (eq. 8); ``"componentwise"``: -C v|v| per local
+        component, C = ``drag_coefficients`` (Till's tendon robot), in place
+        of the medium's drag.
+    drag_coefficients : (float, float, float)
+        C [kg/m^2] of the componentwise law, local frame (axial, y, z); force
+        per unit length.
 
     The sampled sectional arrays (``kl``, ``kth``, ``vl``, ``vth``, ``mass``,
     ``inertia``, ``net_mass``, ``drag_coefficient``, ``added``,
@@ -73,7 +81,8 @@ class Model:
 
     def __init__(self, rod, n_elements, *, gravity=(0.0, -9.81, 0.0), medium=None,
                  medium_density=0.0, cables=(), base=None, drag=True, added_mass=True,
-                 viscosity=True, munk_moment=False, markers=(), loads=()):
+                 viscosity=True, munk_moment=False, markers=(), loads=(), drag_law="morison",
+                 drag_coefficients=None):
         if not isinstance(rod, Rod):
             raise ParameterError(f"`rod` must be a rodmol.Rod, got {rod!r}")
         self.rod = rod
@@ -91,6 +100,7 @@ class Model:
             raise ParameterError(f"`base` must be a rodmol.BaseMotion or None, got {base!r}")
         self.drag, self.added_mass = bool(drag), bool(added_mass)
         self.viscosity, self.munk_moment = bool(viscosity), bool(munk_moment)
+        self.drag_law, self.drag_coefficients = _drag_law(drag_law, drag_coefficients)
         self._check_cables()
         self.loads = tuple(loads)
         for i, load in enumerate(self.loads):
@@ -115,7 +125,8 @@ class Model:
         options = dict(gravity=tuple(self.gravity), medium=self.medium, cables=self.cables,
                        base=self.base, drag=self.drag, added_mass=self.added_mass,
                        viscosity=self.viscosity, munk_moment=self.munk_moment,
-                       markers=self.markers, loads=self.loads)
+                       markers=self.markers, loads=self.loads, drag_law=self.drag_law,
+                       drag_coefficients=self.drag_coefficients)
         return (_rebuild, (type(self), self.rod, self.n_elements, options))
 
     def __repr__(self):
@@ -163,9 +174,12 @@ class Model:
         self.mass = rho * a[:, None] + self.added
         self.inertia = rho * rod.second_moments(s_vel)
         self.net_mass = (rho - med.rho) * a
-        self.drag_coefficient = (
-            med.rho * r[:, None] * np.array([0.5 * np.pi * med.Cx, med.Cy, med.Cz])
-            if self.drag else np.zeros((n, 3)))
+        if not self.drag:
+            self.drag_coefficient = np.zeros((n, 3))
+        elif self.drag_law == "componentwise":
+            self.drag_coefficient = np.tile(self.drag_coefficients, (n, 1))
+        else:
+            self.drag_coefficient = med.rho * r[:, None] * np.array([0.5 * np.pi * med.Cx, med.Cy, med.Cz])
 
         # Fraction of each strain node's cell on the cable path: moving the
         # anchor inside a cell shifts its concentrated load smoothly between
@@ -237,6 +251,27 @@ def _inline_function(value, depth=3):
         if found:
             return found
     return None
+
+
+#: Drag laws a Model accepts (``drag_law``).
+DRAG_LAWS = ("morison", "componentwise")
+
+
+def _drag_law(law, coefficients):
+    """(law, coefficients (3,) [kg/m^2] or None), checked."""
+    if law not in DRAG_LAWS:
+        raise ParameterError(f"unknown `drag_law` {law!r}; choose one of {', '.join(map(repr, DRAG_LAWS))}")
+    if law == "morison":
+        if coefficients is not None:
+            raise ParameterError("`drag_coefficients` belong to drag_law='componentwise' (the Morison "
+                                 f"law takes its coefficients from the medium), got {_checks.short(coefficients)}")
+        return law, None
+    if coefficients is None:
+        raise ParameterError("drag_law='componentwise' needs `drag_coefficients` (C_x, C_y, C_z) [kg/m^2]")
+    c = _checks.vector3("drag_coefficients", coefficients)
+    if np.any(c < 0):
+        raise ParameterError(f"`drag_coefficients` must be >= 0 kg/m^2, got {_checks.short(coefficients)}")
+    return law, tuple(float(x) for x in c)
 
 
 def _medium(medium, medium_density):

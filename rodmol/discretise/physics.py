@@ -149,6 +149,16 @@ def body_force(mass, net_mass, drag, r, gravity, v, w, smoothing2):
 
 
 @jit
+def componentwise_drag(coefficients, v, smoothing2):
+    """Drag law C v|v| per local component (Till's tendon robot), returned
+    with the sign of v (subtract it) [N/m]; ``coefficients`` C [kg/m^2],
+    |v_i| smoothed as sqrt(v_i^2 + ``smoothing2``)."""
+    return (coefficients[0] * v[0] * np.sqrt(v[0] * v[0] + smoothing2),
+            coefficients[1] * v[1] * np.sqrt(v[1] * v[1] + smoothing2),
+            coefficients[2] * v[2] * np.sqrt(v[2] * v[2] + smoothing2))
+
+
+@jit
 def body_torque(inertia, added, munk, v, w):
     """Torque density [N m/m]: gyroscopic -w x (rho J w), and with ``munk``
     the Munk moment -v x (rho_w F v) of a Kirchhoff added-mass model."""

@@ -23,8 +23,9 @@ Packing of the sampled model (built once by ``SemiDiscrete``):
 
 * ``params`` (N, 25): per element, the constant sectional data, one row per
   element (columns ``P_*``);
-* ``consts`` (8,): ds, quaternion restoring rate, drag smoothing speed^2,
-  Munk switch (0/1), gravity (3, global), centred switch (0/1);
+* ``consts`` (9,): ds, quaternion restoring rate, drag smoothing speed^2,
+  Munk switch (0/1), gravity (3, global), centred switch (0/1), drag law
+  (0 Morison, 1 componentwise C v|v|: then ``P_DRAG`` holds C);
 * ``offsets`` (n_c, 3), ``weights`` (n_c, N): cable offsets and their share
   of each strain node's cell;
 * external-load entries: ``kinds``, ``nodes`` (element block of the entry),
@@ -47,6 +48,7 @@ from .physics import (
     body_force,
     body_torque,
     cable_stress,
+    componentwise_drag,
     cross,
     jit,
     kelvin_voigt,
@@ -60,7 +62,9 @@ from .physics import (
 
 #: Index of the scheme switch in ``consts`` (0 upwind, 1 centred).
 CENTRED = 7
-N_CONSTS = 8
+#: Index of the drag law switch in ``consts`` (0 Morison, 1 componentwise).
+COMPONENTWISE_DRAG = 8
+N_CONSTS = 9
 
 P_KL, P_KTH, P_VL, P_VTH, P_MASS, P_INERTIA = 0, 3, 6, 9, 12, 15
 P_NET_MASS, P_DRAG, P_ADDED = 18, 19, 22
@@ -104,6 +108,7 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
     ds, restoring, smoothing2, munk = consts[0], consts[1], consts[2], consts[3] != 0.0
     gravity = (consts[4], consts[5], consts[6])
     centred = consts[CENTRED] != 0.0
+    componentwise = consts[COMPONENTWISE_DRAG] != 0.0
 
     # Pass 1, cells i = 0..N-1: compatibility with the differences of v, w
     # across the cell (cell 0 starts at the base), and the sectional stress.
@@ -190,7 +195,11 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
         mass, inertia = _vec(pr, P_MASS), _vec(pr, P_INERTIA)
 
         f = add(scale(1.0 / length, sub(n_next, n_here)), f_cells)
-        f = add(f, body_force(mass, pr[P_NET_MASS], _vec(pr, P_DRAG), r, gravity, v, w, smoothing2))
+        if componentwise:
+            f = add(f, body_force(mass, pr[P_NET_MASS], zero, r, gravity, v, w, smoothing2))
+            f = sub(f, componentwise_drag(_vec(pr, P_DRAG), v, smoothing2))
+        else:
+            f = add(f, body_force(mass, pr[P_NET_MASS], _vec(pr, P_DRAG), r, gravity, v, w, smoothing2))
         f = add(f, _vec(row, 12))
         t = add(scale(1.0 / length, sub(m_next, m_here)), t_cells)
         t = add(t, body_torque(inertia, _vec(pr, P_ADDED), munk, v, w))

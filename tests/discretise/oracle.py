@@ -114,6 +114,9 @@ class Sampled:
         self.net_mass = (mat.rho - med.rho) * a_vel
         self.drag = (med.rho * r_vel[:, None] * np.array([0.5 * np.pi * med.Cx, med.Cy, med.Cz])
                      if model.drag else np.zeros((n, 3)))
+        self.componentwise = model.drag and model.drag_law == "componentwise"
+        if self.componentwise:  # C v|v| per component replaces the medium's drag
+            self.drag = np.tile(np.asarray(model.drag_coefficients, dtype=float), (n, 1))
         self.radius = r_vel  # at velocity nodes 1..N
         self.gravity = np.asarray(model.gravity, dtype=float)
         self.munk = bool(model.munk_moment)
@@ -270,11 +273,14 @@ def rates(model, t, y, tensions=None, scheme="upwind"):
     f_ext, m_ext = external_loads(model, data, t, quat, u, v, w)
     lengths = data.lengths[:, None]
 
-    speed = np.sqrt(dot(v, v) + DRAG_SMOOTHING_SPEED**2)
+    if data.componentwise:  # |v_i| per component
+        speed = np.sqrt(v * v + DRAG_SMOOTHING_SPEED**2)
+    else:
+        speed = np.sqrt(dot(v, v) + DRAG_SMOOTHING_SPEED**2)[:, None]
     force = ((n_next - n_tot) / lengths + f_cells
              - cross(w, data.mass * v)
              + data.net_mass[:, None] * global_to_local(r, data.gravity)
-             - speed[:, None] * data.drag * v
+             - speed * data.drag * v
              + f_ext)
     torque = ((m_next - m_tot) / lengths + t_cells
               - cross(w, data.inertia * w) + m_ext)

@@ -36,6 +36,8 @@ def _models():
     return {
         "paper arm, cables": arm(9, tensions={11: 1.0, 3: 0.5}),
         "paper arm, no cables, air": arm(6, medium="air"),
+        "componentwise drag": arm(7, tensions={11: 1.0}, drag_law="componentwise",
+                                  drag_coefficients=(0.3, 2.0, 5.0)),
         "per-component viscosity": rodmol.Model(rodmol.Rod(0.3, (0.01, 0.006), rodmol.Material(
             E=2e5, nu=0.3, mu=40.0, rho=1100.0, viscosity=dict(shear_extension=(0.0, 5.0, 7.0)))), 7,
             cables=[rodmol.Cable((0.0, 0.004), 0.25, 0.4)]),
