@@ -143,21 +143,28 @@ class Model:
         """True if a cable tension reads the state."""
         return any(c.tension.feedback for c in self.cables)
 
+    @property
+    def friction(self):
+        """True if a cable rubs on the body (``Cable(friction=...)`` > 0)."""
+        return any(c.friction > 0.0 for c in self.cables)
+
     def _check_cables(self):
         L = self.rod.length
         for c in self.cables:
             if c.anchor > L * (1 + 1e-12):
                 raise ParameterError(
                     f"cable {c.name!r}: `anchor` must lie in (0, L = {L!r} m], got {c.anchor!r}")
+            if c.outside_body:
+                continue
             s = np.linspace(0.0, min(c.anchor, L), 2001)
             r = self.rod.radius_at(s)
-            reach = np.hypot(*c.offset)
+            reach = np.hypot(*c.offset_at(s).T)
             if np.any(reach >= r):
-                where = s[np.argmax(reach >= r)]
+                i = int(np.argmax(reach >= r))
                 raise ParameterError(
-                    f"cable {c.name!r}: offset {c.offset} m (|p| = {reach:.6g} m) lies outside "
-                    f"the body at s = {where:.6g} m where the radius is "
-                    f"{self.rod.radius_at(where):.6g} m")
+                    f"cable {c.name!r}: offset {tuple(c.offset_at(s[i])[0].tolist())} m (|p| = {reach[i]:.6g} m) "
+                    f"lies outside the body at s = {s[i]:.6g} m where the radius is "
+                    f"{r[i]:.6g} m (a cable on spacer disks: Cable(..., outside_body=True))")
 
     def _sample(self):
         """Sample every sectional quantity on the grid (done once)."""
@@ -230,6 +237,7 @@ def _check_no_inline_functions(model):
     """Refuse to pickle inputs given as lambdas or local functions, naming them:
     pickle stores functions by name, so these cannot reach another process."""
     inputs = [(f"cable {c.name!r} tension", c.tension) for c in model.cables]
+    inputs += [(f"cable {c.name!r} offset", c.offset) for c in model.cables if callable(c.offset)]
     inputs += [(f"base {k}", getattr(model.base, k)) for k in ("velocity", "angular_velocity")]
     inputs += [(f"load {getattr(x, 'name', x)!r}", x) for x in model.loads]
     for label, value in inputs:
@@ -246,7 +254,7 @@ def _inline_function(value, depth=3):
     name = getattr(value, "__qualname__", "") if callable(value) else ""
     if "<lambda>" in name or "<locals>" in name:
         return name
-    for attr in ("function", "signal", "force", "moment") if depth else ():
+    for attr in ("function", "signal", "force", "moment", "position") if depth else ():
         found = _inline_function(getattr(value, attr, None), depth - 1)
         if found:
             return found

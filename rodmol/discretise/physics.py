@@ -122,14 +122,15 @@ def kelvin_voigt(kl, kth, vl, vth, q, k, q_t, k_t):
 
 
 @jit
-def cable_stress(q, k, p, tension):
-    """Actuation stress of a cable at offset p pulled with ``tension`` [N]:
-    N_a = T tau, M_a = p x N_a, tau = (q + k x p) / |q + k x p|.
+def cable_stress(q, k, p, dp, tension):
+    """Actuation stress of a cable at offset p (slope p' = ``dp`` along s)
+    pulled with ``tension`` [N]: N_a = T tau, M_a = p x N_a,
+    tau = (q + k x p + p') / |q + k x p + p'|.
 
     Its divergence in the balance laws is exactly the distributed load along
     the cable path plus the concentrated load at the anchor (docs/model.md).
     """
-    c = add(q, cross(k, p))
+    c = add(add(q, cross(k, p)), dp)
     n_a = scale(tension / np.sqrt(dot(c, c)), c)
     return n_a, cross(p, n_a)
 

@@ -26,8 +26,9 @@ Packing of the sampled model (built once by ``SemiDiscrete``):
 * ``consts`` (9,): ds, quaternion restoring rate, drag smoothing speed^2,
   Munk switch (0/1), gravity (3, global), centred switch (0/1), drag law
   (0 Morison, 1 componentwise C v|v|: then ``P_DRAG`` holds C);
-* ``offsets`` (n_c, 3), ``weights`` (n_c, N): cable offsets and their share
-  of each strain node's cell;
+* ``offsets`` (n_c, N, 6), ``weights`` (n_c, N): per cable and cell the
+  offset p and its slope p' (local, :mod:`rodmol.discretise.routing`), and
+  the cell's share of the path times the tension's factor there (friction);
 * external-load entries: ``kinds``, ``nodes`` (element block of the entry),
   ``entry_weights``, ``entry_params`` (E, 12) and ``entry_values`` (E, 3);
 * ``tensions`` (n_c,), ``base`` (6,) = (v0, w0) and ``entry_values``: the
@@ -96,7 +97,8 @@ def _signature():
     # The state comes read-only from CVODE and writable from everywhere else;
     # typing it read-only accepts both with a single compilation.
     f1, f2, i1 = numba.types.float64[::1], numba.types.float64[:, ::1], numba.types.int64[::1]
-    return numba.types.void(f1.copy(readonly=True), f1, f2, f1, f2, f2, f1, f1,
+    f3 = numba.types.float64[:, :, ::1]
+    return numba.types.void(f1.copy(readonly=True), f1, f2, f1, f3, f2, f1, f1,
                             i1, i1, f1, f2, f2, f2)
 
 
@@ -142,12 +144,13 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
     for c in range(offsets.shape[0]):
         if tensions[c] == 0.0:
             continue
-        p = _vec(offsets[c], 0)
         for i in range(n):
             if weights[c, i] == 0.0:  # beyond the anchor
                 continue
             o = HEADER + BLOCK * i
-            n_a, m_a = cable_stress(_vec(y, o + QS), _vec(y, o + K), p, tensions[c] * weights[c, i])
+            route = offsets[c, i]
+            n_a, m_a = cable_stress(_vec(y, o + QS), _vec(y, o + K), _vec(route, 0), _vec(route, 3),
+                                    tensions[c] * weights[c, i])
             row = work[i]
             _put(row, 6, add(_vec(row, 6), n_a))
             _put(row, 9, add(_vec(row, 9), m_a))

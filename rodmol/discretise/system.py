@@ -13,6 +13,7 @@ interface (``size``, ``__call__``, ``layout``, ``pattern``, ``bandwidths``,
 import numpy as np
 
 from . import centreline, external, rotations, stencil
+from .routing import CableRouting
 from .layout import StateLayout, merge
 from .schemes import DEFAULT_SCHEME, get_scheme
 
@@ -67,10 +68,18 @@ class StateView:
     [m], ``rotations`` (N+1, 3, 3), ``q``, ``k``, ``v``, ``w`` (N, 3) local.
     """
 
-    def __init__(self, layout, t, y, ds):
-        self.t, self._layout, self._y, self._ds = t, layout, y, ds
+    def __init__(self, layout, t, y, ds, routing=None):
+        self.t, self._layout, self._y, self._ds, self._routing = t, layout, y, ds, routing
+
+    def cable_length(self, name):
+        """Path length [m] of the cable called ``name`` from the base to its anchor."""
+        if self._routing is None:
+            raise AttributeError("cable lengths need the system's routing (SemiDiscrete.state_view)")
+        return float(self.cable_lengths[self._routing.index[name]])
 
     def __getattr__(self, name):
+        if name == "cable_lengths":
+            return self._routing.lengths(self.q, self.k)
         if name in ("q", "k", "v", "w"):
             return self._layout.field(self._y, name)
         if name == "rotations":
@@ -110,7 +119,8 @@ class SemiDiscrete:
         self.scheme = get_scheme(scheme)
         self.layout = StateLayout(model.n_elements)
         self.size = self.layout.size
-        self.global_coupling = model.feedback  # feedback tensions read the whole state
+        # Feedback and displacement-controlled tensions and friction read the whole state.
+        self.global_coupling = model.feedback or model.friction
         m = model
         self.cells = m.cell_properties(self.scheme.cell_points(m.s_nodes))
         self.node_lengths = self.scheme.node_lengths(m.n_elements, m.ds)
@@ -152,9 +162,12 @@ class SemiDiscrete:
         else:
             active = [i for i, value in enumerate(constant) if value != 0.0]
         self._active = np.array(active, dtype=int)
-        self._offsets = np.ascontiguousarray(m.cable_offsets[self._active]).reshape(-1, 3)
-        self._weights = np.ascontiguousarray(m.cable_weights[self._active]).reshape(
+        self.routing = CableRouting(m, self.scheme.cell_points(m.s_nodes))
+        self._offsets = np.ascontiguousarray(self.routing.geometry[self._active]).reshape(
+            len(active), m.n_elements, 6)
+        self._path_weights = np.ascontiguousarray(self.routing.weights[self._active]).reshape(
             len(active), m.n_elements)
+        self._weights = self._path_weights.copy()  # times the friction factors, refreshed
         self.tension_values = np.array([constant[i] or 0.0 for i in active])
         self._timed = [(j, m.cables[i]) for j, i in enumerate(active) if constant[i] is None]
 
@@ -175,23 +188,46 @@ class SemiDiscrete:
         values of time-dependent loads. ``y`` is read by feedback tensions;
         ``tensions`` (n_cables,) [N], if given, are used instead of the inputs."""
         m = self.model
+        if not self._fixed_base:
+            v0, w0 = m.base.velocities(t)
+            self.base_velocities[:3], self.base_velocities[3:] = v0, w0
         if tensions is not None:
             self.tension_values[:] = np.asarray(tensions, dtype=float)[self._active]
         elif self.global_coupling:
-            state = StateView(self.layout, t, y, m.ds) if y is not None else None
+            state = self.state_view(t, y) if y is not None else None
             self.tension_values[:] = m.tensions(t, state)
         else:
             for j, cable in self._timed:
                 self.tension_values[j] = cable.tension_at(t)
-        if not self._fixed_base:
-            v0, w0 = m.base.velocities(t)
-            self.base_velocities[:3], self.base_velocities[3:] = v0, w0
+        if m.friction:
+            self._weights[:] = self._path_weights * self.friction_factors(y)[self._active]
         self._grid_loads.fill(t, self.entry_values)
 
     def tensions(self, t, y=None):
-        """Tensions of all cables at (t, y), shape (n_cables,) [N]."""
-        state = StateView(self.layout, t, y, self.model.ds) if self.global_coupling and y is not None else None
+        """Tensions of all cables at (t, y) where they leave the base, shape (n_cables,) [N]."""
+        state = self.state_view(t, y) if self.global_coupling and y is not None else None
         return self.model.tensions(t, state)
+
+    def state_view(self, t, y):
+        """A :class:`StateView` of ``y`` at t, with the cables' path lengths."""
+        return StateView(self.layout, t, y, self.model.ds, self.routing)
+
+    def friction_factors(self, y):
+        """Tension along each cable over its tension at the base, (n_cables, N),
+        for the state ``y`` (all ones at rest or without friction; reads the
+        base velocities of the last :meth:`update_inputs`)."""
+        routing, n = self.routing, self.model.n_elements
+        if y is None or not self.model.friction:
+            return np.ones((len(self.model.cables), n))
+        q, k = self.layout.field(y, "q"), self.layout.field(y, "k")
+        v, w = self.layout.field(y, "v"), self.layout.field(y, "w")
+        # Strain rates by the compatibility laws (centred: a direction estimate).
+        v_prev = np.vstack([self.base_velocities[:3], v[:-1]])
+        w_prev = np.vstack([self.base_velocities[3:], w[:-1]])
+        v_bar, w_bar = 0.5 * (v + v_prev), 0.5 * (w + w_prev)
+        q_t = (v - v_prev) / self.model.ds + np.cross(k, v_bar) - np.cross(w_bar, q)
+        k_t = (w - w_prev) / self.model.ds + np.cross(k, w_bar)
+        return routing.friction_factors(q, k, q_t, k_t)
 
     def kernel_arguments(self):
         """Arguments of :func:`rodmol.discretise.stencil.rhs` after (y, out):

@@ -110,11 +110,13 @@ def cable_paths(result, k):
     s_nodes, u, rotation = result.s, result.positions[k], result.rotations[k]
     paths = []
     for cable in result.meta.get("cables", []):
-        p = np.array([0.0, *cable["offset"]])
+        # The routing p(s) at the nodes (a constant offset in older results).
+        offsets = np.asarray(cable.get("node_offsets", [cable["offset"]]), dtype=float)
+        p = np.broadcast_to(np.column_stack([np.zeros(len(offsets)), offsets]), u.shape)
         anchor = min(float(cable["anchor"]), float(s_nodes[-1]))
         on_path = s_nodes < anchor
         s = np.append(s_nodes[on_path], anchor)
-        points = u + rotation @ p
+        points = u + np.einsum("nij,nj->ni", rotation, p)
         at_anchor = [np.interp(anchor, s_nodes, points[:, i]) for i in range(3)]
         paths.append((s, np.vstack([points[on_path], at_anchor])))
     return paths

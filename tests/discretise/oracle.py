@@ -120,7 +120,13 @@ class Sampled:
         self.radius = r_vel  # at velocity nodes 1..N
         self.gravity = np.asarray(model.gravity, dtype=float)
         self.munk = bool(model.munk_moment)
-        self.offsets = np.array([[0.0, *c.offset] for c in model.cables]).reshape(-1, 3)
+        # Routing p(s) (the user's input, read through rodmol): p at the cell's
+        # sampling point, p' as the difference of p across the cell.
+        self.offsets = np.zeros((len(model.cables), n, 3))
+        self.slopes = np.zeros((len(model.cables), n, 3))
+        for j, c in enumerate(model.cables):
+            self.offsets[j, :, 1:] = c.offset_at(s_cell)
+            self.slopes[j, :, 1:] = np.diff(c.offset_at(s), axis=0) / self.ds
         anchors = np.array([c.anchor for c in model.cables]).reshape(-1, 1)
         self.cable_weights = np.clip((anchors - s_str[None, :]) / self.ds, 0.0, 1.0)
 
@@ -144,11 +150,12 @@ def strain_rates(q, k, v, w, v0, w0, ds, centred=False):
     return q_t, k_t
 
 
-def cable_stress(q, k, p, tension):
-    """N_a = T tau, tau = (q + k x p)/|q + k x p|, M_a = p x N_a; tension (n,) per node."""
-    c = q + cross(k, p)
+def cable_stress(q, k, p, dp, tension):
+    """N_a = T tau, tau = (q + k x p + p')/|q + k x p + p'|, M_a = p x N_a;
+    p, p' (n, 3) and tension (n,) per cell."""
+    c = q + cross(k, p) + dp
     n_a = tension[:, None] * c / np.linalg.norm(c, axis=1, keepdims=True)
-    return n_a, cross(np.broadcast_to(p, n_a.shape), n_a)
+    return n_a, cross(p, n_a)
 
 
 def stresses(data, q, k, q_t, k_t, tensions):
@@ -156,8 +163,8 @@ def stresses(data, q, k, q_t, k_t, tensions):
     n_el = data.kl * (q - Q_STAR) + data.vl * q_t
     m_el = data.kth * k + data.vth * k_t
     n_tot, m_tot = n_el.copy(), m_el.copy()
-    for p, tension, weight in zip(data.offsets, tensions, data.cable_weights):
-        n_a, m_a = cable_stress(q, k, p, tension * weight)
+    for p, dp, tension, weight in zip(data.offsets, data.slopes, tensions, data.cable_weights):
+        n_a, m_a = cable_stress(q, k, p, dp, tension * weight)
         n_tot += n_a
         m_tot += m_a
     return n_el, m_el, n_tot, m_tot
