@@ -101,9 +101,14 @@ def _closed_loop(system, t, tol, max_iter, max_rounds=30):
                         np.asarray(model.base.rotation, dtype=float),
                         rotations.from_matrix(model.base.rotation))
     tensions = law(y)
+    # A displacement-controlled cable's law on the straight rod can ask for far
+    # more than the arm carries (the rigid-rod tension); start it slack.
+    tensions[[c.actuated for c in model.cables]] = 0.0
     scale = max(model.load_scale(t, tensions), 1e-12)
+    warm = None
     for _ in range(max_rounds):
-        y = _rest_state(system, t, tol, max_iter, tensions)
+        y = _rest_state(system, t, tol, max_iter, tensions, start=warm)
+        warm = y
         residual = (law(y) - tensions)[feedback]
         if np.max(np.abs(residual)) <= 1e-9 * scale:
             return y
@@ -112,7 +117,7 @@ def _closed_loop(system, t, tol, max_iter, max_rounds=30):
             h = 1e-6 * max(abs(tensions[i]), scale)
             shifted = tensions.copy()
             shifted[i] += h
-            jac[:, j] = ((law(_rest_state(system, t, tol, max_iter, shifted)) - shifted)[feedback]
+            jac[:, j] = ((law(_rest_state(system, t, tol, max_iter, shifted, start=y)) - shifted)[feedback]
                          - residual) / h
         try:
             step = np.linalg.solve(jac, -residual)
@@ -124,8 +129,11 @@ def _closed_loop(system, t, tol, max_iter, max_rounds=30):
                            "(the law and the arm have no common rest state, or it is unstable)")
 
 
-def _rest_state(system, t, tol, max_iter, tensions=None):
-    """The rest state under the loads at t (cable ``tensions`` [N] if given)."""
+def _rest_state(system, t, tol, max_iter, tensions=None, start=None):
+    """The rest state under the loads at t (cable ``tensions`` [N] if given).
+    ``start``, a nearby rest state (the closed loop's last iterate), is tried
+    first at the full loads; the continuation from the straight rod is the
+    fallback."""
     model = system.model
     layout, n, ds = system.layout, model.n_elements, model.ds
     static = BlockLayout(n, dict(STATIC_FIELDS))
@@ -164,6 +172,11 @@ def _rest_state(system, t, tol, max_iter, tensions=None):
 
     bands = static.bandwidths(static_dependencies(system.depends))
     lam, step = 0.0, 1.0
+    if start is not None:
+        z_warm = _newton(lambda x: residual(x, 1.0),
+                         np.hstack([layout.field(start, f) for f in STATIC_FIELDS]).ravel(), tol, max_iter, bands)
+        if z_warm is not None:
+            z, lam = z_warm, 1.0
     while lam < 1.0:
         target = min(1.0, lam + step)
         z_new = _newton(lambda x, lam=target: residual(x, lam), z, tol, max_iter, bands)
