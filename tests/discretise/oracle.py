@@ -158,11 +158,49 @@ def cable_stress(q, k, p, dp, tension):
     return n_a, cross(p, n_a)
 
 
+def friction_factors(model, data, q, k, v, w, v0, w0):
+    """T(cell) / T(base) per cable and cell (n_cables, N) of the regularised
+    capstan law (docs/model.md), cell by cell: the path's curvature
+    |tau' + k x tau| (tau' by central differences, one-sided at the ends),
+    the sliding speed from the rate of change of the path length beyond the
+    cell (strain rates of the compatibility laws with centred velocities),
+    and the wrap to the middle of the cell."""
+    n, ds = data.n, data.ds
+    v_prev, w_prev = np.vstack([v0, v[:-1]]), np.vstack([w0, w[:-1]])
+    q_t, k_t = strain_rates(q, k, v, w, v0, w0, ds, centred=True)
+    factors = np.ones((len(model.cables), n))
+    for j, cable in enumerate(model.cables):
+        tau, rate = np.zeros((n, 3)), np.zeros(n)
+        for i in range(n):
+            c = q[i] + np.cross(k[i], data.offsets[j, i]) + data.slopes[j, i]
+            tau[i] = c / np.linalg.norm(c)
+            rate[i] = tau[i] @ (q_t[i] + np.cross(k_t[i], data.offsets[j, i]))
+        wrap = 0.0
+        for i in range(n):
+            if n == 1:
+                dtau = np.zeros(3)
+            elif i == 0:
+                dtau = (tau[1] - tau[0]) / ds
+            elif i == n - 1:
+                dtau = (tau[-1] - tau[-2]) / ds
+            else:
+                dtau = (tau[i + 1] - tau[i - 1]) / (2 * ds)
+            kappa = np.linalg.norm(dtau + np.cross(k[i], tau[i]))
+            beyond = ds * np.sum(data.cable_weights[j, i:] * rate[i:])
+            sigma = -beyond / np.hypot(beyond, cable.slip_speed)
+            turn = cable.friction * sigma * kappa * data.cable_weights[j, i] * ds
+            factors[j, i] = np.exp(-(wrap + turn / 2))
+            wrap += turn
+    return factors
+
+
 def stresses(data, q, k, q_t, k_t, tensions):
     """(N_el, M_el, N_tot, M_tot) at the strain nodes."""
     n_el = data.kl * (q - Q_STAR) + data.vl * q_t
     m_el = data.kth * k + data.vth * k_t
     n_tot, m_tot = n_el.copy(), m_el.copy()
+    tensions = np.asarray(tensions, dtype=float)
+    tensions = np.broadcast_to(tensions[:, None] if tensions.ndim == 1 else tensions, data.cable_weights.shape)
     for p, dp, tension, weight in zip(data.offsets, data.slopes, tensions, data.cable_weights):
         n_a, m_a = cable_stress(q, k, p, dp, tension * weight)
         n_tot += n_a
@@ -261,6 +299,8 @@ def rates(model, t, y, tensions=None, scheme="upwind"):
         tensions = np.array([c.tension_at(t) for c in model.cables])
 
     q_t, k_t = strain_rates(q, k, v, w, v0, w0, ds, data.centred)
+    if any(c.friction > 0 for c in model.cables):  # tension per cell
+        tensions = np.asarray(tensions, dtype=float)[:, None] * friction_factors(model, data, q, k, v, w, v0, w0)
     _, _, n_tot, m_tot = stresses(data, q, k, q_t, k_t, tensions)
 
     # Velocity nodes 1..N: differences of the total stress of the cells

@@ -40,6 +40,10 @@ def _models():
             rodmol.Cable(lambda s: (0.003 * np.cos(20 * s), 0.003 * np.sin(20 * s)), 0.3, 0.8, name="helix"),
             rodmol.Cable([(0.0, 0.008, 0.0), (0.2, 0.002, 0.001), (0.4, 0.0, 0.002)], L, 0.5, name="knots"),
             rodmol.Cable((0.0, 0.03), 0.25, 0.3, name="disks", outside_body=True)]),
+        "friction (routed, moving base)": rodmol.Model(paper_rod(), 8, medium="water", base=WAVY_BASE, cables=[
+            rodmol.Cable((0.006, 0.002), 0.3, 1.2, name="a", friction=0.3, slip_speed=0.01),
+            rodmol.Cable([(0.0, -0.008, 0.0), (L, -0.002, 0.002)], L, 0.7, name="b", friction=0.1),
+            rodmol.Cable((0.0, 0.005), 0.2, 0.4, name="c")]),
         "componentwise drag": arm(7, tensions={11: 1.0}, drag_law="componentwise",
                                   drag_coefficients=(0.3, 2.0, 5.0)),
         "per-component viscosity": rodmol.Model(rodmol.Rod(0.3, (0.01, 0.006), rodmol.Material(
