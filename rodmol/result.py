@@ -65,8 +65,9 @@ class Result:
     cable_lengths : (n_t, n_cables) path length of each cable from the base to
         its anchor [m] (actuator space: add ``base_to_actuator`` for the
         tendon's length from its actuator).
-    actuator_positions : (n_t, n_cables) actuator position z(t) [m] of the
-        displacement-controlled cables, NaN for tension-driven ones.
+    actuator_positions : (n_t, n_actuated) actuator position z(t) [m] of the
+        displacement-controlled cables, in their order among the cables
+        (named by ``meta["actuators"]``).
     quaternion_norm_error : (n_t,) max over nodes of ||Q| - 1|.
     markers : (n_t, n_markers, 3) marker positions [m], global; their names
         are ``meta["markers"]``.
@@ -148,8 +149,8 @@ def from_states(system, t, y, success, message, stats):
     tensions = np.array([system.tensions(ti, yi) for ti, yi in zip(t, y)]).reshape(n_t, -1)
     q_all, k_all = layout.field(y, "q"), layout.field(y, "k")
     lengths = np.array([system.routing.lengths(q_all[i], k_all[i]) for i in range(n_t)]).reshape(n_t, -1)
-    actuators = np.array([[c.displacement.value(ti) if c.actuated else np.nan for c in model.cables]
-                          for ti in t]).reshape(n_t, -1)
+    actuated = [c for c in model.cables if c.actuated]
+    actuators = np.array([[c.displacement.value(ti) for c in actuated] for ti in t]).reshape(n_t, len(actuated))
     arrays = dict(
         t=t, s=model.s_nodes, radius=model.rod.radius_at(model.s_nodes), tensions=tensions,
         cable_lengths=lengths, actuator_positions=actuators,
@@ -163,6 +164,7 @@ def from_states(system, t, y, success, message, stats):
                 cables=[dict(name=c.name, offset=c.offset_at(0.0)[0].tolist(), anchor=c.anchor,
                              node_offsets=c.offset_at(model.s_nodes).tolist())
                         for c in model.cables],
+                actuators=[c.name for c in actuated],
                 markers=[dict(name=mk.name, s=mk.s, offset=list(model.marker_offsets[i, 1:]))
                          for i, mk in enumerate(model.markers)],
                 loads=[repr(load) for load in model.loads])
