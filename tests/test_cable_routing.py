@@ -57,7 +57,7 @@ def exact_strains(offset, slope, s_points):
         p = np.r_[0.0, offset(s)]
         dp = np.r_[0.0, slope(s)]
 
-        def residual(x):
+        def residual(x, p=p, dp=dp):
             q, k = x[:3], x[3:]
             c = q + np.cross(k, p) + dp
             tau = c / np.linalg.norm(c)

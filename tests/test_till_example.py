@@ -32,7 +32,7 @@ import rodmol
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "till_tendon_robot.py"
 E, G, RADIUS, L, MASS = 207e9, 207e9 / 2.6, 0.00135 / 2, 0.7144, 0.034
-AREA, I = np.pi * RADIUS**2, np.pi * RADIUS**4 / 4
+AREA, J = np.pi * RADIUS**2, np.pi * RADIUS**4 / 4
 WEIGHT = MASS / L * 9.81  # N/m, along -y
 P, BASE_TO_MOTOR, COMPLIANCE = 0.01506, 0.0518, 1e-4
 TILL_STATIC, HELD_Z = -0.1493, -0.01619
@@ -52,7 +52,7 @@ def _strains(n, m, tension, guess):
         norm = np.hypot(c1, c2)
         return [(E * AREA * (q1 - 1) + tension * c1 / norm - n[0]) / (E * AREA),
                 (G * AREA * q2 + tension * c2 / norm - n[1]) / (E * AREA),
-                (E * I * kappa - P * tension * c1 / norm - m) / (E * I)]
+                (E * J * kappa - P * tension * c1 / norm - m) / (E * J)]
     with warnings.catch_warnings():  # "no further improvement": converged to round-off
         warnings.simplefilter("ignore", RuntimeWarning)
         return fsolve(residual, guess, xtol=1e-12)

@@ -24,7 +24,7 @@ import re
 from dataclasses import replace
 
 from .. import _checks
-from ..cables import Cable, Tension, as_tension
+from ..cables import Tension, as_tension
 from ..discretise.schemes import DEFAULT_SCHEME, get_scheme
 from ..errors import ParameterError
 from ..inputs import TimeInput

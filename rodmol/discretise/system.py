@@ -13,8 +13,8 @@ interface (``size``, ``__call__``, ``layout``, ``pattern``, ``bandwidths``,
 import numpy as np
 
 from . import centreline, external, rotations, stencil
-from .routing import CableRouting
 from .layout import StateLayout, merge
+from .routing import CableRouting
 from .schemes import DEFAULT_SCHEME, get_scheme
 
 #: Rate [1/s] at which the quaternion norm is pulled back to 1; the exact

@@ -166,7 +166,6 @@ def friction_factors(model, data, q, k, v, w, v0, w0):
     cell (strain rates of the compatibility laws with centred velocities),
     and the wrap to the middle of the cell."""
     n, ds = data.n, data.ds
-    v_prev, w_prev = np.vstack([v0, v[:-1]]), np.vstack([w0, w[:-1]])
     q_t, k_t = strain_rates(q, k, v, w, v0, w0, ds, centred=True)
     factors = np.ones((len(model.cables), n))
     for j, cable in enumerate(model.cables):
