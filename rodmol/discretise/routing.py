@@ -65,3 +65,15 @@ class CableRouting:
         turn = self.friction[:, None] * sigma * kappa * self.weights * self.ds
         exponent = np.cumsum(turn, axis=1) - 0.5 * turn  # to the middle of each cell
         return np.exp(-exponent)
+
+    def friction_factors_of(self, q, k, v, w, base_velocities):
+        """:meth:`friction_factors` of a state: strains q, k and velocities v, w
+        (N, 3), base velocities (v0, w0) (6,); the strain rates come from the
+        compatibility laws with the velocities averaged over each cell (in
+        both schemes: they only give the sliding direction)."""
+        v_prev = np.vstack([base_velocities[:3], v[:-1]])
+        w_prev = np.vstack([base_velocities[3:], w[:-1]])
+        v_bar, w_bar = 0.5 * (v + v_prev), 0.5 * (w + w_prev)
+        q_t = (v - v_prev) / self.ds + np.cross(k, v_bar) - np.cross(w_bar, q)
+        k_t = (w - w_prev) / self.ds + np.cross(k, w_bar)
+        return self.friction_factors(q, k, q_t, k_t)

@@ -216,18 +216,11 @@ class SemiDiscrete:
         """Tension along each cable over its tension at the base, (n_cables, N),
         for the state ``y`` (all ones at rest or without friction; reads the
         base velocities of the last :meth:`update_inputs`)."""
-        routing, n = self.routing, self.model.n_elements
         if y is None or not self.model.friction:
-            return np.ones((len(self.model.cables), n))
-        q, k = self.layout.field(y, "q"), self.layout.field(y, "k")
-        v, w = self.layout.field(y, "v"), self.layout.field(y, "w")
-        # Strain rates by the compatibility laws (centred: a direction estimate).
-        v_prev = np.vstack([self.base_velocities[:3], v[:-1]])
-        w_prev = np.vstack([self.base_velocities[3:], w[:-1]])
-        v_bar, w_bar = 0.5 * (v + v_prev), 0.5 * (w + w_prev)
-        q_t = (v - v_prev) / self.model.ds + np.cross(k, v_bar) - np.cross(w_bar, q)
-        k_t = (w - w_prev) / self.model.ds + np.cross(k, w_bar)
-        return routing.friction_factors(q, k, q_t, k_t)
+            return np.ones((len(self.model.cables), self.model.n_elements))
+        lay = self.layout
+        return self.routing.friction_factors_of(lay.field(y, "q"), lay.field(y, "k"), lay.field(y, "v"),
+                                                lay.field(y, "w"), self.base_velocities)
 
     def kernel_arguments(self):
         """Arguments of :func:`rodmol.discretise.stencil.rhs` after (y, out):
