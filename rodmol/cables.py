@@ -1,4 +1,5 @@
-"""Cables: routing (constant offset in the section, anchor arc length) and tension inputs.
+"""Cables: routing (offset in the section, anchor arc length), tension inputs,
+displacement control (:class:`ActuatorTension`) and friction.
 
 A tension input is any of
 
@@ -25,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from . import _checks
+from . import _checks, cable_routing
 from .errors import ParameterError, RodmolError
 from .inputs import Knots, TimeInput, as_time_input, read_table
 
@@ -92,43 +93,161 @@ def _required_arguments(function):
     return sum(1 for p in parameters if p.kind in kinds and p.default is inspect.Parameter.empty)
 
 
+class ActuatorTension(Tension):
+    """The tension of a displacement-controlled cable (Till, Aloi and Rucker's
+    tendon model): the tendon runs from an actuator at ``base_to_actuator`` [m]
+    behind the base along the cable path to the anchor; its unstretched length
+    there is l = rest_length + z(t) (z [m] the actuator position, negative
+    when it reels in), and it stretches by compliance [1/N] x l x T, so
+
+        T = max(0, (path length + base_to_actuator - l) / (l x compliance)),
+
+    slack (T = 0) when the path is shorter than the free tendon. It reads the
+    path length of the state (``StateView.cable_length``), so it is a
+    feedback law; without a state it assumes the straight rod.
+    """
+
+    feedback = True
+    constant = None
+
+    def __init__(self, name, position, compliance, base_to_actuator, rest_length, straight_length):
+        self.name, self.position = name, position
+        self.compliance, self.base_to_actuator = compliance, base_to_actuator
+        self.rest_length, self.straight_length = rest_length, straight_length
+
+    def free_length(self, t):
+        """Unstretched tendon length [m] between the actuator and the anchor at t."""
+        return self.rest_length + self.position.value(t)
+
+    def from_length(self, t, length):
+        """Tension [N] for a cable path length ``length`` [m] at t."""
+        free = self.free_length(t)
+        return max(0.0, (length + self.base_to_actuator - free) / (free * self.compliance))
+
+    def __call__(self, t, state=None):
+        length = self.straight_length if state is None else state.cable_length(self.name)
+        return self.from_length(t, length)
+
+    def __repr__(self):
+        return (f"ActuatorTension(z={self.position!r}, compliance={self.compliance!r}, "
+                f"base_to_actuator={self.base_to_actuator!r}, rest_length={self.rest_length!r})")
+
+
 @dataclass(frozen=True)
 class Cable:
-    """A cable at a constant offset in the section, pulled from the base.
+    """A cable pulled from the base, by a tension or by an actuator's displacement.
 
     Parameters
     ----------
-    offset : (float, float)
-        (p_y, p_z) [m]: the cable's position in the section, local frame.
+    offset : (p_y, p_z), [(s, p_y, p_z), ...] or callable p(s)
+        The routing [m], local frame: constant, knots or a function of the
+        arc length (:mod:`rodmol.cable_routing`).
     anchor : float
         Arc length s_bar [m] of the anchor, in (0, L].
     tension : tension input
-        See the module docstring; negative tensions are errors.
+        See the module docstring; negative tensions are errors. Default 0
+        (slack). Not with ``displacement``.
     name : str, optional
         Used in messages and outputs.
+    outside_body : bool, keyword-only
+        The cable runs on spacer disks: offsets beyond the section radius are
+        allowed (refused by default).
+    displacement : time input, keyword-only
+        Actuator position z(t) [m] (constant, ``(t, z)`` knots, CSV path or
+        callable of t), negative when the actuator reels the cable in: the
+        tension then follows from the path length (:class:`ActuatorTension`).
+    compliance : float, keyword-only
+        Tendon compliance [1/N] (stretch per unit length per newton), > 0;
+        with ``displacement`` only.
+    base_to_actuator : float, keyword-only
+        Tendon length [m] from the actuator to the base, >= 0.
+    rest_length : float, keyword-only
+        Unstretched tendon length [m] from the actuator to the anchor at
+        z = 0; default: the path length on the straight rod plus
+        ``base_to_actuator`` (slack-free and unloaded when straight).
+    friction : float, keyword-only
+        Coefficient of friction [-] between the cable and the body (capstan
+        law, see docs/model.md), >= 0; 0 (default) is frictionless.
+    slip_speed : float, keyword-only
+        Sliding speed [m/s] below which friction is regularised (its
+        direction fades linearly to zero), > 0; default 1e-4 m/s.
     """
 
     offset: Any
     anchor: float
-    tension: Any = 0.0
+    tension: Any = None
     name: str = field(default="cable")
+    outside_body: bool = field(default=False, kw_only=True)
+    displacement: Any = field(default=None, kw_only=True)
+    compliance: float | None = field(default=None, kw_only=True)
+    base_to_actuator: float = field(default=0.0, kw_only=True)
+    rest_length: float | None = field(default=None, kw_only=True)
+    friction: float = field(default=0.0, kw_only=True)
+    slip_speed: float = field(default=1e-4, kw_only=True)
 
     def __post_init__(self):
-        p = _checks.floats(self.offset)
-        if p is None or p.shape != (2,) or not np.all(np.isfinite(p)):
-            raise ParameterError(
-                f"cable {_checks.short(self.name)}: `offset` must be (p_y, p_z) in m, got "
-                f"{_checks.short(self.offset)}"
-            )
-        object.__setattr__(self, "offset", (float(p[0]), float(p[1])))
-        object.__setattr__(self, "anchor", _checks.positive(f"cable {self.name!r} anchor",
-                                                             self.anchor, " m"))
-        object.__setattr__(self, "tension", as_tension(self.tension, f"cable {self.name!r} tension"))
+        label = f"cable {self.name!r}"
+        object.__setattr__(self, "offset", cable_routing.as_offset(self.offset, self.name))
+        object.__setattr__(self, "anchor", _checks.positive(f"{label} anchor", self.anchor, " m"))
+        object.__setattr__(self, "outside_body", bool(self.outside_body))
+        object.__setattr__(self, "friction", _checks.non_negative(f"{label} friction", self.friction))
+        object.__setattr__(self, "slip_speed", _checks.positive(f"{label} slip_speed", self.slip_speed, " m/s"))
+        self.offset_at(np.linspace(0.0, self.anchor, 65))  # a failing offset function fails here
+        if self.displacement is None:
+            for key in ("compliance", "rest_length"):
+                if getattr(self, key) is not None:
+                    raise ParameterError(f"{label}: `{key}` belongs to a displacement-controlled cable "
+                                         f"(give `displacement`), got {getattr(self, key)!r}")
+            if self.base_to_actuator != 0.0:
+                raise ParameterError(f"{label}: `base_to_actuator` belongs to a displacement-controlled "
+                                     f"cable (give `displacement`), got {self.base_to_actuator!r}")
+            tension = 0.0 if self.tension is None else self.tension
+            object.__setattr__(self, "tension", as_tension(tension, f"{label} tension"))
+        else:
+            self._actuate(label)
+
+    def _actuate(self, label):
+        if self.tension is not None and not isinstance(self.tension, ActuatorTension):
+            raise ParameterError(f"{label}: give either `tension` or `displacement`, not both "
+                                 f"(got tension={_checks.short(self.tension)})")
+        position = self.displacement
+        if isinstance(position, ActuatorTension):
+            position = position.position
+        position = as_time_input(f"{label} displacement", position, 1, "m")
+        if self.compliance is None:
+            raise ParameterError(f"{label}: a displacement-controlled cable needs `compliance` [1/N] > 0")
+        compliance = _checks.positive(f"{label} compliance", self.compliance, " 1/N")
+        base = _checks.non_negative(f"{label} base_to_actuator", self.base_to_actuator, " m")
+        straight = self.straight_length()
+        rest = straight + base if self.rest_length is None else _checks.positive(
+            f"{label} rest_length", self.rest_length, " m")
+        object.__setattr__(self, "displacement", position)
+        object.__setattr__(self, "compliance", compliance)
+        object.__setattr__(self, "base_to_actuator", base)
+        object.__setattr__(self, "rest_length", rest)
+        object.__setattr__(self, "tension", ActuatorTension(self.name, position, compliance, base, rest,
+                                                            straight))
+
+    @property
+    def actuated(self):
+        """True for a displacement-controlled cable."""
+        return self.displacement is not None
 
     @property
     def offset3(self):
-        """Offset p = (0, p_y, p_z) [m], local frame."""
-        return np.array([0.0, *self.offset])
+        """Offset p = (0, p_y, p_z) [m] at the base, local frame."""
+        return np.array([0.0, *self.offset_at(0.0)[0]])
+
+    def offset_at(self, s):
+        """(p_y, p_z) [m] at arc lengths ``s`` [m], array (len(s), 2), local frame."""
+        return cable_routing.offset_at(self.offset, s, self.name)
+
+    def straight_length(self):
+        """Path length [m] from the base to the anchor on the straight rod,
+        integral of sqrt(1 + |p'|^2) (2000 intervals)."""
+        s = np.linspace(0.0, self.anchor, 2001)
+        p = self.offset_at(s)
+        return float(np.sum(np.sqrt(np.diff(s) ** 2 + np.sum(np.diff(p, axis=0) ** 2, axis=1))))
 
     def tension_at(self, t, state=None):
         """Tension [N] at time t; a negative value is an error naming the cable."""

@@ -60,6 +60,14 @@ class Model:
         Add the Munk moment of the added-mass model (off in the paper).
     markers : sequence of Marker
         Surface points whose trajectories the result carries.
+    drag_law : str
+        ``"morison"`` (default): the paper's -rho_w |v| D v from the medium's
+        coefficients (eq. 8); ``"componentwise"``: -C v|v| per local
+        component, C = ``drag_coefficients`` (Till's tendon robot), in place
+        of the medium's drag.
+    drag_coefficients : (float, float, float)
+        C [kg/m^2] of the componentwise law, local frame (axial, y, z); force
+        per unit length.
 
     The sampled sectional arrays (``kl``, ``kth``, ``vl``, ``vth``, ``mass``,
     ``inertia``, ``net_mass``, ``drag_coefficient``, ``added``,
@@ -73,7 +81,8 @@ class Model:
 
     def __init__(self, rod, n_elements, *, gravity=(0.0, -9.81, 0.0), medium=None,
                  medium_density=0.0, cables=(), base=None, drag=True, added_mass=True,
-                 viscosity=True, munk_moment=False, markers=(), loads=()):
+                 viscosity=True, munk_moment=False, markers=(), loads=(), drag_law="morison",
+                 drag_coefficients=None):
         if not isinstance(rod, Rod):
             raise ParameterError(f"`rod` must be a rodmol.Rod, got {rod!r}")
         self.rod = rod
@@ -91,6 +100,7 @@ class Model:
             raise ParameterError(f"`base` must be a rodmol.BaseMotion or None, got {base!r}")
         self.drag, self.added_mass = bool(drag), bool(added_mass)
         self.viscosity, self.munk_moment = bool(viscosity), bool(munk_moment)
+        self.drag_law, self.drag_coefficients = _drag_law(drag_law, drag_coefficients)
         self._check_cables()
         self.loads = tuple(loads)
         for i, load in enumerate(self.loads):
@@ -115,7 +125,8 @@ class Model:
         options = dict(gravity=tuple(self.gravity), medium=self.medium, cables=self.cables,
                        base=self.base, drag=self.drag, added_mass=self.added_mass,
                        viscosity=self.viscosity, munk_moment=self.munk_moment,
-                       markers=self.markers, loads=self.loads)
+                       markers=self.markers, loads=self.loads, drag_law=self.drag_law,
+                       drag_coefficients=self.drag_coefficients)
         return (_rebuild, (type(self), self.rod, self.n_elements, options))
 
     def __repr__(self):
@@ -132,21 +143,28 @@ class Model:
         """True if a cable tension reads the state."""
         return any(c.tension.feedback for c in self.cables)
 
+    @property
+    def friction(self):
+        """True if a cable rubs on the body (``Cable(friction=...)`` > 0)."""
+        return any(c.friction > 0.0 for c in self.cables)
+
     def _check_cables(self):
         L = self.rod.length
         for c in self.cables:
             if c.anchor > L * (1 + 1e-12):
                 raise ParameterError(
                     f"cable {c.name!r}: `anchor` must lie in (0, L = {L!r} m], got {c.anchor!r}")
+            if c.outside_body:
+                continue
             s = np.linspace(0.0, min(c.anchor, L), 2001)
             r = self.rod.radius_at(s)
-            reach = np.hypot(*c.offset)
+            reach = np.hypot(*c.offset_at(s).T)
             if np.any(reach >= r):
-                where = s[np.argmax(reach >= r)]
+                i = int(np.argmax(reach >= r))
                 raise ParameterError(
-                    f"cable {c.name!r}: offset {c.offset} m (|p| = {reach:.6g} m) lies outside "
-                    f"the body at s = {where:.6g} m where the radius is "
-                    f"{self.rod.radius_at(where):.6g} m")
+                    f"cable {c.name!r}: offset {tuple(c.offset_at(s[i])[0].tolist())} m (|p| = {reach[i]:.6g} m) "
+                    f"lies outside the body at s = {s[i]:.6g} m where the radius is "
+                    f"{r[i]:.6g} m (a cable on spacer disks: Cable(..., outside_body=True))")
 
     def _sample(self):
         """Sample every sectional quantity on the grid (done once)."""
@@ -163,9 +181,12 @@ class Model:
         self.mass = rho * a[:, None] + self.added
         self.inertia = rho * rod.second_moments(s_vel)
         self.net_mass = (rho - med.rho) * a
-        self.drag_coefficient = (
-            med.rho * r[:, None] * np.array([0.5 * np.pi * med.Cx, med.Cy, med.Cz])
-            if self.drag else np.zeros((n, 3)))
+        if not self.drag:
+            self.drag_coefficient = np.zeros((n, 3))
+        elif self.drag_law == "componentwise":
+            self.drag_coefficient = np.tile(self.drag_coefficients, (n, 1))
+        else:
+            self.drag_coefficient = med.rho * r[:, None] * np.array([0.5 * np.pi * med.Cx, med.Cy, med.Cz])
 
         # Fraction of each strain node's cell on the cable path: moving the
         # anchor inside a cell shifts its concentrated load smoothly between
@@ -216,6 +237,7 @@ def _check_no_inline_functions(model):
     """Refuse to pickle inputs given as lambdas or local functions, naming them:
     pickle stores functions by name, so these cannot reach another process."""
     inputs = [(f"cable {c.name!r} tension", c.tension) for c in model.cables]
+    inputs += [(f"cable {c.name!r} offset", c.offset) for c in model.cables if callable(c.offset)]
     inputs += [(f"base {k}", getattr(model.base, k)) for k in ("velocity", "angular_velocity")]
     inputs += [(f"load {getattr(x, 'name', x)!r}", x) for x in model.loads]
     for label, value in inputs:
@@ -232,11 +254,32 @@ def _inline_function(value, depth=3):
     name = getattr(value, "__qualname__", "") if callable(value) else ""
     if "<lambda>" in name or "<locals>" in name:
         return name
-    for attr in ("function", "signal", "force", "moment") if depth else ():
+    for attr in ("function", "signal", "force", "moment", "position") if depth else ():
         found = _inline_function(getattr(value, attr, None), depth - 1)
         if found:
             return found
     return None
+
+
+#: Drag laws a Model accepts (``drag_law``).
+DRAG_LAWS = ("morison", "componentwise")
+
+
+def _drag_law(law, coefficients):
+    """(law, coefficients (3,) [kg/m^2] or None), checked."""
+    if law not in DRAG_LAWS:
+        raise ParameterError(f"unknown `drag_law` {law!r}; choose one of {', '.join(map(repr, DRAG_LAWS))}")
+    if law == "morison":
+        if coefficients is not None:
+            raise ParameterError("`drag_coefficients` belong to drag_law='componentwise' (the Morison "
+                                 f"law takes its coefficients from the medium), got {_checks.short(coefficients)}")
+        return law, None
+    if coefficients is None:
+        raise ParameterError("drag_law='componentwise' needs `drag_coefficients` (C_x, C_y, C_z) [kg/m^2]")
+    c = _checks.vector3("drag_coefficients", coefficients)
+    if np.any(c < 0):
+        raise ParameterError(f"`drag_coefficients` must be >= 0 kg/m^2, got {_checks.short(coefficients)}")
+    return law, tuple(float(x) for x in c)
 
 
 def _medium(medium, medium_density):

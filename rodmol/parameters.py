@@ -2,6 +2,8 @@
 
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from . import _checks
 from .errors import ParameterError
 
@@ -25,6 +27,17 @@ class Material:
         Shear modulus [Pa], instead of ``nu`` (for example a Timoshenko beam
         with G = E / 100). Give exactly one of ``nu`` and ``G``; ``nu`` is
         then reported as E / (2 G) - 1.
+    viscosity : dict, optional, keyword-only
+        Kelvin-Voigt viscosities per strain component [Pa s], instead of the
+        paper's ratios: ``shear_extension=(eta_x, eta_y, eta_z)`` gives
+        Vl = A diag(eta) (extension along the local x axis, then the two
+        shears), ``bending_torsion=(eta_x, eta_y, eta_z)`` gives
+        Vth = diag(Jx eta_x, Jy eta_y, Jz eta_z) (torsion, then the two
+        bendings). A key left out keeps the paper's values from ``mu``:
+        (3 mu, mu, mu) and (mu, 3 mu, 3 mu). So
+        ``viscosity=dict(shear_extension=(0, 0, 0))`` with mu > 0 damps
+        bending and torsion only. A sectional damping matrix B [N s or
+        N m^2 s] of a constant section is ``B / A`` or ``B / J`` here.
     """
 
     E: float
@@ -32,6 +45,7 @@ class Material:
     mu: float = 0.0
     rho: float | None = None
     G: float | None = field(default=None, kw_only=True)
+    viscosity: dict | None = field(default=None, kw_only=True)
 
     def __post_init__(self):
         object.__setattr__(self, "E", _checks.positive("E", self.E, " Pa"))
@@ -51,6 +65,48 @@ class Material:
         else:
             object.__setattr__(self, "G", _checks.positive("G", self.G, " Pa"))
             object.__setattr__(self, "nu", self.E / (2.0 * self.G) - 1.0)
+        if self.viscosity is not None:
+            object.__setattr__(self, "viscosity", _component_viscosities(self.viscosity))
+
+    @property
+    def viscosities(self):
+        """(eta_l, eta_th): the Kelvin-Voigt viscosities [Pa s] of the strain
+        components, local frame order (extension, shear y, shear z) and
+        (torsion, bending y, bending z); Vl = A eta_l, Vth = J eta_th."""
+        given = self.viscosity or {}
+        paper = {"shear_extension": (3.0 * self.mu, self.mu, self.mu),
+                 "bending_torsion": (self.mu, 3.0 * self.mu, 3.0 * self.mu)}
+        return tuple(np.array(given.get(key, paper[key]), dtype=float) for key in VISCOSITY_KEYS)
+
+    def relaxation_times(self):
+        """Kelvin-Voigt relaxation time eta / modulus [s] of each strain
+        component (extension, shear y, shear z, torsion, bending y, bending z)."""
+        eta_l, eta_th = self.viscosities
+        moduli = np.array([self.E, self.G, self.G, self.G, self.E, self.E])
+        return np.concatenate([eta_l, eta_th]) / moduli
+
+
+#: Keys of ``Material(viscosity=...)``.
+VISCOSITY_KEYS = ("shear_extension", "bending_torsion")
+
+
+def _component_viscosities(value):
+    """The ``viscosity`` dict checked: known keys, three finite values >= 0 [Pa s] each."""
+    if not isinstance(value, dict):
+        raise ParameterError("`viscosity` must be a dict with keys "
+                             f"{', '.join(VISCOSITY_KEYS)}, got {_checks.short(value)}")
+    unknown = sorted(set(value) - set(VISCOSITY_KEYS))
+    if unknown:
+        raise ParameterError(f"unknown `viscosity` key {unknown[0]!r}; valid keys are "
+                             f"{', '.join(VISCOSITY_KEYS)}")
+    checked = {}
+    for key, eta in value.items():
+        arr = _checks.floats(eta)
+        if arr is None or arr.shape != (3,) or not np.all(np.isfinite(arr)) or np.any(arr < 0):
+            raise ParameterError(f"`viscosity[{key!r}]` must be three finite numbers >= 0 Pa s, "
+                                 f"got {_checks.short(eta)}")
+        checked[key] = tuple(float(x) for x in arr)
+    return checked
 
 
 @dataclass(frozen=True)

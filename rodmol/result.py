@@ -30,6 +30,8 @@ ARRAYS = {
     "external_force": "N/m, global",
     "external_moment": "N m/m, global",
     "tensions": "N",
+    "cable_lengths": "m",
+    "actuator_positions": "m",
     "quaternion_norm_error": "-",
     "markers": "m, global",
 }
@@ -60,7 +62,13 @@ class Result:
     external_force, external_moment : (n_t, N+1, 3) external load densities
         [N/m, N m/m] at the nodes, global frame (point loads appear as their
         share over the node's ``node_length``; node 0, the clamp, carries none).
-    tensions : (n_t, n_cables) cable tensions [N].
+    tensions : (n_t, n_cables) cable tensions [N] (where the cable leaves the base).
+    cable_lengths : (n_t, n_cables) path length of each cable from the base to
+        its anchor [m] (actuator space: add ``base_to_actuator`` for the
+        tendon's length from its actuator).
+    actuator_positions : (n_t, n_actuated) actuator position z(t) [m] of the
+        displacement-controlled cables, in their order among the cables
+        (named by ``meta["actuators"]``).
     quaternion_norm_error : (n_t,) max over nodes of ||Q| - 1|.
     markers : (n_t, n_markers, 3) marker positions [m], global; their names
         are ``meta["markers"]``.
@@ -149,12 +157,17 @@ def from_states(system, t, y, success, message, stats):
     integration), by the same compiled kernel as the integration. Until then
     the result holds the system and the states, and pickles as them.
     """
-    layout = system.layout
+    model, layout = system.model, system.layout
     n_t = len(t)
     quat_all = layout.quaternions(y)
     tensions = np.array([system.tensions(ti, yi) for ti, yi in zip(t, y)]).reshape(n_t, -1)
+    q_all, k_all = layout.field(y, "q"), layout.field(y, "k")
+    lengths = np.array([system.routing.lengths(q_all[i], k_all[i]) for i in range(n_t)]).reshape(n_t, -1)
+    actuated = [c for c in model.cables if c.actuated]
+    actuators = np.array([[c.displacement.value(ti) for c in actuated] for ti in t]).reshape(n_t, len(actuated))
     arrays = dict(
         t=t, tensions=tensions, **static_arrays(system),
+        cable_lengths=lengths, actuator_positions=actuators,
         states=np.asarray(y),
         quaternion_norm_error=np.max(np.abs(np.linalg.norm(quat_all, axis=-1) - 1.0), axis=-1),
     )
@@ -171,11 +184,14 @@ def static_arrays(system):
 
 
 def run_meta(system):
-    """The ``meta`` of a Result of ``system``: sizes, scheme, cables, markers and loads."""
+    """The ``meta`` of a Result of ``system``: sizes, scheme, cables, actuators, markers and loads."""
     model = system.model
+    actuated = [c for c in model.cables if c.actuated]
     return dict(n_elements=model.n_elements, length=model.rod.length, scheme=system.scheme.name,
-                cables=[dict(name=c.name, offset=list(c.offset), anchor=c.anchor)
+                cables=[dict(name=c.name, offset=c.offset_at(0.0)[0].tolist(), anchor=c.anchor,
+                             node_offsets=c.offset_at(model.s_nodes).tolist())
                         for c in model.cables],
+                actuators=[c.name for c in actuated],
                 markers=[dict(name=mk.name, s=mk.s, offset=list(model.marker_offsets[i, 1:]))
                          for i, mk in enumerate(model.markers)],
                 loads=[repr(load) for load in model.loads])
@@ -199,9 +215,13 @@ def _mechanics(system, t, y, tensions):
     for c in range(len(model.cables)):
         if model.cable_weights[c, -1] != 1.0:
             continue
-        p = tuple(model.cable_offsets[c])
+        p, dp = tuple(system.routing.geometry[c, -1, :3]), tuple(system.routing.geometry[c, -1, 3:])
         for i in range(n_t):
-            n_a, m_a = physics.cable_stress(tuple(q[i, -1]), tuple(k[i, -1]), p, tensions[i, c])
+            tension = tensions[i, c]
+            if model.friction:  # the tension that reaches the tip cell
+                system.update_inputs(float(t[i]), y[i])
+                tension = tension * system.friction_factors(y[i])[c, -1]
+            n_a, m_a = physics.cable_stress(tuple(q[i, -1]), tuple(k[i, -1]), p, dp, tension)
             n_tip[i] -= n_a
             m_tip[i] -= m_a
     kl_tip, kth_tip = model.rod.stiffness(model.rod.length)

@@ -105,9 +105,13 @@ class Rod:
         return kl, kth
 
     def viscosity(self, s):
-        """Kelvin-Voigt diagonals Vl = mu (3A, A, A), Vth = mu (Jx, 3Jy, 3Jz) [N s, N m^2 s]."""
+        """Kelvin-Voigt diagonals Vl = mu (3A, A, A), Vth = mu (Jx, 3Jy, 3Jz) [N s, N m^2 s],
+        or A eta_l, J eta_th with the material's per-component viscosities."""
         mu = self.material.mu
         a = self.area(s)[..., None]
+        if self.material.viscosity is not None:
+            eta_l, eta_th = self.material.viscosities
+            return a * eta_l, self.second_moments(s) * eta_th
         vl = mu * a * np.array([3.0, 1.0, 1.0])
         vth = mu * self.second_moments(s) * np.array([1.0, 3.0, 3.0])
         return vl, vth

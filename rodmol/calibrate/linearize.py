@@ -4,7 +4,7 @@ import numpy as np
 
 from ..cables import Cable
 from ..discretise.schemes import DEFAULT_SCHEME
-from ..discretise.system import SemiDiscrete, StateView
+from ..discretise.system import SemiDiscrete
 from ..errors import ParameterError
 from ..model import Model
 
@@ -43,14 +43,15 @@ def linearize(model, state, t=0.0, scheme=DEFAULT_SCHEME):
     layout_size = probe.size
     if y.shape != (layout_size,) or not np.all(np.isfinite(y)):
         raise ParameterError(f"`state` must be {layout_size} finite numbers (the state size), got shape {y.shape}")
-    tensions = model.tensions(t, StateView(probe.layout, t, y, model.ds) if model.feedback else None)
+    tensions = model.tensions(t, probe.state_view(t, y) if model.feedback else None)
     # The same model with every cable active and its tension set by hand: a
     # constant nonzero tension keeps each cable in the kernel.
     held = Model(model.rod, model.n_elements, gravity=model.gravity, medium=model.medium,
-                 cables=[Cable(c.offset, c.anchor, 1.0, name=c.name) for c in model.cables],
+                 cables=[Cable(c.offset, c.anchor, 1.0, name=c.name, outside_body=c.outside_body)
+                         for c in model.cables],
                  base=model.base, drag=model.drag, added_mass=model.added_mass,
                  viscosity=model.viscosity, munk_moment=model.munk_moment, markers=model.markers,
-                 loads=model.loads)
+                 loads=model.loads, drag_law=model.drag_law, drag_coefficients=model.drag_coefficients)
     system = SemiDiscrete(held, scheme)
     system.tension_values[:] = tensions
     a = system.jacobian(system.atol_scale(), matrix="dense").dense(t, y)

@@ -24,7 +24,7 @@ import re
 from dataclasses import replace
 
 from .. import _checks
-from ..cables import Cable, Tension, as_tension
+from ..cables import Tension, as_tension
 from ..discretise.schemes import DEFAULT_SCHEME, get_scheme
 from ..errors import ParameterError
 from ..inputs import TimeInput
@@ -131,7 +131,8 @@ def apply(spec, overrides):
     new_model = _guard("overrides", changes, lambda: Model(
         Rod(model.rod.length, model.rod.radius, material), n_elements, gravity=model.gravity,
         medium=medium, cables=cables, base=model.base, viscosity=model.viscosity,
-        markers=model.markers, loads=model.loads, **switches))
+        markers=model.markers, loads=model.loads, drag_law=model.drag_law,
+        drag_coefficients=model.drag_coefficients, **switches))
     solver = dict(spec.solver)
     t_end = spec.t_end
     for name, value in groups["solver"].items():
@@ -204,13 +205,14 @@ def _cable(cable, change):
         if isinstance(signal, ScaledTension):  # scale the original, not a scaled copy
             signal = signal.signal
         tension = Tension(ScaledTension(signal, scale, offset))
-    return Cable(cable.offset, cable.anchor, tension, name=cable.name)
+    return replace(cable, tension=tension)
 
 
 def _material(material, changes):
     values = {k: changes.get(k, getattr(material, k)) for k in ("E", "mu", "rho")}
     if "G" in changes and "nu" in changes:
         raise ParameterError("give either `material.nu` or `material.G`, not both")
+    values["viscosity"] = material.viscosity
     if "G" in changes:
         return Material(**values, G=changes["G"])
     return Material(**values, nu=changes.get("nu", material.nu))

@@ -137,14 +137,15 @@ def kelvin_voigt(kl, kth, vl, vth, q, k, q_t, k_t):
 
 
 @jit
-def cable_stress(q, k, p, tension):
-    """Actuation stress of a cable at offset p pulled with ``tension`` [N]:
-    N_a = T tau, M_a = p x N_a, tau = (q + k x p) / |q + k x p|.
+def cable_stress(q, k, p, dp, tension):
+    """Actuation stress of a cable at offset p (slope p' = ``dp`` along s)
+    pulled with ``tension`` [N]: N_a = T tau, M_a = p x N_a,
+    tau = (q + k x p + p') / |q + k x p + p'|.
 
     Its divergence in the balance laws is exactly the distributed load along
     the cable path plus the concentrated load at the anchor (docs/model.md).
     """
-    c = add(q, cross(k, p))
+    c = add(add(q, cross(k, p)), dp)
     n_a = scale(tension / np.sqrt(dot(c, c)), c)
     return n_a, cross(p, n_a)
 
@@ -161,6 +162,16 @@ def body_force(mass, net_mass, drag, r, gravity, v, w, smoothing2):
     f = add(f, scale(net_mass, to_local(r, gravity)))
     speed = np.sqrt(dot(v, v) + smoothing2)
     return sub(f, scale(speed, mul(drag, v)))
+
+
+@jit
+def componentwise_drag(coefficients, v, smoothing2):
+    """Drag law C v|v| per local component (Till's tendon robot), returned
+    with the sign of v (subtract it) [N/m]; ``coefficients`` C [kg/m^2],
+    |v_i| smoothed as sqrt(v_i^2 + ``smoothing2``)."""
+    return (coefficients[0] * v[0] * np.sqrt(v[0] * v[0] + smoothing2),
+            coefficients[1] * v[1] * np.sqrt(v[1] * v[1] + smoothing2),
+            coefficients[2] * v[2] * np.sqrt(v[2] * v[2] + smoothing2))
 
 
 @jit

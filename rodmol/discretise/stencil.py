@@ -23,10 +23,12 @@ Packing of the sampled model (built once by ``SemiDiscrete``):
 
 * ``params`` (N, 25): per element, the constant sectional data, one row per
   element (columns ``P_*``);
-* ``consts`` (8,): ds, quaternion restoring rate, drag smoothing speed^2,
-  Munk switch (0/1), gravity (3, global), centred switch (0/1);
-* ``offsets`` (n_c, 3), ``weights`` (n_c, N): cable offsets and their share
-  of each strain node's cell;
+* ``consts`` (9,): ds, quaternion restoring rate, drag smoothing speed^2,
+  Munk switch (0/1), gravity (3, global), centred switch (0/1), drag law
+  (0 Morison, 1 componentwise C v|v|: then ``P_DRAG`` holds C);
+* ``offsets`` (n_c, N, 6), ``weights`` (n_c, N): per cable and cell the
+  offset p and its slope p' (local, :mod:`rodmol.discretise.routing`), and
+  the cell's share of the path times the tension's factor there (friction);
 * external-load entries: ``kinds``, ``nodes`` (element block of the entry),
   ``entry_weights``, ``entry_params`` (E, 12) and ``entry_values`` (E, 3);
 * ``tensions`` (n_c,), ``base`` (6,) = (v0, w0) and ``entry_values``: the
@@ -47,6 +49,7 @@ from .physics import (
     body_force,
     body_torque,
     cable_stress,
+    componentwise_drag,
     cross,
     jit,
     kelvin_voigt,
@@ -60,7 +63,9 @@ from .physics import (
 
 #: Index of the scheme switch in ``consts`` (0 upwind, 1 centred).
 CENTRED = 7
-N_CONSTS = 8
+#: Index of the drag law switch in ``consts`` (0 Morison, 1 componentwise).
+COMPONENTWISE_DRAG = 8
+N_CONSTS = 9
 
 P_KL, P_KTH, P_VL, P_VTH, P_MASS, P_INERTIA = 0, 3, 6, 9, 12, 15
 P_NET_MASS, P_DRAG, P_ADDED = 18, 19, 22
@@ -92,7 +97,8 @@ def _signature():
     # The state comes read-only from CVODE and writable from everywhere else;
     # typing it read-only accepts both with a single compilation.
     f1, f2, i1 = numba.types.float64[::1], numba.types.float64[:, ::1], numba.types.int64[::1]
-    return numba.types.void(f1.copy(readonly=True), f1, f2, f1, f2, f2, f1, f1,
+    f3 = numba.types.float64[:, :, ::1]
+    return numba.types.void(f1.copy(readonly=True), f1, f2, f1, f3, f2, f1, f1,
                             i1, i1, f1, f2, f2, f2)
 
 
@@ -104,6 +110,7 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
     ds, restoring, smoothing2, munk = consts[0], consts[1], consts[2], consts[3] != 0.0
     gravity = (consts[4], consts[5], consts[6])
     centred = consts[CENTRED] != 0.0
+    componentwise = consts[COMPONENTWISE_DRAG] != 0.0
 
     # Pass 1, cells i = 0..N-1: compatibility with the differences of v, w
     # across the cell (cell 0 starts at the base), and the sectional stress.
@@ -137,12 +144,13 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
     for c in range(offsets.shape[0]):
         if tensions[c] == 0.0:
             continue
-        p = _vec(offsets[c], 0)
         for i in range(n):
             if weights[c, i] == 0.0:  # beyond the anchor
                 continue
             o = HEADER + BLOCK * i
-            n_a, m_a = cable_stress(_vec(y, o + QS), _vec(y, o + K), p, tensions[c] * weights[c, i])
+            route = offsets[c, i]
+            n_a, m_a = cable_stress(_vec(y, o + QS), _vec(y, o + K), _vec(route, 0), _vec(route, 3),
+                                    tensions[c] * weights[c, i])
             row = work[i]
             _put(row, 6, add(_vec(row, 6), n_a))
             _put(row, 9, add(_vec(row, 9), m_a))
@@ -190,7 +198,11 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
         mass, inertia = _vec(pr, P_MASS), _vec(pr, P_INERTIA)
 
         f = add(scale(1.0 / length, sub(n_next, n_here)), f_cells)
-        f = add(f, body_force(mass, pr[P_NET_MASS], _vec(pr, P_DRAG), r, gravity, v, w, smoothing2))
+        if componentwise:
+            f = add(f, body_force(mass, pr[P_NET_MASS], zero, r, gravity, v, w, smoothing2))
+            f = sub(f, componentwise_drag(_vec(pr, P_DRAG), v, smoothing2))
+        else:
+            f = add(f, body_force(mass, pr[P_NET_MASS], _vec(pr, P_DRAG), r, gravity, v, w, smoothing2))
         f = add(f, _vec(row, 12))
         t = add(scale(1.0 / length, sub(m_next, m_here)), t_cells)
         t = add(t, body_torque(inertia, _vec(pr, P_ADDED), munk, v, w))

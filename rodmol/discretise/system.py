@@ -15,6 +15,7 @@ import numpy as np
 from . import centreline, external, rotations, stencil
 from .layout import StateLayout, merge
 from .physics import compile_signatures
+from .routing import CableRouting
 from .schemes import DEFAULT_SCHEME, get_scheme
 
 #: Rate [1/s] at which the quaternion norm is pulled back to 1; the exact
@@ -46,9 +47,17 @@ def grid_damping_ratio(model):
     """Kelvin-Voigt damping ratio zeta = omega tau / 2 of the fastest axial
     wave the grid carries, omega = (pi / ds) sqrt(E / rho), with the
     relaxation time tau = 3 mu / E of the sectional law. Below 1 every mode
-    of the grid is underdamped; the paper's arm at N = 100 has about 30."""
+    of the grid is underdamped; the paper's arm at N = 100 has about 30.
+    With per-component viscosities (``Material(viscosity=...)``) tau is the
+    shortest relaxation time of the six components: one undamped component
+    (e.g. no extension-shear damping, Bse = 0) leaves its modes undamped."""
     mat = model.rod.material
-    tau = 3.0 * mat.mu / mat.E if model.viscosity else 0.0
+    if not model.viscosity:
+        tau = 0.0
+    elif mat.viscosity is None:
+        tau = 3.0 * mat.mu / mat.E
+    else:
+        tau = float(np.min(mat.relaxation_times()))
     return 0.5 * tau * np.pi / model.ds * np.sqrt(mat.E / mat.rho)
 
 
@@ -60,10 +69,18 @@ class StateView:
     [m], ``rotations`` (N+1, 3, 3), ``q``, ``k``, ``v``, ``w`` (N, 3) local.
     """
 
-    def __init__(self, layout, t, y, ds):
-        self.t, self._layout, self._y, self._ds = t, layout, y, ds
+    def __init__(self, layout, t, y, ds, routing=None):
+        self.t, self._layout, self._y, self._ds, self._routing = t, layout, y, ds, routing
+
+    def cable_length(self, name):
+        """Path length [m] of the cable called ``name`` from the base to its anchor."""
+        if self._routing is None:
+            raise AttributeError("cable lengths need the system's routing (SemiDiscrete.state_view)")
+        return float(self.cable_lengths[self._routing.index[name]])
 
     def __getattr__(self, name):
+        if name == "cable_lengths":
+            return self._routing.lengths(self.q, self.k)
         if name in ("q", "k", "v", "w"):
             return self._layout.field(self._y, name)
         if name == "rotations":
@@ -104,7 +121,8 @@ class SemiDiscrete:
         self.scheme = get_scheme(scheme)
         self.layout = StateLayout(model.n_elements)
         self.size = self.layout.size
-        self.global_coupling = model.feedback  # feedback tensions read the whole state
+        # Feedback and displacement-controlled tensions and friction read the whole state.
+        self.global_coupling = model.feedback or model.friction
         m = model
         self.cells = m.cell_properties(self.scheme.cell_points(m.s_nodes))
         self.node_lengths = self.scheme.node_lengths(m.n_elements, m.ds)
@@ -115,6 +133,7 @@ class SemiDiscrete:
         self._consts[:7] = (m.ds, QUATERNION_RESTORING_RATE, DRAG_SMOOTHING_SPEED**2,
                             1.0 if m.munk_moment else 0.0, *m.gravity)
         self._consts[stencil.CENTRED] = 1.0 if self.scheme.centred else 0.0
+        self._consts[stencil.COMPONENTWISE_DRAG] = 1.0 if m.drag_law == "componentwise" else 0.0
         self._work = np.zeros((m.n_elements, stencil.WORK_COLUMNS))
         self.base_velocities = np.zeros(6)
         self._fixed_base = m.base.fixed
@@ -145,9 +164,12 @@ class SemiDiscrete:
         else:
             active = [i for i, value in enumerate(constant) if value != 0.0]
         self._active = np.array(active, dtype=int)
-        self._offsets = np.ascontiguousarray(m.cable_offsets[self._active]).reshape(-1, 3)
-        self._weights = np.ascontiguousarray(m.cable_weights[self._active]).reshape(
+        self.routing = CableRouting(m, self.scheme.cell_points(m.s_nodes))
+        self._offsets = np.ascontiguousarray(self.routing.geometry[self._active]).reshape(
+            len(active), m.n_elements, 6)
+        self._path_weights = np.ascontiguousarray(self.routing.weights[self._active]).reshape(
             len(active), m.n_elements)
+        self._weights = self._path_weights.copy()  # times the friction factors, refreshed
         self.tension_values = np.array([constant[i] or 0.0 for i in active])
         self._timed = [(j, m.cables[i]) for j, i in enumerate(active) if constant[i] is None]
 
@@ -168,23 +190,39 @@ class SemiDiscrete:
         values of time-dependent loads. ``y`` is read by feedback tensions;
         ``tensions`` (n_cables,) [N], if given, are used instead of the inputs."""
         m = self.model
+        if not self._fixed_base:
+            v0, w0 = m.base.velocities(t)
+            self.base_velocities[:3], self.base_velocities[3:] = v0, w0
         if tensions is not None:
             self.tension_values[:] = np.asarray(tensions, dtype=float)[self._active]
         elif self.global_coupling:
-            state = StateView(self.layout, t, y, m.ds) if y is not None else None
+            state = self.state_view(t, y) if y is not None else None
             self.tension_values[:] = m.tensions(t, state)
         else:
             for j, cable in self._timed:
                 self.tension_values[j] = cable.tension_at(t)
-        if not self._fixed_base:
-            v0, w0 = m.base.velocities(t)
-            self.base_velocities[:3], self.base_velocities[3:] = v0, w0
+        if m.friction:
+            self._weights[:] = self._path_weights * self.friction_factors(y)[self._active]
         self._grid_loads.fill(t, self.entry_values)
 
     def tensions(self, t, y=None):
-        """Tensions of all cables at (t, y), shape (n_cables,) [N]."""
-        state = StateView(self.layout, t, y, self.model.ds) if self.global_coupling and y is not None else None
+        """Tensions of all cables at (t, y) where they leave the base, shape (n_cables,) [N]."""
+        state = self.state_view(t, y) if self.global_coupling and y is not None else None
         return self.model.tensions(t, state)
+
+    def state_view(self, t, y):
+        """A :class:`StateView` of ``y`` at t, with the cables' path lengths."""
+        return StateView(self.layout, t, y, self.model.ds, self.routing)
+
+    def friction_factors(self, y):
+        """Tension along each cable over its tension at the base, (n_cables, N),
+        for the state ``y`` (all ones at rest or without friction; reads the
+        base velocities of the last :meth:`update_inputs`)."""
+        if y is None or not self.model.friction:
+            return np.ones((len(self.model.cables), self.model.n_elements))
+        lay = self.layout
+        return self.routing.friction_factors_of(lay.field(y, "q"), lay.field(y, "k"), lay.field(y, "v"),
+                                                lay.field(y, "w"), self.base_velocities)
 
     def kernel_arguments(self):
         """Arguments of :func:`rodmol.discretise.stencil.rhs` after (y, out):

@@ -15,6 +15,7 @@ from ..base_motion import BaseMotion
 from ..cables import Cable
 from ..inputs import Constant
 from ..markers import Marker
+from ..model import DRAG_LAWS
 from ..parameters import MEDIA, Material, Medium
 from ..rod import Rod
 from . import scenario_readers as read
@@ -51,7 +52,8 @@ def material(data, ctx):
         return FAILED
     path = ("material",)
     table = ctx.table(data["material"], path, MATERIAL, required=MATERIAL_REQUIRED)
-    values = {k: ctx.read(table, path, k, read.number()) for k in MATERIAL if k in table}
+    values = {k: ctx.read(table, path, k, read.component_viscosity if k == "viscosity" else read.number())
+              for k in MATERIAL if k in table}
     elastic = [k for k in ("nu", "G") if k in table]
     if not isinstance(data["material"], dict):
         return FAILED  # recorded by ctx.table
@@ -95,6 +97,10 @@ def medium(data, ctx, default):
     coefficients = {k: ctx.read(table, path, k, read.number("non-negative"))
                     for k in COEFFICIENTS if k in table}
     switches = {k: ctx.read(table, path, k, read.boolean) for k in SWITCHES if k in table}
+    if "drag_law" in table:
+        switches["drag_law"] = ctx.read(table, path, "drag_law", read.choice(DRAG_LAWS))
+    if "drag_coefficients" in table:
+        switches["drag_coefficients"] = ctx.read(table, path, "drag_coefficients", read.vector(3, "kg/m^2"))
     if failed(preset, *coefficients.values(), *switches.values()) or not isinstance(value, dict):
         return FAILED, {}
     start = {k: getattr(MEDIA[preset], k) for k in COEFFICIENTS}
@@ -124,14 +130,25 @@ def cables(data, ctx):
         if name in names:
             ctx.add(path + ("name",), f"`name` {name!r} is already used by [[cable]] #{names[name] + 1}")
         names.setdefault(name, i)
-        offset = ctx.read(table, path, "offset", read.vector(2, "m"))
+        offset = ctx.read(table, path, "offset", read.offset)
         anchor = ctx.read(table, path, "anchor", read.number("positive", "m"))
-        tension = ctx.read(table, path, "tension", read.tension(ctx.base_dir, name), 0.0)
-        if failed(name, offset, anchor, tension) or offset is None or anchor is None:
+        tension = ctx.read(table, path, "tension", read.tension(ctx.base_dir, name))
+        options = {k: ctx.read(table, path, k, reader) for k, reader in _cable_options(ctx, name).items()
+                   if k in table}
+        if failed(name, offset, anchor, tension, *options.values()) or offset is None or anchor is None:
             built.append(FAILED)
             continue
-        built.append(ctx.construct(path, table, partial(Cable, offset, anchor, tension, name=name)))
+        built.append(ctx.construct(path, table, partial(Cable, offset, anchor, tension, name=name, **options)))
     return FAILED if failed(*built) else built
+
+
+def _cable_options(ctx, name):
+    """Readers of the optional [[cable]] keys (routing on spacer disks,
+    displacement control, friction)."""
+    return {"outside_body": read.boolean, "displacement": read.displacement(ctx.base_dir, name),
+            "compliance": read.number("positive", "1/N"), "base_to_actuator": read.number("non-negative", "m"),
+            "rest_length": read.number("positive", "m"), "friction": read.number("non-negative"),
+            "slip_speed": read.number("positive", "m/s")}
 
 
 def paper_cables(data, ctx, scenario):

@@ -104,6 +104,36 @@ def pairs(what, unit):
     return read
 
 
+def offset(value):
+    """A cable routing: [p_y, p_z] or [[s, p_y, p_z], ...] knots [m]."""
+    if isinstance(value, list) and value and all(isinstance(row, list) for row in value):
+        if len(value) >= 2 and all(len(row) == 3 and all(map(_is_number, row)) for row in value):
+            return [tuple(float(x) for x in row) for row in value]
+        raise Bad(f"must be [p_y, p_z] or at least two [s, p_y, p_z] knots [m], got {short(value)}")
+    return vector(2, "m")(value)
+
+
+def displacement(base_dir, name):
+    """An actuator position z(t): a number [m], [t, z] knots or a CSV file relative to ``base_dir``."""
+    def read(value):
+        if isinstance(value, str):
+            return str(_resolve(base_dir, value))
+        if isinstance(value, list):
+            return pairs("(t, z)", "s, m")(value)
+        if _is_number(value):
+            return float(value)
+        raise Bad(f"must be a number [m], a list of [t, z] knots [s, m] or a CSV file name, got {short(value)}")
+    return read
+
+
+def component_viscosity(value):
+    """``{shear_extension = [3 numbers], bending_torsion = [3 numbers]}`` [Pa s]."""
+    keys = ("shear_extension", "bending_torsion")
+    if not isinstance(value, dict) or not value or set(value) - set(keys):
+        raise Bad(f"must be a table with keys {', '.join(keys)} (three viscosities [Pa s] each), got {short(value)}")
+    return {k: vector(3, "Pa s")(v) for k, v in value.items()}
+
+
 def _resolve(base_dir, value):
     path = Path(value)
     return path if path.is_absolute() else base_dir / path

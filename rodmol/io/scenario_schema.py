@@ -9,13 +9,15 @@ Documented in ``docs/scenario-reference.md``; the checks live in
 TOP = ("name", "description", "arm", "scenario", "gravity", "rod", "material", "medium",
        "cable", "marker", "load", "base", "discretization", "solver", "output")
 ROD = ("length", "radius")
-MATERIAL = ("E", "nu", "G", "mu", "rho")
+MATERIAL = ("E", "nu", "G", "mu", "rho", "viscosity")
 #: Keys of [material] that are always required (and exactly one of nu, G).
 MATERIAL_REQUIRED = ("E", "mu", "rho")
 COEFFICIENTS = ("rho", "Cx", "Cy", "Cz", "By", "Bz")
 SWITCHES = ("drag", "added_mass", "munk_moment")
-MEDIUM = ("preset",) + COEFFICIENTS + SWITCHES
-CABLE = ("name", "offset", "anchor", "tension")
+DRAG_LAW = ("drag_law", "drag_coefficients")
+MEDIUM = ("preset",) + COEFFICIENTS + SWITCHES + DRAG_LAW
+CABLE = ("name", "offset", "anchor", "tension", "outside_body", "displacement", "compliance",
+         "base_to_actuator", "rest_length", "friction", "slip_speed")
 PAPER_CABLE = ("number", "tension")
 MARKER = ("name", "s", "offset")
 BASE = ("fixed", "position", "rotation", "velocity", "angular_velocity")
@@ -25,7 +27,9 @@ OUTPUT = ("directory", "format", "vtk", "npz", "every", "chunk_frames")
 ARMS = ("paper",)
 INITIAL = ("equilibrium", "straight")
 UNITS = {"length": "m", "radius": "m", "E": "Pa", "G": "Pa", "mu": "Pa s", "rho": "kg/m^3",
-         "anchor": "m", "s": "m", "t_end": "s", "output_dt": "s", "max_wall_time": "s", "offset": "m", "tension": "N"}
+         "anchor": "m", "s": "m", "t_end": "s", "output_dt": "s", "max_wall_time": "s", "offset": "m", "tension": "N",
+         "viscosity": "Pa s", "displacement": "m", "compliance": "1/N", "base_to_actuator": "m",
+         "rest_length": "m", "friction": "-", "slip_speed": "m/s", "drag_coefficients": "kg/m^2"}
 
 # --------------------------------------------------------------------------- [[load]]
 

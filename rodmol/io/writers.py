@@ -116,13 +116,16 @@ def cable_points(s_nodes, positions, rotations, meta):
     """
     paths = []
     for cable in meta.get("cables", []):
-        offset = [float(x) for x in cable["offset"]]  # local y, z of the cable; local x is 0
+        # The routing p(s) (local y, z) at the nodes; a constant offset in older results.
+        offsets = np.broadcast_to(np.asarray(cable.get("node_offsets", [cable["offset"]]), dtype=float),
+                                  (len(s_nodes), 2))
         anchor = min(float(cable["anchor"]), float(s_nodes[-1]))
         on_path = int(np.count_nonzero(s_nodes < anchor))  # the nodes below the anchor come first
         s = np.append(s_nodes[:on_path], anchor)
         j = min(int(np.searchsorted(s_nodes, anchor, side="right")) - 1, len(s_nodes) - 2)
         used = slice(0, max(on_path, j + 2))
-        points = positions[:, used] + offset[0] * rotations[:, used, :, 1] + offset[1] * rotations[:, used, :, 2]
+        points = (positions[:, used] + offsets[used, 0, None] * rotations[:, used, :, 1]
+                  + offsets[used, 1, None] * rotations[:, used, :, 2])
         w = (anchor - s_nodes[j]) / (s_nodes[j + 1] - s_nodes[j])
         at_anchor = (1.0 - w) * points[:, j] + w * points[:, j + 1]
         paths.append((s, np.concatenate([points[:, :on_path], at_anchor[:, None]], axis=1)))

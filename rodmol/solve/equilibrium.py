@@ -101,31 +101,56 @@ def _closed_loop(system, t, tol, max_iter, max_rounds=30):
                         np.asarray(model.base.rotation, dtype=float),
                         rotations.from_matrix(model.base.rotation))
     tensions = law(y)
+    # A displacement-controlled cable's law on the straight rod can ask for far
+    # more than the arm carries (the rigid-rod tension); start it slack.
+    tensions[[c.actuated for c in model.cables]] = 0.0
     scale = max(model.load_scale(t, tensions), 1e-12)
+    warm = None
+    # One feedback cable: F(T) decreases with T for a tendon (more pull, a
+    # shorter path, less stretch), so a bracket [low, high] of its root
+    # safeguards Newton across the kink where the cable goes slack.
+    low, high = 0.0, np.inf
     for _ in range(max_rounds):
-        y = _rest_state(system, t, tol, max_iter, tensions)
+        y = _rest_state(system, t, tol, max_iter, tensions, start=warm)
+        warm = y
         residual = (law(y) - tensions)[feedback]
         if np.max(np.abs(residual)) <= 1e-9 * scale:
             return y
+        if residual.size == 1:
+            if residual[0] > 0.0:
+                low = max(low, tensions[feedback][0])
+            else:
+                high = min(high, tensions[feedback][0])
         jac = np.empty((residual.size, residual.size))
         for j, i in enumerate(np.flatnonzero(feedback)):
             h = 1e-6 * max(abs(tensions[i]), scale)
             shifted = tensions.copy()
             shifted[i] += h
-            jac[:, j] = ((law(_rest_state(system, t, tol, max_iter, shifted)) - shifted)[feedback]
+            jac[:, j] = ((law(_rest_state(system, t, tol, max_iter, shifted, start=y)) - shifted)[feedback]
                          - residual) / h
         try:
             step = np.linalg.solve(jac, -residual)
         except np.linalg.LinAlgError:
             break
+        # On fine grids the law's value carries the rest state's round-off
+        # (a stiff tendon amplifies path-length noise): a step below the
+        # tension's resolution with a small residual is converged too.
+        if (np.max(np.abs(step)) <= 1e-9 * max(np.max(np.abs(tensions)), scale)
+                and np.max(np.abs(residual)) <= 1e-6 * scale):
+            return y
         tensions = tensions.copy()
         tensions[feedback] = np.maximum(tensions[feedback] + step, 0.0)
+        if residual.size == 1 and np.isfinite(high) and not low < tensions[feedback][0] < high:
+            tensions[feedback] = 0.5 * (low + high)
     raise EquilibriumError(f"no static equilibrium found for the feedback tensions at t = {t} s "
                            "(the law and the arm have no common rest state, or it is unstable)")
 
 
-def _rest_state(system, t, tol, max_iter, tensions=None):
-    """The rest state under the loads at t (cable ``tensions`` [N] if given)."""
+def _rest_state(system, t, tol, max_iter, tensions=None, start=None):
+    """The rest state under the loads at t (cable ``tensions`` [N] if given).
+    ``start``, a nearby rest state (the closed loop's last iterate), is tried
+    first at the full loads; the continuation from the straight rod is the
+    fallback."""
     model = system.model
     layout, n, ds = system.layout, model.n_elements, model.ds
     static = BlockLayout(n, dict(STATIC_FIELDS))
@@ -164,6 +189,11 @@ def _rest_state(system, t, tol, max_iter, tensions=None):
 
     bands = static.bandwidths(static_dependencies(system.depends))
     lam, step = 0.0, 1.0
+    if start is not None:
+        z_warm = _newton(lambda x: residual(x, 1.0),
+                         np.hstack([layout.field(start, f) for f in STATIC_FIELDS]).ravel(), tol, max_iter, bands)
+        if z_warm is not None:
+            z, lam = z_warm, 1.0
     while lam < 1.0:
         target = min(1.0, lam + step)
         z_new = _newton(lambda x, lam=target: residual(x, lam), z, tol, max_iter, bands)

@@ -32,7 +32,6 @@ import numba
 import numpy as np
 
 from ..discretise.layout import BLOCK, HEADER, QUAT, K, Q
-from ..discretise.system import StateView
 
 #: Axial stretch q1 at or below which an element counts as inverted or collapsed.
 MIN_STRETCH = 0.05
@@ -156,7 +155,7 @@ class Watch:
     def _tip(self, t, y):
         state = None
         if self.system.global_coupling:
-            state = StateView(self.layout, t, y, self.ds)
+            state = self.system.state_view(t, y)
         pull = sum(c.tension_at(t, state) for c in self.tip_cables)
         q1 = 1.0 - pull / self.tip_stiffness
         if q1 > MIN_STRETCH:

@@ -100,6 +100,12 @@ class Sampled:
         mu = mat.mu if model.viscosity else 0.0
         self.vl = mu * a_str[:, None] * np.array([3.0, 1.0, 1.0])
         self.vth = mu * j_str[:, None] * np.array([2.0, 3.0, 3.0])
+        given = mat.viscosity if model.viscosity and mat.viscosity is not None else None
+        if given is not None:  # per-component viscosities [Pa s]: Vl = A eta, Vth = J eta
+            eta_l = np.asarray(given.get("shear_extension", (3 * mu, mu, mu)))
+            eta_th = np.asarray(given.get("bending_torsion", (mu, 3 * mu, 3 * mu)))
+            self.vl = a_str[:, None] * eta_l
+            self.vth = j_str[:, None] * np.array([2.0, 1.0, 1.0]) * eta_th
         added = (med.rho * a_vel[:, None] * np.array([0.0, med.By, med.Bz]) if model.added_mass
                  else np.zeros((n, 3)))
         self.added = added
@@ -108,10 +114,19 @@ class Sampled:
         self.net_mass = (mat.rho - med.rho) * a_vel
         self.drag = (med.rho * r_vel[:, None] * np.array([0.5 * np.pi * med.Cx, med.Cy, med.Cz])
                      if model.drag else np.zeros((n, 3)))
+        self.componentwise = model.drag and model.drag_law == "componentwise"
+        if self.componentwise:  # C v|v| per component replaces the medium's drag
+            self.drag = np.tile(np.asarray(model.drag_coefficients, dtype=float), (n, 1))
         self.radius = r_vel  # at velocity nodes 1..N
         self.gravity = np.asarray(model.gravity, dtype=float)
         self.munk = bool(model.munk_moment)
-        self.offsets = np.array([[0.0, *c.offset] for c in model.cables]).reshape(-1, 3)
+        # Routing p(s) (the user's input, read through rodmol): p at the cell's
+        # sampling point, p' as the difference of p across the cell.
+        self.offsets = np.zeros((len(model.cables), n, 3))
+        self.slopes = np.zeros((len(model.cables), n, 3))
+        for j, c in enumerate(model.cables):
+            self.offsets[j, :, 1:] = c.offset_at(s_cell)
+            self.slopes[j, :, 1:] = np.diff(c.offset_at(s), axis=0) / self.ds
         anchors = np.array([c.anchor for c in model.cables]).reshape(-1, 1)
         self.cable_weights = np.clip((anchors - s_str[None, :]) / self.ds, 0.0, 1.0)
 
@@ -135,11 +150,47 @@ def strain_rates(q, k, v, w, v0, w0, ds, centred=False):
     return q_t, k_t
 
 
-def cable_stress(q, k, p, tension):
-    """N_a = T tau, tau = (q + k x p)/|q + k x p|, M_a = p x N_a; tension (n,) per node."""
-    c = q + cross(k, p)
+def cable_stress(q, k, p, dp, tension):
+    """N_a = T tau, tau = (q + k x p + p')/|q + k x p + p'|, M_a = p x N_a;
+    p, p' (n, 3) and tension (n,) per cell."""
+    c = q + cross(k, p) + dp
     n_a = tension[:, None] * c / np.linalg.norm(c, axis=1, keepdims=True)
-    return n_a, cross(np.broadcast_to(p, n_a.shape), n_a)
+    return n_a, cross(p, n_a)
+
+
+def friction_factors(model, data, q, k, v, w, v0, w0):
+    """T(cell) / T(base) per cable and cell (n_cables, N) of the regularised
+    capstan law (docs/model.md), cell by cell: the path's curvature
+    |tau' + k x tau| (tau' by central differences, one-sided at the ends),
+    the sliding speed from the rate of change of the path length beyond the
+    cell (strain rates of the compatibility laws with centred velocities),
+    and the wrap to the middle of the cell."""
+    n, ds = data.n, data.ds
+    q_t, k_t = strain_rates(q, k, v, w, v0, w0, ds, centred=True)
+    factors = np.ones((len(model.cables), n))
+    for j, cable in enumerate(model.cables):
+        tau, rate = np.zeros((n, 3)), np.zeros(n)
+        for i in range(n):
+            c = q[i] + np.cross(k[i], data.offsets[j, i]) + data.slopes[j, i]
+            tau[i] = c / np.linalg.norm(c)
+            rate[i] = tau[i] @ (q_t[i] + np.cross(k_t[i], data.offsets[j, i]))
+        wrap = 0.0
+        for i in range(n):
+            if n == 1:
+                dtau = np.zeros(3)
+            elif i == 0:
+                dtau = (tau[1] - tau[0]) / ds
+            elif i == n - 1:
+                dtau = (tau[-1] - tau[-2]) / ds
+            else:
+                dtau = (tau[i + 1] - tau[i - 1]) / (2 * ds)
+            kappa = np.linalg.norm(dtau + np.cross(k[i], tau[i]))
+            beyond = ds * np.sum(data.cable_weights[j, i:] * rate[i:])
+            sigma = -beyond / np.hypot(beyond, cable.slip_speed)
+            turn = cable.friction * sigma * kappa * data.cable_weights[j, i] * ds
+            factors[j, i] = np.exp(-(wrap + turn / 2))
+            wrap += turn
+    return factors
 
 
 def stresses(data, q, k, q_t, k_t, tensions):
@@ -147,8 +198,10 @@ def stresses(data, q, k, q_t, k_t, tensions):
     n_el = data.kl * (q - Q_STAR) + data.vl * q_t
     m_el = data.kth * k + data.vth * k_t
     n_tot, m_tot = n_el.copy(), m_el.copy()
-    for p, tension, weight in zip(data.offsets, tensions, data.cable_weights):
-        n_a, m_a = cable_stress(q, k, p, tension * weight)
+    tensions = np.asarray(tensions, dtype=float)
+    tensions = np.broadcast_to(tensions[:, None] if tensions.ndim == 1 else tensions, data.cable_weights.shape)
+    for p, dp, tension, weight in zip(data.offsets, data.slopes, tensions, data.cable_weights):
+        n_a, m_a = cable_stress(q, k, p, dp, tension * weight)
         n_tot += n_a
         m_tot += m_a
     return n_el, m_el, n_tot, m_tot
@@ -245,6 +298,8 @@ def rates(model, t, y, tensions=None, scheme="upwind"):
         tensions = np.array([c.tension_at(t) for c in model.cables])
 
     q_t, k_t = strain_rates(q, k, v, w, v0, w0, ds, data.centred)
+    if any(c.friction > 0 for c in model.cables):  # tension per cell
+        tensions = np.asarray(tensions, dtype=float)[:, None] * friction_factors(model, data, q, k, v, w, v0, w0)
     _, _, n_tot, m_tot = stresses(data, q, k, q_t, k_t, tensions)
 
     # Velocity nodes 1..N: differences of the total stress of the cells
@@ -264,11 +319,14 @@ def rates(model, t, y, tensions=None, scheme="upwind"):
     f_ext, m_ext = external_loads(model, data, t, quat, u, v, w)
     lengths = data.lengths[:, None]
 
-    speed = np.sqrt(dot(v, v) + DRAG_SMOOTHING_SPEED**2)
+    if data.componentwise:  # |v_i| per component
+        speed = np.sqrt(v * v + DRAG_SMOOTHING_SPEED**2)
+    else:
+        speed = np.sqrt(dot(v, v) + DRAG_SMOOTHING_SPEED**2)[:, None]
     force = ((n_next - n_tot) / lengths + f_cells
              - cross(w, data.mass * v)
              + data.net_mass[:, None] * global_to_local(r, data.gravity)
-             - speed[:, None] * data.drag * v
+             - speed * data.drag * v
              + f_ext)
     torque = ((m_next - m_tot) / lengths + t_cells
               - cross(w, data.inertia * w) + m_ext)

@@ -36,6 +36,19 @@ def _models():
     return {
         "paper arm, cables": arm(9, tensions={11: 1.0, 3: 0.5}),
         "paper arm, no cables, air": arm(6, medium="air"),
+        "routed cables (helix, knots, spacer disks)": rodmol.Model(paper_rod(), 8, medium="water", cables=[
+            rodmol.Cable(lambda s: (0.003 * np.cos(20 * s), 0.003 * np.sin(20 * s)), 0.3, 0.8, name="helix"),
+            rodmol.Cable([(0.0, 0.008, 0.0), (0.2, 0.002, 0.001), (0.4, 0.0, 0.002)], L, 0.5, name="knots"),
+            rodmol.Cable((0.0, 0.03), 0.25, 0.3, name="disks", outside_body=True)]),
+        "friction (routed, moving base)": rodmol.Model(paper_rod(), 8, medium="water", base=WAVY_BASE, cables=[
+            rodmol.Cable((0.006, 0.002), 0.3, 1.2, name="a", friction=0.3, slip_speed=0.01),
+            rodmol.Cable([(0.0, -0.008, 0.0), (L, -0.002, 0.002)], L, 0.7, name="b", friction=0.1),
+            rodmol.Cable((0.0, 0.005), 0.2, 0.4, name="c")]),
+        "componentwise drag": arm(7, tensions={11: 1.0}, drag_law="componentwise",
+                                  drag_coefficients=(0.3, 2.0, 5.0)),
+        "per-component viscosity": rodmol.Model(rodmol.Rod(0.3, (0.01, 0.006), rodmol.Material(
+            E=2e5, nu=0.3, mu=40.0, rho=1100.0, viscosity=dict(shear_extension=(0.0, 5.0, 7.0)))), 7,
+            cables=[rodmol.Cable((0.0, 0.004), 0.25, 0.4)]),
         "moving base": arm(8, tensions={11: 1.0}, base=WAVY_BASE),
         "Munk moment": arm(7, tensions={7: 0.8, 2: 0.3}, munk_moment=True),
         "timed tensions (knots, callable)": arm(6, tensions={1: [(0.0, 0.0), (1.0, 2.0)],
@@ -222,9 +235,9 @@ def test_kelvin_voigt():
 
 def test_cable_stress():
     q = (1.02, 0.01, -0.03)
-    k, p = _vec(), (0.0, 0.004, -0.002)
-    n_a, m_a = physics.cable_stress(q, k, p, 1.7)
-    c = np.array(q) + np.cross(k, p)
+    k, p, dp = _vec(), (0.0, 0.004, -0.002), (0.0, 0.03, 0.01)
+    n_a, m_a = physics.cable_stress(q, k, p, dp, 1.7)
+    c = np.array(q) + np.cross(k, p) + dp
     _close(n_a, 1.7 * c / np.linalg.norm(c))
     _close(m_a, np.cross(p, 1.7 * c / np.linalg.norm(c)))
 
