@@ -105,6 +105,29 @@ class Function(TimeInput):
         return f"Function({self.function!r})"
 
 
+def knot_times(root):
+    """The times [s] of the knots of every :class:`Knots` input reachable
+    from ``root`` (a model: its cables, loads, base motion and their inputs),
+    sorted and unique. An input has kinks there, so a time integrator with
+    large steps must stop at them rather than stride over a short ramp.
+    """
+    times, seen, stack = [], set(), [root]
+    while stack:
+        obj = stack.pop()
+        if id(obj) in seen:
+            continue
+        seen.add(id(obj))
+        if isinstance(obj, Knots):
+            times.append(obj.times)
+        elif isinstance(obj, (list, tuple)):
+            stack.extend(obj)
+        elif isinstance(obj, dict):
+            stack.extend(obj.values())
+        elif type(obj).__module__.startswith("rodmol") and hasattr(obj, "__dict__"):
+            stack.extend(vars(obj).values())
+    return np.unique(np.concatenate(times)) if times else np.empty(0)
+
+
 def as_time_input(name, value, width=1, unit="", minimum=None):
     """Turn an accepted input (see the module docstring) into a :class:`TimeInput`.
 

@@ -131,3 +131,18 @@ def test_example_runs_and_matches_till(tmp_path):
     # t = 10 s value by +5.3 and -2.7 mm (docs/examples.md).
     assert abs(held) < 3.0
     assert (tmp_path / "f.png").stat().st_size > 10_000
+
+
+def test_cvode_stops_at_the_motor_knots_of_a_resting_robot():
+    """The robot rests until the motor moves at 3.65 s; with outputs far
+    apart CVODE's steps grow long and, without stopping at the inputs' knots,
+    strode over the 0.3 s ramp (3 steps for 25 s: the motor never acted)."""
+    robot = _example().model(20)
+    result = rodmol.simulate(robot, 25.0, output_times=[0.0, 10.0, 25.0])
+    assert result.success, result.message
+    assert result.stats["steps"] > 100
+    assert result.actuator_positions[1, 0] == HELD_Z
+    # Held at z = -16.19 mm by t = 10 s: the tip has swung up from the static
+    # -0.148 m to about 0.206 m (the example's trajectory), and is back down at 25 s.
+    assert 0.19 < result.tip[1, 1] < 0.22
+    assert abs(result.tip[2, 1] - result.tip[0, 1]) < 0.01

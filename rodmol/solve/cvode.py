@@ -8,6 +8,7 @@ from scipy import sparse
 
 from ..discretise.preconditioner import check_structure
 from ..errors import ParameterError
+from ..inputs import knot_times
 from .outputs import Outputs, cause, step_size_stats
 from .watch import Watch
 
@@ -142,8 +143,13 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, l
             solver = CVODE(rhs, **options)
         with _small_pages():  # the solver's memory is allocated here
             solver.init_step(float(t_out[0]), np.asarray(y0, dtype=float))
+        # Steps stop at the inputs' knots: a rod at rest takes long steps and
+        # would stride over a short ramp that starts between two of them.
+        kinks = [t for t in knot_times(system.model) if t_out[0] < t < t_end][::-1]
         while not out.done:
-            r = solver.step(t_end, method="onestep", tstop=t_end)
+            while kinks and kinks[-1] <= t_last:
+                kinks.pop()
+            r = solver.step(t_end, method="onestep", tstop=kinks[-1] if kinks else t_end)
             if not r.success or len(failures) > MAX_RHS_FAILURES:
                 if failures:
                     t_bad, exc = failures[-1]
