@@ -369,7 +369,9 @@ def test_bending_pull_moves_tip_toward_cable(bending_run):
     at 2 N."""
     model, result = bending_run
     assert result.success, result.message
-    assert result.quaternion_norm_error.max() < 1e-4  # a few times the default rtol, 2e-5
+    # A few times the default rtol (3e-5): measured 1.1e-4 with CVODE stopping at the
+    # tension knots (0.5, 4, 4.5 s), 7e-5 without; the tips agree to 0.03 mm.
+    assert result.quaternion_norm_error.max() < 3e-4
     y = result.tip[:, 1]
     assert np.all(np.diff(y[: _at(result, 2.0)]) > 0)  # rises while pulled
     assert y[_at(result, 4.0)] - y[0] > 0.25  # measured 0.30 m
