@@ -162,7 +162,7 @@ def from_states(system, t, y, success, message, stats):
     quat_all = layout.quaternions(y)
     tensions = np.array([system.tensions(ti, yi) for ti, yi in zip(t, y)]).reshape(n_t, -1)
     q_all, k_all = layout.field(y, "q"), layout.field(y, "k")
-    lengths = np.array([system.routing.lengths(q_all[i], k_all[i]) for i in range(n_t)]).reshape(n_t, -1)
+    lengths = system.routing.lengths(q_all, k_all).reshape(n_t, -1)
     actuated = [c for c in model.cables if c.actuated]
     actuators = np.array([[c.displacement.value(ti) for c in actuated] for ti in t]).reshape(n_t, len(actuated))
     arrays = dict(

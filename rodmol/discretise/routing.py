@@ -10,9 +10,12 @@ kernel's cable stress reads; here they are evaluated in numpy for the laws
 that read the whole path (displacement control, friction).
 """
 
+import math
+
 import numpy as np
 
 from ..cable_routing import cell_geometry
+from .physics import jit
 
 
 class CableRouting:
@@ -35,13 +38,17 @@ class CableRouting:
         self.index = {c.name: i for i, c in enumerate(cables)}
 
     def path_vectors(self, q, k):
-        """c = q + k x p + p' (n_cables, N, 3), local frame, for strains q, k (N, 3)."""
+        """c = q + k x p + p' (..., n_cables, N, 3), local frame, for strains q, k (..., N, 3)."""
         p, dp = self.geometry[..., :3], self.geometry[..., 3:]
-        return q[None] + np.cross(k[None], p) + dp
+        return q[..., None, :, :] + np.cross(k[..., None, :, :], p) + dp
 
     def lengths(self, q, k):
-        """Path lengths [m] from the base to each anchor, (n_cables,)."""
-        return self.ds * np.sum(self.weights * np.linalg.norm(self.path_vectors(q, k), axis=-1), axis=1)
+        """Path lengths [m] from the base to each anchor, (..., n_cables), for strains q, k (..., N, 3)."""
+        q, k = np.asarray(q, dtype=float), np.asarray(k, dtype=float)
+        out = np.empty(q.shape[:-2] + (len(self.weights),))
+        _path_lengths(np.ascontiguousarray(q).reshape(-1, self.n, 3), np.ascontiguousarray(k).reshape(-1, self.n, 3),
+                      self.geometry, self.weights, self.ds, out.reshape(-1, len(self.weights)))
+        return out
 
     def friction_factors(self, q, k, q_t, k_t):
         """T(cell) / T(base) of each cable (n_cables, N) under the regularised capstan law.
@@ -77,3 +84,21 @@ class CableRouting:
         q_t = (v - v_prev) / self.ds + np.cross(k, v_bar) - np.cross(w_bar, q)
         k_t = (w - w_prev) / self.ds + np.cross(k, w_bar)
         return self.friction_factors(q, k, q_t, k_t)
+
+
+@jit
+def _path_lengths(q, k, geometry, weights, ds, out):
+    # ds sum_i w_i |q + k x p + p'| per frame and cable, in one pass (the numpy
+    # form made (frames, cables, N, 3) temporaries; results keep it per frame).
+    for f in range(q.shape[0]):
+        for c in range(geometry.shape[0]):
+            total = 0.0
+            for i in range(q.shape[1]):
+                if weights[c, i] == 0.0:
+                    continue
+                g = geometry[c, i]
+                x = q[f, i, 0] + k[f, i, 1] * g[2] - k[f, i, 2] * g[1] + g[3]
+                y = q[f, i, 1] + k[f, i, 2] * g[0] - k[f, i, 0] * g[2] + g[4]
+                z = q[f, i, 2] + k[f, i, 0] * g[1] - k[f, i, 1] * g[0] + g[5]
+                total += weights[c, i] * math.sqrt(x * x + y * y + z * z)
+            out[f, c] = ds * total

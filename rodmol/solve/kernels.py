@@ -14,6 +14,8 @@ import contextlib
 
 import numpy as np
 
+from ..discretise import rotations
+
 #: Span [s] of the preparing run.
 SPAN = 1e-6
 _prepared = set()
@@ -42,4 +44,7 @@ def prepare(system, t, y, run, rtol, atol, options):
         fy = system(t, y)
         preconditioner.setup(t, y, fy, False, np.zeros(1, dtype=int), 1e-3)
         preconditioner.apply(fy)
+    # The post-processing of the frames (poses, cable path lengths).
+    rotations.matrices(system.layout.quaternions(y))
+    system.routing.lengths(system.layout.field(y, "q"), system.layout.field(y, "k"))
     _prepared.add(key)
