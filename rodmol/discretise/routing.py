@@ -45,10 +45,11 @@ class CableRouting:
     def lengths(self, q, k):
         """Path lengths [m] from the base to each anchor, (..., n_cables), for strains q, k (..., N, 3)."""
         q, k = np.asarray(q, dtype=float), np.asarray(k, dtype=float)
-        out = np.empty(q.shape[:-2] + (len(self.weights),))
-        _path_lengths(np.ascontiguousarray(q).reshape(-1, self.n, 3), np.ascontiguousarray(k).reshape(-1, self.n, 3),
-                      self.geometry, self.weights, self.ds, out.reshape(-1, len(self.weights)))
-        return out
+        frames, n_cables = int(np.prod(q.shape[:-2])), len(self.weights)  # explicit: 0 cables is common
+        out = np.empty((frames, n_cables))
+        _path_lengths(np.ascontiguousarray(q).reshape(frames, self.n, 3),
+                      np.ascontiguousarray(k).reshape(frames, self.n, 3), self.geometry, self.weights, self.ds, out)
+        return out.reshape(q.shape[:-2] + (n_cables,))
 
     def friction_factors(self, q, k, q_t, k_t):
         """T(cell) / T(base) of each cable (n_cables, N) under the regularised capstan law.
