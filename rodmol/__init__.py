@@ -31,6 +31,7 @@ from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
 from .discretise.system import SemiDiscrete, StateView
 from .errors import EquilibriumError, IntegrationError, ParameterError, RodmolError, UserFunctionError
+from .io.load import load_result
 from .io.scenario_file import ScenarioError, load_scenario
 from .io.writers import write_series
 from .loads import (
@@ -45,7 +46,7 @@ from .loads import (
 from .markers import Marker
 from .model import Model
 from .parameters import MEDIA, Material, Medium
-from .result import Result, load_result
+from .result import Result
 from .rod import Rod
 from .simulate import default_atol, simulate, straight_state
 from .solve.backends import BACKENDS

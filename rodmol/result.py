@@ -2,7 +2,6 @@
 
 import json
 from functools import partial
-from pathlib import Path
 
 import numpy as np
 
@@ -110,34 +109,12 @@ class Result:
         return self.positions[:, -1]
 
     def save(self, path):
-        """Write the result to ``path`` (.npz); read it back with :func:`load_result`."""
+        """Write the result to ``path`` (.npz); read it back with :func:`rodmol.load_result`."""
         info = dict(success=self.success, message=self.message, stats=self.stats, meta=self.meta,
                     units=ARRAYS)
         arrays = {k: getattr(self, k) for k in ARRAYS}
         # Never a half-written file under the real name (see write_atomically).
         write_atomically(path, lambda handle: np.savez_compressed(handle, info=json.dumps(info), **arrays))
-
-
-def load_result(path):
-    """Read a :class:`Result`: a run directory (its ``result.h5``, else ``result.npz``), a
-    streamed run's ``result.h5`` or one of its views (``rod.xdmf``, ...; arrays read on first
-    access), or a ``.npz`` written by :meth:`Result.save`."""
-    path = Path(path)
-    if path.is_dir() or path.suffix == ".xdmf":
-        folder = path if path.is_dir() else path.parent
-        found = [folder / name for name in ("result.h5", "result.npz") if (folder / name).is_file()]
-        if not found:
-            raise FileNotFoundError(f"no result.h5 or result.npz in {str(folder)!r}")
-        path = found[0]
-    if path.suffix == ".h5":
-        from .io.h5result import read_result
-
-        return read_result(path)
-    with np.load(path, allow_pickle=False) as data:
-        info = json.loads(str(data["info"]))
-        # Files written before a key existed load without it.
-        arrays = {k: data[k] for k in ARRAYS if k in data}
-    return Result(arrays, info["success"], info["message"], info["stats"], info.get("meta"))
 
 
 #: The arrays each deferred group of :func:`from_states` computes.

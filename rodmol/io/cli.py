@@ -22,12 +22,12 @@ from pathlib import Path
 
 from .._progress import Progress
 from ..errors import ParameterError
+from .cli_options import EXAMPLES, add_run_options, load_spec
 from .lock import OutputLock
 
 EXIT_FAILED, EXIT_USAGE, EXIT_OUTPUT, EXIT_INTERRUPTED = 1, 2, 3, 130
 #: Exit code of a run stopped by each signal (128 + the signal's number, as a shell reports it).
 EXIT_SIGNAL = {signal.SIGINT: 130, signal.SIGTERM: 143}
-EXAMPLES = ("bending", "reaching", "fetching")
 __all__ = ["Progress", "main", "summary"]
 
 
@@ -59,12 +59,12 @@ def _parser():
     run.add_argument("scenario", nargs="?", help="TOML scenario file (see docs/scenario-reference.md)")
     run.add_argument("--example", choices=EXAMPLES, metavar="NAME", help="run one of the paper's tests instead of a file: "
                                                                   + ", ".join(EXAMPLES))
-    _run_options(run)
+    add_run_options(run)
     run.set_defaults(command=_run)
 
     example = commands.add_parser("example", help="run one of the paper's tests without a file")
     example.add_argument("example", choices=EXAMPLES)
-    _run_options(example)
+    add_run_options(example)
     example.set_defaults(command=_run, scenario=None)
 
     render = commands.add_parser("render", help="render the last frame (PNG) and an animation (GIF)")
@@ -83,48 +83,10 @@ def _parser():
     return parser
 
 
-def _run_options(parser):
-    parser.add_argument("--out", type=Path, metavar="DIR", help="output directory (default: [output] directory, "
-                                                 "else out/NAME)")
-    parser.add_argument("--backend", metavar="NAME", help="solver backend (cvode, galpha, rk23)")
-    parser.add_argument("--n-elements", type=int, metavar="N", help="number of elements N")
-    parser.add_argument("--scheme", metavar="NAME", help="spatial scheme (centred, upwind)")
-    parser.add_argument("--t-end", type=float, metavar="T", help="end time [s]")
-    parser.add_argument("--max-wall-time", type=float, metavar="S",
-                        help="wall-time budget [s]: stop the run there (the frames done are kept)")
-    parser.add_argument("--format", choices=("xdmf", "vtp"), help="outputs: streamed result.h5 and XDMF "
-                        "views (xdmf, default) or result.npz and a .pvd/.vtp series after the run (vtp)")
-    parser.add_argument("--chunk-frames", type=int, metavar="N", help="output frames per chunk file, "
-                        "the restart points of --resume (default: [output] chunk_frames, else 2000)")
-    parser.add_argument("--resume", action="store_true", help="continue the unfinished run in the output "
-                        "directory from its last complete chunk (xdmf format)")
-    parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
-
-
 # --------------------------------------------------------------------------- run
 
-def _load(args):
-    """The checked scenario, with the command line's overrides; raises ScenarioError."""
-    from .scenario_file import Override, load_scenario, parse_scenario
-
-    overrides = {}
-    for option, key in (("backend", "solver.backend"), ("n_elements", "discretization.n_elements"),
-                        ("scheme", "discretization.scheme"), ("t_end", "solver.t_end"),
-                        ("max_wall_time", "solver.max_wall_time")):
-        if getattr(args, option) is not None:
-            overrides[key] = Override(getattr(args, option), "--" + option.replace("_", "-"))
-    if args.example and args.scenario:
-        raise ParameterError("give either a scenario file or `--example`, not both")
-    if args.example:
-        text = f'name = "{args.example}"\narm = "paper"\nscenario = "{args.example}"\n'
-        return parse_scenario(text, source=f"<example {args.example}>", overrides=overrides)
-    if not args.scenario:
-        raise ParameterError("give a scenario file (rodmol run FILE.toml) or `--example NAME`")
-    return load_scenario(args.scenario, overrides=overrides)
-
-
 def _run(args):
-    spec = _load(args)
+    spec = load_spec(args)
     out = args.out or spec.output.directory or Path("out") / spec.name
     try:  # before the run, so a directory that cannot be made does not waste it
         out.mkdir(parents=True, exist_ok=True)
@@ -317,7 +279,7 @@ def summary(spec, result, wall, written):
 
 def _result_in(directory):
     """The result in a run directory (result.h5, else result.npz), or in the file given."""
-    from ..result import load_result
+    from .load import load_result
 
     path = Path(directory)
     if path.is_dir():

@@ -43,7 +43,7 @@ def add_commands(commands):
 
 
 def _common(parser, measured):
-    from .cli import EXAMPLES, _run_options
+    from .cli_options import EXAMPLES, add_run_options
 
     parser.add_argument("scenario", nargs="?", help="TOML scenario file")
     parser.add_argument("--example", choices=EXAMPLES, metavar="NAME", help="one of the paper's tests instead")
@@ -56,7 +56,7 @@ def _common(parser, measured):
     where.add_argument("--workers", type=int, metavar="N", help="LocalCluster worker processes (default: cores)")
     where.add_argument("--scheduler", metavar="ADDRESS", help="a running dask scheduler, e.g. tcp://host:8786")
     where.add_argument("--serial", action="store_true", help="run in this process, without dask")
-    _run_options(parser)
+    add_run_options(parser)
 
 
 def _setup(args):
@@ -64,9 +64,9 @@ def _setup(args):
     from ..calibrate import read_tension_log
     from ..calibrate.parallel import SERIAL
     from ..calibrate.variants import apply
-    from .cli import _load
+    from .cli_options import load_spec
 
-    spec = _load(args)
+    spec = load_spec(args)
     if args.tensions:
         spec = apply(spec, read_tension_log(args.tensions, clip_negative=True).overrides())
     if args.workers is not None and args.workers < 1:

@@ -25,7 +25,7 @@ from ..errors import ParameterError
 from ..solve.chunked import merge_stats
 from . import h5result, xdmf
 from .h5result import INDEX, SERIES, STATIC
-from .writers import cable_points
+from .parts import cable_points
 
 #: Number type of the arrays only the views use (the Result's own stay float64):
 #: single precision halves the largest of them, the cables' points.

@@ -10,7 +10,7 @@ ParaView 5.11). So a view is small, is replaced atomically after each chunk,
 and the writing stays linear in the number of frames.
 
 The rod is one polyline cell with the point arrays of
-:data:`rodmol.io.writers.ROD_ARRAYS` plus ``s [m]``, ``radius [m]`` (for the
+:data:`rodmol.io.parts.ROD_ARRAYS` plus ``s [m]``, ``radius [m]`` (for the
 Tube filter), ``velocity (global) [m/s]`` and the frame vectors
 ``frame x/y/z [-]`` (columns of the rotation, global). The cables are
 two-point segments with ``tension [N]`` (point and cell data), ``s [m]`` and
@@ -22,7 +22,7 @@ two-point segments with ``tension [N]`` (point and cell data), ``s [m]`` and
 from pathlib import Path
 
 from .._files import write_atomically
-from .writers import ROD_ARRAYS
+from .parts import ROD_ARRAYS
 
 VIEWS = ("rod", "cables", "markers")
 HEADER = '<?xml version="1.0" encoding="utf-8"?>\n<Xdmf Version="3.0"{ns}>\n<Domain>\n'

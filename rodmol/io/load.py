@@ -1,0 +1,30 @@
+"""Reading results back: :func:`load_result` for every file a run or
+:meth:`rodmol.Result.save` writes."""
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from ..result import ARRAYS, Result
+from .h5result import read_result
+
+
+def load_result(path):
+    """Read a :class:`Result`: a run directory (its ``result.h5``, else ``result.npz``), a
+    streamed run's ``result.h5`` or one of its views (``rod.xdmf``, ...; arrays read on first
+    access), or a ``.npz`` written by :meth:`Result.save`."""
+    path = Path(path)
+    if path.is_dir() or path.suffix == ".xdmf":
+        folder = path if path.is_dir() else path.parent
+        found = [folder / name for name in ("result.h5", "result.npz") if (folder / name).is_file()]
+        if not found:
+            raise FileNotFoundError(f"no result.h5 or result.npz in {str(folder)!r}")
+        path = found[0]
+    if path.suffix == ".h5":
+        return read_result(path)
+    with np.load(path, allow_pickle=False) as data:
+        info = json.loads(str(data["info"]))
+        # Files written before a key existed load without it.
+        arrays = {k: data[k] for k in ARRAYS if k in data}
+    return Result(arrays, info["success"], info["message"], info["stats"], info.get("meta"))
