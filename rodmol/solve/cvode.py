@@ -9,7 +9,7 @@ from scipy import sparse
 from ..discretise.preconditioner import check_structure
 from ..errors import ParameterError
 from ..inputs import knot_times
-from .outputs import Outputs, cause, step_size_stats
+from .outputs import Outputs, cause, run_steps, step_size_stats
 from .watch import Watch
 
 LINEAR_SOLVERS = ("gmres", "band", "lapackband", "sparse", "dense")
@@ -135,7 +135,9 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, l
 
     t_end = float(t_out[-1])
     sizes, r, t_last = [], None, float(t_out[0])  # sizes of the steps taken [s]
-    try:
+
+    def steps():
+        nonlocal r, t_last
         with warnings.catch_warnings():
             # scikit-sundae warns that its own coloured differences are not used
             # when both `sparsity` and `jacfn` are given: that is the point.
@@ -169,11 +171,7 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, l
             slow = watch.pace(r.t, r.y)
             if slow and not out.done:
                 return stop(slow)
-    except KeyboardInterrupt:
-        return stop("interrupted")
-    except Exception as exc:
-        return stop(cause(exc), exc)
-    return out.solution(True, "The solver reached the end time.", **stats())
+    return run_steps(steps, stop, out, stats)
 
 
 @contextlib.contextmanager

@@ -33,7 +33,7 @@ import numpy as np
 
 from ..errors import ParameterError
 from .newton_matrix import CONVERGED, DIVERGED, NOT_FINITE, SLOW, converged, newton_matrix
-from .outputs import Outputs, cause, step_size_stats
+from .outputs import Outputs, run_steps, step_size_stats
 from .watch import STALL_STEP, Watch
 
 #: Steps per first bending period of the rod when ``dt="auto"`` (period
@@ -154,7 +154,8 @@ def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_
     y = np.array(y0, dtype=float)
     t = t0
     f_start, f_end = np.empty_like(y), np.empty_like(y)  # rates at the step ends, for outputs
-    try:
+    def steps():
+        nonlocal t, y
         ydot = rates(t0, y, np.empty_like(y))
         g = gamma * alpha_f * h / alpha_m  # the Newton matrix's I - g J, for the step h
         matrix.refresh(t0, y, ydot, g)
@@ -209,11 +210,7 @@ def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_
             slow = watch.pace(t, y)
             if slow and not out.done:
                 return stop(slow)
-    except KeyboardInterrupt:
-        return stop("interrupted")
-    except Exception as exc:  # noqa: BLE001 (a user callback's too: the frames so far are kept)
-        return stop(cause(exc, t), exc)
-    return out.solution(True, "The solver reached the end time.", **stats())
+    return run_steps(steps, stop, out, stats, now=lambda: t)
 
 
 def _failure(outcome, t, h):

@@ -57,6 +57,23 @@ class Outputs:
         return RawSolution(self.t_out[:n].copy(), self.ys[:n], success, message, stats, error)
 
 
+def run_steps(steps, stop, out, stats, now=None):
+    """A backend's step loop with the endings every backend shares.
+
+    ``steps()`` returns a RawSolution to end early (``stop(reason)``), or
+    None once every output is done. Ctrl-C and exceptions (a user callback's
+    too) stop the run with the frames so far; ``now()`` [s] says when, for
+    exceptions that do not say it themselves.
+    """
+    try:
+        ended = steps()
+    except KeyboardInterrupt:
+        return stop("interrupted")
+    except Exception as exc:  # noqa: BLE001 (the frames so far are kept, the exception too)
+        return stop(cause(exc, None if now is None else now()), exc)
+    return ended if ended is not None else out.solution(True, "The solver reached the end time.", **stats())
+
+
 def step_size_stats(sizes):
     """Smallest, median and largest step [s] (0 if none), for the run's stats."""
     if not sizes:

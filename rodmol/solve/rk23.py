@@ -3,7 +3,7 @@
 import numpy as np
 from scipy.integrate import RK23
 
-from .outputs import Outputs, cause, step_size_stats
+from .outputs import Outputs, run_steps, step_size_stats
 from .watch import Watch
 
 
@@ -29,7 +29,7 @@ def rk23(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, ma
     def stop(reason, error=None):
         return out.stopped("RK23", watch, reason, error, **stats())
 
-    try:
+    def steps():
         solver = RK23(rhs, float(t_out[0]), np.array(y0, dtype=float), float(t_out[-1]),
                       rtol=rtol, atol=atol, max_step=max_step or np.inf)
         while not out.done:
@@ -47,8 +47,4 @@ def rk23(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, ma
             slow = watch.pace(solver.t, solver.y)
             if slow and not out.done:
                 return stop(slow)
-    except KeyboardInterrupt:
-        return stop("interrupted")
-    except Exception as exc:
-        return stop(cause(exc), exc)
-    return out.solution(True, "The solver reached the end time.", **stats())
+    return run_steps(steps, stop, out, stats)

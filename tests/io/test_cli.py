@@ -38,6 +38,15 @@ def assert_valid_series(directory):
 
 
 @pytest.mark.subprocess
+def assert_interrupted_run(out, stdout):
+    """An interrupted run of the fetching example: said so, and its directory valid up to where it got."""
+    assert "STOPPED" in stdout and "interrupted" in stdout
+    result = rodmol.load_result(out)
+    assert not result.success and "interrupted" in result.message
+    assert 2 <= len(result.t) < 801
+    assert assert_valid_views(out) == pytest.approx(list(result.t))
+
+
 def test_version():
     proc = rodmol_cli("--version")
     assert proc.returncode == 0 and proc.stdout.strip() == f"rodmol {rodmol.__version__}"
@@ -128,11 +137,7 @@ def test_ctrl_c_keeps_a_valid_partial_run(tmp_path):
         if process.poll() is None:
             process.kill()
     assert process.returncode == 130, stderr
-    assert "STOPPED" in stdout and "interrupted" in stdout
-    result = rodmol.load_result(out)
-    assert not result.success and "interrupted" in result.message
-    assert 2 <= len(result.t) < 801
-    assert assert_valid_views(out) == pytest.approx(list(result.t))
+    assert_interrupted_run(out, stdout)
 
 
 @pytest.mark.subprocess
