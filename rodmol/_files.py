@@ -11,8 +11,9 @@ def _umask():
     return mask
 
 
-def write_atomically(path, write):
-    """Call ``write(handle)`` on a binary file, then move it to ``path``.
+@contextlib.contextmanager
+def atomic_path(path):
+    """Yield a temporary path beside ``path``; moved to ``path`` when the block ends normally.
 
     The file is written under a unique temporary name in the same folder and
     renamed with :func:`os.replace`: a half-written file never sits under the
@@ -22,12 +23,18 @@ def write_atomically(path, write):
     path = os.fspath(path)
     folder, name = os.path.split(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".part", dir=folder)
+    os.close(fd)
     try:
-        with os.fdopen(fd, "wb") as handle:
-            write(handle)
+        yield tmp
         os.chmod(tmp, 0o666 & ~_umask())  # as an ordinary open() would have made it
         os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
+
+
+def write_atomically(path, write):
+    """Call ``write(handle)`` on a binary file, then move it to ``path`` (see :func:`atomic_path`)."""
+    with atomic_path(path) as tmp, open(tmp, "wb") as handle:
+        write(handle)

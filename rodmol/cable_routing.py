@@ -58,11 +58,6 @@ def offset_at(offset, s, name):
     return np.tile(np.asarray(offset, dtype=float), (len(s), 1))
 
 
-def is_constant(offset):
-    """True for a constant ``(p_y, p_z)`` offset."""
-    return not callable(offset) and not isinstance(offset[0], tuple)
-
-
 def cell_geometry(offset, s_nodes, s_cells, name):
     """Per cell: p at the cell's sampling point and p' across the cell, as the
     rows [0, p_y, p_z, 0, p_y', p_z'] (local frame), shape (len(s_cells), 6).

@@ -145,11 +145,11 @@ def as_time_input(name, value, width=1, unit="", minimum=None):
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError, OverflowError):
         raise ParameterError(f"`{name}` must be a number, {width} numbers, knots, a CSV path "
-                             f"or a callable of t, got {_short(value)}") from None
+                             f"or a callable of t, got {short(value)}") from None
     if arr.shape == (width,) or (width == 1 and arr.ndim == 0):
         arr = arr.reshape(width)
         if not np.all(np.isfinite(arr)):
-            raise ParameterError(f"`{name}` must be finite, got {_short(value)}")
+            raise ParameterError(f"`{name}` must be finite, got {short(value)}")
         _check_minimum(name, arr[None], minimum, unit, lambda i: "the value")
         return Constant(arr, width)
     times, values = knots(name, arr, width, value)
@@ -161,9 +161,9 @@ def knots(name, arr, width, raw=None):
     """Validated (times, values) of an array of knots (t, x_1..x_width)."""
     if arr.ndim != 2 or arr.shape[1] != 1 + width or len(arr) < 1:
         shape = "(t, value)" if width == 1 else f"(t, {width} values)"
-        raise ParameterError(f"`{name}` knots must be a list of {shape} rows, got {_short(raw)}")
+        raise ParameterError(f"`{name}` knots must be a list of {shape} rows, got {short(raw)}")
     if not np.all(np.isfinite(arr)):
-        raise ParameterError(f"`{name}` knots must be finite, got {_short(raw)}")
+        raise ParameterError(f"`{name}` knots must be finite, got {short(raw)}")
     steps = np.diff(arr[:, 0])
     if np.any(steps <= 0.0):
         i = int(np.flatnonzero(steps <= 0.0)[0]) + 1
@@ -179,10 +179,6 @@ def _check_minimum(name, values, minimum, unit, where):
         i = int(bad[0])
         raise ParameterError(f"`{name}` must be >= {minimum:g} {unit}; {where(i)} has "
                              f"{values[i].tolist() if values.shape[1] > 1 else float(values[i, 0])!r}")
-
-
-def _short(value):
-    return short(value)
 
 
 def _number(cell):

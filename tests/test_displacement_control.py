@@ -32,6 +32,9 @@ def test_pulling_the_actuator_shortens_the_path_by_dz_minus_the_tendon_stretch()
     for t, z in ((0.0, 0.0), (1.0, -PULL)):
         y = rodmol.equilibrium(model, t)
         tension = system.tensions(t, y)[0]
+        # Independent of the tendon law: the same rod pulled by that tension rests in that state.
+        twin = rodmol.Model(ROD, 20, cables=[rodmol.Cable((OFFSET, 0.0), L, tension=tension)])
+        np.testing.assert_allclose(rodmol.equilibrium(twin), y, atol=1e-8)
         free = rest + z
         lengths.append(path_length(model, y))
         stretches.append(COMPLIANCE * free * tension)

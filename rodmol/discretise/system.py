@@ -79,6 +79,11 @@ class StateView:
         return float(self.cable_lengths[self._routing.index[name]])
 
     def __getattr__(self, name):
+        value = self._compute(name)
+        self.__dict__[name] = value  # once per view: laws read the same attribute repeatedly
+        return value
+
+    def _compute(self, name):
         if name == "cable_lengths":
             return self._routing.lengths(self.q, self.k)
         if name in ("q", "k", "v", "w"):
@@ -122,7 +127,8 @@ class SemiDiscrete:
         self.layout = StateLayout(model.n_elements)
         self.size = self.layout.size
         # Feedback and displacement-controlled tensions and friction read the whole state.
-        self.global_coupling = model.feedback or model.friction
+        self._friction = model.friction  # a property over the cables: read once, not per call
+        self.global_coupling = model.feedback or self._friction
         m = model
         self.cells = m.cell_properties(self.scheme.cell_points(m.s_nodes))
         self.node_lengths = self.scheme.node_lengths(m.n_elements, m.ds)
@@ -201,7 +207,7 @@ class SemiDiscrete:
         else:
             for j, cable in self._timed:
                 self.tension_values[j] = cable.tension_at(t)
-        if m.friction:
+        if self._friction:
             self._weights[:] = self._path_weights * self.friction_factors(y)[self._active]
         self._grid_loads.fill(t, self.entry_values)
 
@@ -218,7 +224,7 @@ class SemiDiscrete:
         """Tension along each cable over its tension at the base, (n_cables, N),
         for the state ``y`` (all ones at rest or without friction; reads the
         base velocities of the last :meth:`update_inputs`)."""
-        if y is None or not self.model.friction:
+        if y is None or not self._friction:
             return np.ones((len(self.model.cables), self.model.n_elements))
         lay = self.layout
         return self.routing.friction_factors_of(lay.field(y, "q"), lay.field(y, "k"), lay.field(y, "v"),

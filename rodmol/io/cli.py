@@ -279,17 +279,14 @@ def summary(spec, result, wall, written):
 
 def _result_in(directory):
     """The result in a run directory (result.h5, else result.npz), or in the file given."""
-    from .load import load_result
+    from .load import load_result, result_file
 
-    path = Path(directory)
-    if path.is_dir():
-        found = [path / name for name in ("result.h5", "result.npz") if (path / name).is_file()]
-        if not found:
-            raise ParameterError(f"no result.h5 or result.npz in {str(directory)!r}; run "
-                                 "`rodmol run ... --out DIR` first")
-        path = found[0]
-    elif not path.is_file():
+    if not Path(directory).exists():
         raise ParameterError(f"no such run directory or result file: {str(directory)!r}")
+    try:
+        path = result_file(directory)
+    except FileNotFoundError as exc:
+        raise ParameterError(f"{exc}; run `rodmol run ... --out DIR` first") from None
     try:
         return load_result(path)
     except (OSError, KeyError, ValueError) as exc:

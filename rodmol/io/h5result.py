@@ -21,12 +21,11 @@ first access) and concatenates the chunks.
 """
 
 import json
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from .._files import atomic_path
 from ..result import ARRAYS, Result
 
 INDEX = "result.h5"
@@ -44,17 +43,8 @@ def atomic_h5(path, fill):
     """Write an HDF5 file with ``fill(h5py.File)`` under a temporary name, then rename it to ``path``."""
     import h5py
 
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
-    os.close(fd)
-    try:
-        with h5py.File(tmp, "w", libver=LIBVER) as handle:
-            fill(handle)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_path(path) as tmp, h5py.File(tmp, "w", libver=LIBVER) as handle:
+        fill(handle)
 
 
 def chunk_name(index):

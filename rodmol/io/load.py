@@ -10,17 +10,24 @@ from ..result import ARRAYS, Result
 from .h5result import read_result
 
 
-def load_result(path):
-    """Read a :class:`Result`: a run directory (its ``result.h5``, else ``result.npz``), a
-    streamed run's ``result.h5`` or one of its views (``rod.xdmf``, ...; arrays read on first
-    access), or a ``.npz`` written by :meth:`Result.save`."""
+def result_file(path):
+    """The result file of ``path``: itself, or for a run directory or one of its
+    views the directory's ``result.h5``, else its ``result.npz``."""
     path = Path(path)
     if path.is_dir() or path.suffix == ".xdmf":
         folder = path if path.is_dir() else path.parent
         found = [folder / name for name in ("result.h5", "result.npz") if (folder / name).is_file()]
         if not found:
             raise FileNotFoundError(f"no result.h5 or result.npz in {str(folder)!r}")
-        path = found[0]
+        return found[0]
+    return path
+
+
+def load_result(path):
+    """Read a :class:`Result`: a run directory (its ``result.h5``, else ``result.npz``), a
+    streamed run's ``result.h5`` or one of its views (``rod.xdmf``, ...; arrays read on first
+    access), or a ``.npz`` written by :meth:`Result.save`."""
+    path = result_file(path)
     if path.suffix == ".h5":
         return read_result(path)
     with np.load(path, allow_pickle=False) as data:

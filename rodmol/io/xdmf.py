@@ -22,9 +22,9 @@ two-point segments with ``tension [N]`` (point and cell data), ``s [m]`` and
 from pathlib import Path
 
 from .._files import write_atomically
-from .parts import ROD_ARRAYS
+from .parts import PARTS, ROD_ARRAYS
 
-VIEWS = ("rod", "cables", "markers")
+VIEWS = PARTS  # one view per drawn part
 HEADER = '<?xml version="1.0" encoding="utf-8"?>\n<Xdmf Version="3.0"{ns}>\n<Domain>\n'
 FOOTER = "</Domain>\n</Xdmf>\n"
 XI = ' xmlns:xi="http://www.w3.org/2001/XInclude"'

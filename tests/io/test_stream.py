@@ -46,7 +46,7 @@ def test_chunks_restart_the_solver_within_its_tolerance(model, tmp_path):
     assert len(list((tmp_path / "frames").glob("chunk_*.h5"))) == 9  # 61 frames: 8 of 7 + the first
     np.testing.assert_array_equal(chunked.t, memory.t)
     # A restart forgets the step history, not the state: the tip moves by the solver's error only.
-    assert np.abs(chunked.tip - memory.tip).max() < 1e-4 * model.rod.length * 10
+    assert np.abs(chunked.tip - memory.tip).max() < 1e-4 * model.rod.length  # measured 2.1e-5 m
     assert assert_valid_views(tmp_path) == pytest.approx(memory.t)
 
 

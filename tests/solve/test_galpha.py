@@ -32,15 +32,9 @@ def steel_models(n=40, mu=0.0):
     return free, loaded
 
 
-def released(model, loaded):
-    """The loaded model's static equilibrium, the start of a release."""
-    return rodmol.equilibrium(loaded)
-
-
 def test_coefficients_second_order_and_limits():
-    for rho in (0.0, 0.3, 0.9, 1.0):
-        am, af, g = coefficients(rho)
-        assert g == pytest.approx(0.5 + am - af)
+    # Jansen, Whiting and Hulbert (2000), rho_inf = 0.5: alpha_m = 5/6, alpha_f = gamma = 2/3.
+    assert coefficients(0.5) == pytest.approx((5 / 6, 2 / 3, 2 / 3))
     assert coefficients(1.0) == pytest.approx((0.5, 0.5, 0.5))  # implicit midpoint
     assert coefficients(0.0) == pytest.approx((1.5, 1.0, 1.0))  # BDF2-like
 
@@ -114,9 +108,10 @@ def test_steel_cantilever_first_period_matches_euler_bernoulli():
                           dt=2e-3, rho_inf=0.9, output_dt=2e-3)
     assert run.success
     assert rodmol.oscillation_period(run.t, run.tip[:, 1]) == pytest.approx(period, rel=5e-3)
-    # the tip swings about the gravity equilibrium with the release amplitude
+    # the tip swings about the gravity equilibrium with the release amplitude: the
+    # tip force's static deflection F L^3 / (3 EI) = 52 mm (measured 51 mm)
     amplitude = np.ptp(run.tip[:, 1]) / 2
-    assert amplitude == pytest.approx(0.051, rel=0.05)
+    assert amplitude == pytest.approx(TIP_FORCE * p["length"]**3 / (3 * ei), rel=0.05)
 
 
 def test_compiled_and_python_newton_loops_agree():
