@@ -1,5 +1,6 @@
 """Small validators shared by the parameter classes (never ``assert``)."""
 
+import difflib
 import math
 
 import numpy as np
@@ -86,3 +87,11 @@ def integer_at_least(name, value, minimum):
     if value < minimum:
         raise ParameterError(f"`{name}` must be >= {minimum}, got {short(value)}")
     return int(value)
+
+
+def did_you_mean(value, options):
+    """``"; did you mean 'x'?"`` for a near miss among ``options``, else ``""``."""
+    if not isinstance(value, str):
+        return ""
+    close = difflib.get_close_matches(value, [str(o) for o in options], n=1, cutoff=0.6)
+    return f"; did you mean {close[0]!r}?" if close else ""

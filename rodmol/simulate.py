@@ -7,10 +7,9 @@ from contextlib import contextmanager, nullcontext
 import numpy as np
 
 from . import _checks
-from .discretise import rotations
 from .discretise.layout import StateLayout
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
-from .discretise.system import SemiDiscrete, field_scales
+from .discretise.system import SemiDiscrete, field_scales, straight_state
 from .errors import ParameterError
 from .model import Model
 from .result import Result, from_states
@@ -29,14 +28,6 @@ def default_atol(model, rtol):
     with T the first bending period), so that every field's error moves the
     rod by about ``rtol`` L."""
     return rtol * StateLayout(model.n_elements).scales(field_scales(model))
-
-
-def straight_state(model):
-    """The undeformed rod at rest along the base's x axis."""
-    base = model.base
-    return StateLayout(model.n_elements).straight(
-        model.s_nodes, np.asarray(base.position, dtype=float), np.asarray(base.rotation, dtype=float),
-        rotations.from_matrix(base.rotation))
 
 
 def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, backend="cvode",
@@ -145,7 +136,7 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
         t_out = plan
     if isinstance(initial, str) and initial not in INITIAL:
         raise ParameterError(f"unknown `initial` {_checks.short(initial)}"
-                             f"{options.did_you_mean(initial, INITIAL)}; use 'equilibrium', "
+                             f"{_checks.did_you_mean(initial, INITIAL)}; use 'equilibrium', "
                              "'straight' or a state")
     if atol is not None:
         atol = _state_sized("atol", atol, size, positive=True, layout=StateLayout(model.n_elements))

@@ -15,11 +15,11 @@ To add a scheme, add a :class:`Scheme` to :data:`SCHEMES` (and, if its loop
 differs, a switch in the stencil).
 """
 
-import difflib
 from dataclasses import dataclass
 
 import numpy as np
 
+from .._checks import did_you_mean
 from ..errors import ParameterError
 
 #: Fields of the upwind stencil. The next block's w reaches the force only
@@ -91,6 +91,5 @@ def get_scheme(name):
         return name
     if name in SCHEMES:
         return SCHEMES[name]
-    close = difflib.get_close_matches(str(name), SCHEMES, n=1)
-    hint = f" (did you mean {close[0]!r}?)" if close else ""
-    raise ParameterError(f"unknown `scheme` {name!r}{hint}; choose one of {', '.join(map(repr, SCHEMES))}")
+    raise ParameterError(f"unknown `scheme` {name!r}{did_you_mean(name, SCHEMES)} "
+                         f"(schemes: {', '.join(map(repr, SCHEMES))})")

@@ -26,6 +26,23 @@ QUATERNION_RESTORING_RATE = 1.0
 DRAG_SMOOTHING_SPEED = 1e-6
 
 
+def first_bending_period(model):
+    """Period [s] of the first bending mode of a uniform cantilever with the
+    base section (Euler-Bernoulli, without the fluid): the rod's time scale."""
+    rod = model.rod
+    mat, r_base = rod.material, float(rod.radius_at(0.0))
+    omega = 1.8751**2 * np.sqrt(mat.E * r_base**2 / (4.0 * mat.rho)) / rod.length**2
+    return 2.0 * np.pi / omega
+
+
+def straight_state(model):
+    """The undeformed rod at rest along the base's x axis."""
+    base = model.base
+    return StateLayout(model.n_elements).straight(
+        model.s_nodes, np.asarray(base.position, dtype=float), np.asarray(base.rotation, dtype=float),
+        rotations.from_matrix(base.rotation))
+
+
 def field_scales(model):
     """Typical size of each field, chosen so that an error of ``rtol``
     times the scale in any field moves the rod by about ``rtol`` L:
@@ -35,11 +52,9 @@ def field_scales(model):
     first bending mode of a uniform cantilever with the base section
     (Euler-Bernoulli, without the fluid), the time scale of the motion."""
     rod = model.rod
-    length, r_base = rod.length, float(rod.radius_at(0.0))
+    length = rod.length
     r_min = float(np.min(rod.radius_at(model.s_nodes)))
-    mat = rod.material
-    omega = 1.8751**2 * np.sqrt(mat.E * r_base**2 / (4.0 * mat.rho)) / length**2
-    speed = length * omega / (2.0 * np.pi)
+    speed = length / first_bending_period(model)
     return {"u": length, "Q": 1.0, "q": 1.0, "k": 1.0 / length, "v": speed, "w": speed / r_min}
 
 
@@ -130,7 +145,8 @@ class SemiDiscrete:
         self._friction = model.friction  # a property over the cables: read once, not per call
         self.global_coupling = model.feedback or self._friction
         m = model
-        self.cells = m.cell_properties(self.scheme.cell_points(m.s_nodes))
+        s_cells = self.scheme.cell_points(m.s_nodes)
+        self.cells = m.cell_properties(s_cells)
         self.node_lengths = self.scheme.node_lengths(m.n_elements, m.ds)
         self.lightly_damped = grid_damping_ratio(m) < 1.0
         self._params = stencil.pack_params(*self.cells, m.mass, m.inertia, m.net_mass,
@@ -143,7 +159,7 @@ class SemiDiscrete:
         self._work = np.zeros((m.n_elements, stencil.WORK_COLUMNS))
         self.base_velocities = np.zeros(6)
         self._fixed_base = m.base.fixed
-        self._setup_cables()
+        self._setup_cables(s_cells)
         self._setup_loads()
         self.depends = merge(self.scheme.depends, external.dependency_table(set(self._kinds)))
         self._inputs_vary = bool(self.global_coupling or self._timed or self._grid_loads.values
@@ -158,7 +174,7 @@ class SemiDiscrete:
 
     # ------------------------------------------------------------------ inputs
 
-    def _setup_cables(self):
+    def _setup_cables(self, s_cells):
         """Sort the cables by how their tension is evaluated, once: constant
         tensions are read here (slack ones are left out of the kernel), the
         time-dependent ones at each call; feedback laws read the state, so
@@ -170,7 +186,7 @@ class SemiDiscrete:
         else:
             active = [i for i, value in enumerate(constant) if value != 0.0]
         self._active = np.array(active, dtype=int)
-        self.routing = CableRouting(m, self.scheme.cell_points(m.s_nodes))
+        self.routing = CableRouting(m, s_cells)
         self._offsets = np.ascontiguousarray(self.routing.geometry[self._active]).reshape(
             len(active), m.n_elements, 6)
         self._path_weights = np.ascontiguousarray(self.routing.weights[self._active]).reshape(

@@ -22,7 +22,7 @@ from pathlib import Path
 
 from .._progress import Progress
 from ..errors import ParameterError
-from .cli_options import EXAMPLES, add_run_options, load_spec
+from .cli_options import EXAMPLES, add_run_options, load_spec, make_output_directory
 from .lock import OutputLock
 
 EXIT_FAILED, EXIT_USAGE, EXIT_OUTPUT, EXIT_INTERRUPTED = 1, 2, 3, 130
@@ -88,11 +88,7 @@ def _parser():
 def _run(args):
     spec = load_spec(args)
     out = args.out or spec.output.directory or Path("out") / spec.name
-    try:  # before the run, so a directory that cannot be made does not waste it
-        out.mkdir(parents=True, exist_ok=True)
-    except (OSError, ValueError) as exc:
-        reason = getattr(exc, "strerror", None) or str(exc)
-        raise ParameterError(f"cannot create the output directory {str(out)!r}: {reason}") from None
+    make_output_directory(out)  # before the run, so a directory that cannot be made does not waste it
     with OutputLock(out):  # one run per output directory
         return _run_locked(args, spec, out)
 

@@ -84,10 +84,9 @@ def _progress(args, label):
 
 def _out(args, spec, kind):
     out = args.out or Path("out") / f"{spec.name}-{kind}"
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise ParameterError(f"cannot create the output directory {str(out)!r}: {exc.strerror}") from None
+    from .cli_options import make_output_directory
+
+    make_output_directory(out)
     return out
 
 

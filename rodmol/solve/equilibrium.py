@@ -17,7 +17,7 @@ from scipy.linalg import solve_banded
 from ..discretise import centreline, rotations
 from ..discretise.layout import BlockLayout
 from ..discretise.schemes import DEFAULT_SCHEME
-from ..discretise.system import SemiDiscrete
+from ..discretise.system import SemiDiscrete, straight_state
 from ..errors import EquilibriumError, ParameterError
 from ..model import Model
 from .watch import state_problem
@@ -91,15 +91,12 @@ def _closed_loop(system, t, tol, max_iter, max_rounds=30):
     """The rest state under feedback tensions: Newton on the tensions T of the
     feedback cables, F(T) = law(rest state under T) - T = 0, with differences."""
     model = system.model
-    layout = system.layout
     feedback = np.array([c.tension.feedback for c in model.cables])
 
     def law(y):
         return system.tensions(t, y)
 
-    y = layout.straight(model.s_nodes, np.asarray(model.base.position, dtype=float),
-                        np.asarray(model.base.rotation, dtype=float),
-                        rotations.from_matrix(model.base.rotation))
+    y = straight_state(model)
     tensions = law(y)
     # A displacement-controlled cable's law on the straight rod can ask for far
     # more than the arm carries (the rigid-rod tension); start it slack.
@@ -158,7 +155,7 @@ def _rest_state(system, t, tol, max_iter, tensions=None, start=None):
     base = model.base
     quat0 = rotations.from_matrix(base.rotation)
     u0 = np.asarray(base.position, dtype=float)
-    y = layout.straight(model.s_nodes, u0, np.asarray(base.rotation, dtype=float), quat0)
+    y = straight_state(model)
     z = np.hstack([layout.field(y, f) for f in STATIC_FIELDS]).ravel()
     scale = model.load_scale(t, tensions)
     if scale == 0.0 and not model.loads:

@@ -65,10 +65,9 @@ def coefficients(rho_inf):
 
 def auto_dt(system):
     """The step of ``dt="auto"`` [s]: the first bending period over STEPS_PER_PERIOD."""
-    from ..discretise.system import field_scales
+    from ..discretise.system import first_bending_period
 
-    # field_scales' velocity scale is L / T, T the first bending period.
-    return system.model.rod.length / field_scales(system.model)["v"] / STEPS_PER_PERIOD
+    return first_bending_period(system.model) / STEPS_PER_PERIOD
 
 
 def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None,

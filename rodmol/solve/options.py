@@ -5,7 +5,6 @@ Backend options are checked against the backend's own keyword arguments
 :data:`VALUES`; output sizes are bounded before anything is allocated.
 """
 
-import difflib
 import inspect
 import math
 
@@ -63,7 +62,7 @@ def _flag(name, value):
 def _choice(options):
     def check(name, value):
         if value not in options:
-            raise ParameterError(f"unknown `{name}` {_checks.short(value)}{did_you_mean(value, options)}; "
+            raise ParameterError(f"unknown `{name}` {_checks.short(value)}{_checks.did_you_mean(value, options)}; "
                                  f"valid: {', '.join(map(repr, options))}")
         return value
     return check
@@ -84,14 +83,6 @@ def _values():
     }
 
 
-def did_you_mean(value, options):
-    """``"; did you mean 'x'?"`` for a near miss among ``options``, else ``""``."""
-    if not isinstance(value, str):
-        return ""
-    close = difflib.get_close_matches(value, [str(o) for o in options], n=1, cutoff=0.6)
-    return f"; did you mean {close[0]!r}?" if close else ""
-
-
 def backend_options(backend, run, options):
     """The checked ``options`` of backend function ``run`` (named ``backend``)."""
     accepted = [name for name, p in inspect.signature(run).parameters.items()
@@ -100,7 +91,7 @@ def backend_options(backend, run, options):
     checked = {}
     for key, value in options.items():
         if key not in accepted:
-            tip = did_you_mean(key, accepted + list(SIMULATE_KEYWORDS))
+            tip = _checks.did_you_mean(key, accepted + list(SIMULATE_KEYWORDS))
             valid = ", ".join(accepted) if accepted else "none"
             raise ParameterError(f"unknown option `{key}` for backend {backend!r}{tip} "
                                  f"(its options: {valid})")
