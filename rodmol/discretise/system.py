@@ -26,13 +26,13 @@ QUATERNION_RESTORING_RATE = 1.0
 DRAG_SMOOTHING_SPEED = 1e-6
 
 
-def first_bending_period(model):
-    """Period [s] of the first bending mode of a uniform cantilever with the
-    base section (Euler-Bernoulli, without the fluid): the rod's time scale."""
+def first_bending_frequency(model):
+    """Angular frequency [rad/s] of the first bending mode of a uniform
+    cantilever with the base section (Euler-Bernoulli, without the fluid):
+    2 pi over it is the rod's time scale."""
     rod = model.rod
     mat, r_base = rod.material, float(rod.radius_at(0.0))
-    omega = 1.8751**2 * np.sqrt(mat.E * r_base**2 / (4.0 * mat.rho)) / rod.length**2
-    return 2.0 * np.pi / omega
+    return 1.8751**2 * np.sqrt(mat.E * r_base**2 / (4.0 * mat.rho)) / rod.length**2
 
 
 def straight_state(model):
@@ -54,7 +54,7 @@ def field_scales(model):
     rod = model.rod
     length = rod.length
     r_min = float(np.min(rod.radius_at(model.s_nodes)))
-    speed = length / first_bending_period(model)
+    speed = length * first_bending_frequency(model) / (2.0 * np.pi)  # L / T
     return {"u": length, "Q": 1.0, "q": 1.0, "k": 1.0 / length, "v": speed, "w": speed / r_min}
 
 

@@ -65,9 +65,9 @@ def coefficients(rho_inf):
 
 def auto_dt(system):
     """The step of ``dt="auto"`` [s]: the first bending period over STEPS_PER_PERIOD."""
-    from ..discretise.system import first_bending_period
+    from ..discretise.system import first_bending_frequency
 
-    return first_bending_period(system.model) / STEPS_PER_PERIOD
+    return 2.0 * np.pi / first_bending_frequency(system.model) / STEPS_PER_PERIOD
 
 
 def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None,
