@@ -118,16 +118,25 @@ class Model:
         self.marker_offsets = marker_offsets(self.markers, rod)
         self._sample()
 
+    def options(self):
+        """The keyword arguments this model was built with (after checking)."""
+        return dict(gravity=tuple(self.gravity), medium=self.medium, cables=self.cables,
+                    base=self.base, drag=self.drag, added_mass=self.added_mass,
+                    viscosity=self.viscosity, munk_moment=self.munk_moment,
+                    markers=self.markers, loads=self.loads, drag_law=self.drag_law,
+                    drag_coefficients=self.drag_coefficients)
+
+    def replace(self, *, rod=None, n_elements=None, **changes):
+        """A new Model with ``changes`` (any argument of the constructor); the others as here."""
+        return type(self)(self.rod if rod is None else rod,
+                          self.n_elements if n_elements is None else n_elements,
+                          **{**self.options(), **changes})
+
     def __reduce__(self):
         # Rebuilt from its arguments on unpickling: the sampled arrays follow
         # from them, and the grid loads' time functions are closures.
         _check_no_inline_functions(self)
-        options = dict(gravity=tuple(self.gravity), medium=self.medium, cables=self.cables,
-                       base=self.base, drag=self.drag, added_mass=self.added_mass,
-                       viscosity=self.viscosity, munk_moment=self.munk_moment,
-                       markers=self.markers, loads=self.loads, drag_law=self.drag_law,
-                       drag_coefficients=self.drag_coefficients)
-        return (_rebuild, (type(self), self.rod, self.n_elements, options))
+        return (_rebuild, (type(self), self.rod, self.n_elements, self.options()))
 
     def __repr__(self):
         return (f"Model(L={self.rod.length} m, N={self.n_elements}, medium rho={self.medium.rho} "

@@ -26,7 +26,9 @@ def linearize(model, state, t=0.0, scheme=DEFAULT_SCHEME):
     -------
     A : (size, size) d f / d y, from the system's compiled Jacobian, with the
         cable tensions held at their values at (state, t) (open loop: a
-        feedback law's own dependence on the state is not in A).
+        feedback law's or an actuator's own dependence on the state is not in
+        A). With friction, whose factors along each cable depend on the
+        sliding of its whole path, A comes from central differences instead.
     B : (size, n_cables) d f / d T [per N], one column per cable in the
         model's order. The right-hand side is affine in the tensions (the
         cable loads are T times a function of the state), so B is exact up
@@ -46,21 +48,23 @@ def linearize(model, state, t=0.0, scheme=DEFAULT_SCHEME):
     tensions = model.tensions(t, probe.state_view(t, y) if model.feedback else None)
     # The same model with every cable active and its tension set by hand: a
     # constant nonzero tension keeps each cable in the kernel.
-    held = Model(model.rod, model.n_elements, gravity=model.gravity, medium=model.medium,
-                 cables=[Cable(c.offset, c.anchor, 1.0, name=c.name, outside_body=c.outside_body)
-                         for c in model.cables],
-                 base=model.base, drag=model.drag, added_mass=model.added_mass,
-                 viscosity=model.viscosity, munk_moment=model.munk_moment, markers=model.markers,
-                 loads=model.loads, drag_law=model.drag_law, drag_coefficients=model.drag_coefficients)
+    # Friction stays: its factors depend on the state, and scale the tension.
+    held = model.replace(cables=[Cable(c.offset, c.anchor, 1.0, name=c.name, outside_body=c.outside_body,
+                                       friction=c.friction, slip_speed=c.slip_speed)
+                                 for c in model.cables])
     system = SemiDiscrete(held, scheme)
-    system.tension_values[:] = tensions
-    a = system.jacobian(system.atol_scale(), matrix="dense").dense(t, y)
-    b = np.empty((system.size, len(model.cables)))
-    for j in range(len(model.cables)):
+
+    def rates(x, cable_tensions):
+        return system.rest_rates(t, x, np.empty(system.size), tensions=cable_tensions)
+
+    if system.global_coupling:  # friction couples each cable's whole path: no band to colour
+        step = 1e-6 * system.atol_scale()
+        a = np.column_stack([(rates(y + e, tensions) - rates(y - e, tensions)) / (2 * h)
+                             for e, h in zip(np.diag(step), step)])
+    else:
         system.tension_values[:] = tensions
-        system.tension_values[j] += 1.0
-        up = system(t, y).copy()
-        system.tension_values[j] -= 2.0
-        b[:, j] = 0.5 * (up - system(t, y))
-    system.tension_values[:] = tensions
+        a = system.jacobian(system.atol_scale(), matrix="dense").dense(t, y)
+    b = np.empty((system.size, len(model.cables)))
+    for j, unit in enumerate(np.eye(len(model.cables))):
+        b[:, j] = 0.5 * (rates(y, tensions + unit) - rates(y, tensions - unit))
     return a, b

@@ -128,11 +128,9 @@ def apply(spec, overrides):
                     lambda: Medium(**{**{k: getattr(model.medium, k) for k in MEDIUM}, **groups["medium"]}))
     cables = [_cable(c, groups["tension"].get(i)) for i, c in enumerate(model.cables)]
     switches = {k: groups["switches"].get(k, getattr(model, k)) for k in SWITCHES}
-    new_model = _guard("overrides", changes, lambda: Model(
-        Rod(model.rod.length, model.rod.radius, material), n_elements, gravity=model.gravity,
-        medium=medium, cables=cables, base=model.base, viscosity=model.viscosity,
-        markers=model.markers, loads=model.loads, drag_law=model.drag_law,
-        drag_coefficients=model.drag_coefficients, **switches))
+    new_model = _guard("overrides", changes, lambda: model.replace(
+        rod=Rod(model.rod.length, model.rod.radius, material), n_elements=n_elements, medium=medium,
+        cables=cables, **switches))
     solver = dict(spec.solver)
     t_end = spec.t_end
     for name, value in groups["solver"].items():

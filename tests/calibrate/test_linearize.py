@@ -1,5 +1,7 @@
 """Linearisation: A and B against finite differences of the system."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -30,8 +32,13 @@ def central(f, x, h):
     return np.column_stack(cols)
 
 
-def test_state_jacobian_matches_central_differences(bent):
+@pytest.mark.parametrize("friction", [0.0, 0.3])
+def test_state_jacobian_matches_central_differences(bent, friction):
+    """With friction the tension along the cable depends on the sliding
+    velocities, a coupling the linearisation must keep."""
     model, y = bent
+    if friction:
+        model = model.replace(cables=[replace(c, friction=friction, slip_speed=0.05) for c in model.cables])
     a, _ = linearize(model, y, 0.3)
     system = rodmol.SemiDiscrete(model)
     reference = central(lambda x: system(0.3, x), y, 1e-6 * system.atol_scale())
