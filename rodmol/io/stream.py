@@ -91,9 +91,7 @@ class RunWriter:
 
         started = time.perf_counter()
         chunk = from_states(self.system, np.asarray(t, dtype=float), np.asarray(y), True, "", {})
-        chunk.meta.update(self.extra_meta)
-        self.store({name: getattr(chunk, name) for name in SERIES},
-                   {key: getattr(chunk, key) for key in STATIC}, chunk.meta)
+        self.store({name: getattr(chunk, name) for name in SERIES})
         self.seconds += time.perf_counter() - started
 
     def end(self, success, message, stats):
@@ -113,8 +111,9 @@ class RunWriter:
 
     # ----------------------------------------------------------------- other uses
 
-    def store(self, arrays, static, meta):
-        """Write one chunk from the Result arrays of its frames (``SERIES`` names, time first)."""
+    def store(self, arrays, static=None, meta=None):
+        """Write one chunk from the Result arrays of its frames (``SERIES`` names, time first);
+        ``static`` arrays and ``meta`` of the Result, unless :meth:`begin` gave them."""
         if self.static is None:
             self.static, self.meta = static, dict(meta, **self.extra_meta)
         index = len(self.chunks)
