@@ -136,7 +136,7 @@ class Watch:
         # 1 - T / EA turns negative) though no element of the state does.
         model = system.model
         self.system = system
-        self.tip_cables = [c for c, w in zip(model.cables, model.cable_weights[:, -1]) if w == 1.0]
+        self.tip_cables = np.flatnonzero(model.cable_weights[:, -1] == 1.0)  # anchored at the tip
         self.tip_stiffness = float(model.rod.stiffness(model.rod.length)[0][0])
 
     def state(self, t, h, y):
@@ -148,15 +148,12 @@ class Watch:
         if code != OK:
             return _describe(self.layout, self.ds, t, code, i, value)
         self._worst = (i, value)
-        if self.tip_cables:
+        if len(self.tip_cables):
             return self._tip(t, y)
         return None
 
     def _tip(self, t, y):
-        state = None
-        if self.system.global_coupling:
-            state = self.system.state_view(t, y)
-        pull = sum(c.tension_at(t, state) for c in self.tip_cables)
+        pull = float(np.sum(self.system.tensions(t, y)[self.tip_cables]))
         q1 = 1.0 - pull / self.tip_stiffness
         if q1 > MIN_STRETCH:
             return None
