@@ -19,8 +19,10 @@ import subprocess
 import sys
 import tempfile
 import textwrap
+import time
 
 import _common as C
+import numpy as np
 
 SCRIPT = "long_output.py"
 FETCHING = os.path.join(os.path.dirname(C.HERE), "examples", "fetching.toml")
@@ -64,8 +66,24 @@ def run_case(t_end, fmt, n_elements=0):
             raise RuntimeError(proc.stderr[-3000:])
         row = json.loads(proc.stdout.strip().splitlines()[-1])
         files = [os.path.join(d, f) for d, _, names in os.walk(out) for f in names]
-        row.update(files=len(files), megabytes=sum(os.path.getsize(f) for f in files) / 1e6)
+        sizes = [os.path.getsize(f) for f in files]
+        row.update(files=len(files), megabytes=sum(sizes) / 1e6, raw_disk_s=raw_disk_time(sizes, tmp))
     return row
+
+
+def raw_disk_time(sizes, folder):
+    """Wall time [s] to write files of ``sizes`` bytes with plain ``write`` calls: what the
+    disk alone costs for the run's bytes, with the run's own writes flushed first."""
+    os.sync()
+    largest = np.zeros(max(sizes), dtype=np.uint8)
+    started = time.perf_counter()
+    for i, size in enumerate(sizes):
+        with open(os.path.join(folder, f"raw_{i}"), "wb") as handle:
+            handle.write(memoryview(largest)[:size])
+    elapsed = time.perf_counter() - started
+    for i in range(len(sizes)):
+        os.unlink(os.path.join(folder, f"raw_{i}"))
+    return elapsed
 
 
 def main(argv=None):
@@ -79,10 +97,13 @@ def main(argv=None):
     for t_end, fmt in cases:
         row = dict(t_end_s=t_end, format=fmt, N=n or 100, **run_case(t_end, fmt, n))
         row["writing_over_solver"] = row["writing_s"] / row["solver_s"]
+        # The disk's share, and what the exact state history alone (7 + 19 N doubles a frame) weighs.
+        row["raw_disk_over_solver"] = row["raw_disk_s"] / row["solver_s"]
+        row["states_mb"] = row["frames"] * (7 + 19 * row["N"]) * 8 / 1e6
         rows.append(row)
         print(f"t_end = {t_end:g} s, {fmt}: solver {row['solver_s']:.2f} s, writing {row['writing_s']:.2f} s "
               f"({row['writing_over_solver']:.2f}x), peak {row['peak_rss_mb']:.0f} MB, {row['files']} files, "
-              f"{row['megabytes']:.0f} MB", flush=True)
+              f"{row['megabytes']:.0f} MB (plain writes of as many bytes: {row['raw_disk_s']:.2f} s)", flush=True)
     base = os.path.join(args.out, "long_output")
     C.write_csv(base + ".csv", rows, header)
     C.write_markdown(base + ".md", "Long runs and output (examples/fetching.toml)", header,

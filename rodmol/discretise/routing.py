@@ -61,30 +61,43 @@ class CableRouting:
         sliding, with the sign regularised as x / sqrt(x^2 + slip_speed^2):
         T(s) = T(0) exp(-mu int_0^s sigma kappa ds).
         """
-        c = self.path_vectors(q, k)
-        norm = np.linalg.norm(c, axis=-1, keepdims=True)
-        tau = c / norm
-        # d|c|/dt = tau . (q_t + k_t x p): the path's stretch rate per unit s.
-        stretch_rate = np.sum(tau * (q_t[None] + np.cross(k_t[None], self.geometry[..., :3])), axis=-1)
-        beyond = np.cumsum((self.weights * stretch_rate)[:, ::-1], axis=1)[:, ::-1] * self.ds
-        sigma = -beyond / np.sqrt(beyond**2 + self.slip_speed[:, None] ** 2)
-        dtau = np.gradient(tau, self.ds, axis=1) if self.n > 1 else np.zeros_like(tau)
-        kappa = np.linalg.norm(dtau + np.cross(k[None], tau), axis=-1)
-        turn = self.friction[:, None] * sigma * kappa * self.weights * self.ds
-        exponent = np.cumsum(turn, axis=1) - 0.5 * turn  # to the middle of each cell
-        return np.exp(-exponent)
+        out = np.empty(self.weights.shape)
+        _friction_factors(*(np.ascontiguousarray(a, dtype=float) for a in (q, k, q_t, k_t)), self.geometry,
+                          self.weights, self.friction, self.slip_speed, self.ds, out)
+        return out
 
     def friction_factors_of(self, q, k, v, w, base_velocities):
         """:meth:`friction_factors` of a state: strains q, k and velocities v, w
         (N, 3), base velocities (v0, w0) (6,); the strain rates come from the
         compatibility laws with the velocities averaged over each cell (in
         both schemes: they only give the sliding direction)."""
-        v_prev = np.vstack([base_velocities[:3], v[:-1]])
-        w_prev = np.vstack([base_velocities[3:], w[:-1]])
-        v_bar, w_bar = 0.5 * (v + v_prev), 0.5 * (w + w_prev)
-        q_t = (v - v_prev) / self.ds + np.cross(k, v_bar) - np.cross(w_bar, q)
-        k_t = (w - w_prev) / self.ds + np.cross(k, w_bar)
+        q_t, k_t = np.empty((self.n, 3)), np.empty((self.n, 3))
+        _strain_rates(*(np.ascontiguousarray(a, dtype=float) for a in (q, k, v, w, base_velocities)),
+                      self.ds, q_t, k_t)
         return self.friction_factors(q, k, q_t, k_t)
+
+
+@jit
+def _strain_rates(q, k, v, w, base_velocities, ds, q_t, k_t):
+    # q_t = v' + k x v - w x q, k_t = w' + k x w with v, w averaged over each cell.
+    for i in range(q.shape[0]):
+        if i == 0:
+            v0, v1, v2 = base_velocities[0], base_velocities[1], base_velocities[2]
+            w0, w1, w2 = base_velocities[3], base_velocities[4], base_velocities[5]
+        else:
+            v0, v1, v2 = v[i - 1, 0], v[i - 1, 1], v[i - 1, 2]
+            w0, w1, w2 = w[i - 1, 0], w[i - 1, 1], w[i - 1, 2]
+        vb0, vb1, vb2 = 0.5 * (v[i, 0] + v0), 0.5 * (v[i, 1] + v1), 0.5 * (v[i, 2] + v2)
+        wb0, wb1, wb2 = 0.5 * (w[i, 0] + w0), 0.5 * (w[i, 1] + w1), 0.5 * (w[i, 2] + w2)
+        kv = _cross(k[i, 0], k[i, 1], k[i, 2], vb0, vb1, vb2)
+        wq = _cross(wb0, wb1, wb2, q[i, 0], q[i, 1], q[i, 2])
+        kw = _cross(k[i, 0], k[i, 1], k[i, 2], wb0, wb1, wb2)
+        q_t[i, 0] = (v[i, 0] - v0) / ds + kv[0] - wq[0]
+        q_t[i, 1] = (v[i, 1] - v1) / ds + kv[1] - wq[1]
+        q_t[i, 2] = (v[i, 2] - v2) / ds + kv[2] - wq[2]
+        k_t[i, 0] = (w[i, 0] - w0) / ds + kw[0]
+        k_t[i, 1] = (w[i, 1] - w1) / ds + kw[1]
+        k_t[i, 2] = (w[i, 2] - w2) / ds + kw[2]
 
 
 @jit
@@ -103,3 +116,43 @@ def _path_lengths(q, k, geometry, weights, ds, out):
                 z = q[f, i, 2] + k[f, i, 0] * g[1] - k[f, i, 1] * g[0] + g[5]
                 total += weights[c, i] * math.sqrt(x * x + y * y + z * z)
             out[f, c] = ds * total
+
+
+@jit
+def _cross(a0, a1, a2, b0, b1, b2):
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+@jit
+def _friction_factors(q, k, q_t, k_t, geometry, weights, friction, slip_speed, ds, out):
+    # One pass per cable over its cells (the numpy form cost about 12 right-hand
+    # sides per call in temporaries): tangents, stretch rates, the sliding
+    # beyond each cell, the path curvature, then the capstan exponent.
+    n = q.shape[0]
+    tau, stretch, kappa = np.empty((n, 3)), np.empty(n), np.empty(n)
+    for c in range(geometry.shape[0]):
+        for i in range(n):
+            g = geometry[c, i]
+            kx = _cross(k[i, 0], k[i, 1], k[i, 2], g[0], g[1], g[2])
+            x, y, z = q[i, 0] + kx[0] + g[3], q[i, 1] + kx[1] + g[4], q[i, 2] + kx[2] + g[5]
+            norm = math.sqrt(x * x + y * y + z * z)
+            tau[i, 0], tau[i, 1], tau[i, 2] = x / norm, y / norm, z / norm
+            kt = _cross(k_t[i, 0], k_t[i, 1], k_t[i, 2], g[0], g[1], g[2])
+            stretch[i] = (tau[i, 0] * (q_t[i, 0] + kt[0]) + tau[i, 1] * (q_t[i, 1] + kt[1])
+                          + tau[i, 2] * (q_t[i, 2] + kt[2]))
+        for i in range(n):  # tau' by differences: central inside, one-sided at the ends
+            lo, hi = max(i - 1, 0), min(i + 1, n - 1)
+            span = max(hi - lo, 1) * ds  # a single cell: tau' = 0
+            kt = _cross(k[i, 0], k[i, 1], k[i, 2], tau[i, 0], tau[i, 1], tau[i, 2])
+            kappa[i] = math.sqrt(((tau[hi, 0] - tau[lo, 0]) / span + kt[0]) ** 2
+                                 + ((tau[hi, 1] - tau[lo, 1]) / span + kt[1]) ** 2
+                                 + ((tau[hi, 2] - tau[lo, 2]) / span + kt[2]) ** 2)
+        beyond = 0.0
+        for i in range(n - 1, -1, -1):  # the path's stretch from cell i to the anchor
+            beyond += weights[c, i] * stretch[i] * ds
+            stretch[i] = -beyond / math.sqrt(beyond * beyond + slip_speed[c] * slip_speed[c])  # sigma
+        exponent = 0.0
+        for i in range(n):
+            turn = friction[c] * stretch[i] * kappa[i] * weights[c, i] * ds
+            out[c, i] = math.exp(-(exponent + 0.5 * turn))  # to the middle of the cell
+            exponent += turn
