@@ -22,6 +22,7 @@ import cProfile
 import os
 import pstats
 import time
+from dataclasses import replace
 
 import _common as C
 from _common import np, plt, rodmol
@@ -92,10 +93,14 @@ def main(argv=None):
     fy = fast(0.3, y)
     pre.setup(0.3, y, fy, False, [0], 1e-3)
     z = np.empty_like(y)
+    # The same arm with friction on every cable: the capstan factors of each
+    # cable's whole path are evaluated at every call (rodmol.discretise.routing).
+    rough = C.SemiDiscrete(model.replace(cables=[replace(c, friction=0.3) for c in model.cables]))
 
     calls = [
         ("right-hand side, compiled (SemiDiscrete call)", per_call(lambda: fast(0.3, y, out), reps)),
         ("right-hand side, bare kernel", per_call(lambda: stencil.rhs(y, out, *karg), reps)),
+        ("right-hand side with friction on every cable", per_call(lambda: rough(0.3, y, out), reps)),
         (f"Jacobian, compiled ({pre.jacobian.evaluations} kernel evaluations)", per_call(lambda: pre.jacobian.evaluate(0.3, y, fy),
                                                                  max(20, reps // 50))),
         ("preconditioner setup (factor I - gamma J)", per_call(lambda: pre.factor(1e-3), max(20, reps // 20))),
