@@ -18,18 +18,18 @@ skipped where ParaView is not installed.
 import os
 import re
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+import xserver
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 FENCE = re.compile(r"(?:<!-- file: (?P<file>[\w.-]+) -->\s*\n)?^```(?P<lang>python|bash)\n(?P<code>.*?)^```$",
                    re.M | re.S)
 SET_UP = re.compile(r"python3? -m venv|pip install|-m pytest")
-XVFB = ["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24"]
+XVFB = ["xvfb-run", *xserver.XVFB_ARGS]
 
 
 def blocks(page):
@@ -38,16 +38,6 @@ def blocks(page):
     for match in FENCE.finditer(text):
         kind = f"file:{match['file']}" if match["file"] else match["lang"]
         yield kind, match["code"], text.count("\n", 0, match.start("code")) + 1
-
-
-def _run(argv, env, attempts=3):
-    """Run a command; a virtual X server that lost the race for its display
-    number (``xvfb-run -a`` beside another one starting) is tried again."""
-    for _ in range(attempts):
-        done = subprocess.run(argv, env=env, capture_output=True, text=True, timeout=600)
-        if done.returncode == 0 or "bad X server connection" not in done.stderr:
-            return done
-    return done
 
 
 def commands(code):
@@ -86,5 +76,5 @@ def test_page_runs_as_written(page, tmp_path, monkeypatch):
                     argv = XVFB + argv
                 if command.startswith("xvfb-run") and not shutil.which("xvfb-run"):
                     pytest.skip("xvfb-run is not installed")
-                done = _run(argv, env)
+                done = xserver.run(argv, env=env, timeout=600)
                 assert done.returncode == 0, f"{where}: `{command}` failed:\n{done.stdout}\n{done.stderr}"
