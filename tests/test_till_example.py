@@ -128,7 +128,8 @@ def test_example_runs_and_matches_till(tmp_path):
     print(out.stdout)
     assert abs(static) < 2.0
     # 2.7 mm: Till's BDF2 step (dt = 0.05 s) and his Euler grid move his
-    # t = 10 s value by +5.3 and -2.7 mm (docs/examples.md).
+    # t = 10 s value by +5.8 and -2.9 mm (tests/test_till_reference.py,
+    # solvers/results/till_reference.md).
     assert abs(held) < 3.0
     assert (tmp_path / "f.png").stat().st_size > 10_000
 
