@@ -145,9 +145,16 @@ def cable_stress(q, k, p, dp, tension):
     Its divergence in the balance laws is exactly the distributed load along
     the cable path plus the concentrated load at the anchor (docs/model.md).
     """
-    c = add(add(q, cross(k, p)), dp)
+    c = path_vector(q, k, p, dp)
     n_a = scale(tension / np.sqrt(dot(c, c)), c)
     return n_a, cross(p, n_a)
+
+
+@jit
+def path_vector(q, k, p, dp):
+    """c = q + k x p + p': the cable path's tangent u_c' = R c, local frame
+    (its length is the path's stretch, its direction the cable's)."""
+    return add(add(q, cross(k, p)), dp)
 
 
 # --------------------------------------------------------------------------- body loads

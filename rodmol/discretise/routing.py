@@ -15,6 +15,7 @@ import math
 import numpy as np
 
 from ..cable_routing import cell_geometry
+from . import physics
 from .physics import jit
 
 
@@ -62,7 +63,7 @@ class CableRouting:
         T(s) = T(0) exp(-mu int_0^s sigma kappa ds).
         """
         out = np.empty(self.weights.shape)
-        _friction_factors(*(np.ascontiguousarray(a, dtype=float) for a in (q, k, q_t, k_t)), self.geometry,
+        _friction_factors(*(np.asarray(a, dtype=float) for a in (q, k, q_t, k_t)), self.geometry,
                           self.weights, self.friction, self.slip_speed, self.ds, out)
         return out
 
@@ -72,32 +73,29 @@ class CableRouting:
         compatibility laws with the velocities averaged over each cell (in
         both schemes: they only give the sliding direction)."""
         q_t, k_t = np.empty((self.n, 3)), np.empty((self.n, 3))
-        _strain_rates(*(np.ascontiguousarray(a, dtype=float) for a in (q, k, v, w, base_velocities)),
-                      self.ds, q_t, k_t)
+        _strain_rates(*(np.asarray(a, dtype=float) for a in (q, k, v, w, base_velocities)), self.ds, q_t, k_t)
         return self.friction_factors(q, k, q_t, k_t)
 
 
 @jit
 def _strain_rates(q, k, v, w, base_velocities, ds, q_t, k_t):
-    # q_t = v' + k x v - w x q, k_t = w' + k x w with v, w averaged over each cell.
+    # The compatibility laws with v, w averaged over each cell (v0, w0 before the first).
     for i in range(q.shape[0]):
+        v_i, w_i = _row(v, i), _row(w, i)
         if i == 0:
-            v0, v1, v2 = base_velocities[0], base_velocities[1], base_velocities[2]
-            w0, w1, w2 = base_velocities[3], base_velocities[4], base_velocities[5]
+            v_prev = (base_velocities[0], base_velocities[1], base_velocities[2])
+            w_prev = (base_velocities[3], base_velocities[4], base_velocities[5])
         else:
-            v0, v1, v2 = v[i - 1, 0], v[i - 1, 1], v[i - 1, 2]
-            w0, w1, w2 = w[i - 1, 0], w[i - 1, 1], w[i - 1, 2]
-        vb0, vb1, vb2 = 0.5 * (v[i, 0] + v0), 0.5 * (v[i, 1] + v1), 0.5 * (v[i, 2] + v2)
-        wb0, wb1, wb2 = 0.5 * (w[i, 0] + w0), 0.5 * (w[i, 1] + w1), 0.5 * (w[i, 2] + w2)
-        kv = _cross(k[i, 0], k[i, 1], k[i, 2], vb0, vb1, vb2)
-        wq = _cross(wb0, wb1, wb2, q[i, 0], q[i, 1], q[i, 2])
-        kw = _cross(k[i, 0], k[i, 1], k[i, 2], wb0, wb1, wb2)
-        q_t[i, 0] = (v[i, 0] - v0) / ds + kv[0] - wq[0]
-        q_t[i, 1] = (v[i, 1] - v1) / ds + kv[1] - wq[1]
-        q_t[i, 2] = (v[i, 2] - v2) / ds + kv[2] - wq[2]
-        k_t[i, 0] = (w[i, 0] - w0) / ds + kw[0]
-        k_t[i, 1] = (w[i, 1] - w1) / ds + kw[1]
-        k_t[i, 2] = (w[i, 2] - w2) / ds + kw[2]
+            v_prev, w_prev = _row(v, i - 1), _row(w, i - 1)
+        terms_q, terms_k = physics.strain_rate_terms(_row(q, i), _row(k, i), physics.scale(0.5, physics.add(v_i, v_prev)),
+                                                     physics.scale(0.5, physics.add(w_i, w_prev)))
+        q_t[i] = physics.add(physics.scale(1.0 / ds, physics.sub(v_i, v_prev)), terms_q)
+        k_t[i] = physics.add(physics.scale(1.0 / ds, physics.sub(w_i, w_prev)), terms_k)
+
+
+@jit
+def _row(a, i):
+    return a[i, 0], a[i, 1], a[i, 2]
 
 
 @jit
@@ -111,16 +109,9 @@ def _path_lengths(q, k, geometry, weights, ds, out):
                 if weights[c, i] == 0.0:
                     continue
                 g = geometry[c, i]
-                x = q[f, i, 0] + k[f, i, 1] * g[2] - k[f, i, 2] * g[1] + g[3]
-                y = q[f, i, 1] + k[f, i, 2] * g[0] - k[f, i, 0] * g[2] + g[4]
-                z = q[f, i, 2] + k[f, i, 0] * g[1] - k[f, i, 1] * g[0] + g[5]
-                total += weights[c, i] * math.sqrt(x * x + y * y + z * z)
+                path = physics.path_vector(_row(q[f], i), _row(k[f], i), (g[0], g[1], g[2]), (g[3], g[4], g[5]))
+                total += weights[c, i] * math.sqrt(physics.dot(path, path))
             out[f, c] = ds * total
-
-
-@jit
-def _cross(a0, a1, a2, b0, b1, b2):
-    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
 @jit
@@ -133,20 +124,17 @@ def _friction_factors(q, k, q_t, k_t, geometry, weights, friction, slip_speed, d
     for c in range(geometry.shape[0]):
         for i in range(n):
             g = geometry[c, i]
-            kx = _cross(k[i, 0], k[i, 1], k[i, 2], g[0], g[1], g[2])
-            x, y, z = q[i, 0] + kx[0] + g[3], q[i, 1] + kx[1] + g[4], q[i, 2] + kx[2] + g[5]
-            norm = math.sqrt(x * x + y * y + z * z)
-            tau[i, 0], tau[i, 1], tau[i, 2] = x / norm, y / norm, z / norm
-            kt = _cross(k_t[i, 0], k_t[i, 1], k_t[i, 2], g[0], g[1], g[2])
-            stretch[i] = (tau[i, 0] * (q_t[i, 0] + kt[0]) + tau[i, 1] * (q_t[i, 1] + kt[1])
-                          + tau[i, 2] * (q_t[i, 2] + kt[2]))
+            p = (g[0], g[1], g[2])
+            path = physics.path_vector(_row(q, i), _row(k, i), p, (g[3], g[4], g[5]))
+            tau[i] = physics.scale(1.0 / math.sqrt(physics.dot(path, path)), path)
+            # d|c|/dt = tau . (q_t + k_t x p): the path's stretch rate per unit s.
+            stretch[i] = physics.dot(_row(tau, i), physics.add(_row(q_t, i), physics.cross(_row(k_t, i), p)))
         for i in range(n):  # tau' by differences: central inside, one-sided at the ends
             lo, hi = max(i - 1, 0), min(i + 1, n - 1)
             span = max(hi - lo, 1) * ds  # a single cell: tau' = 0
-            kt = _cross(k[i, 0], k[i, 1], k[i, 2], tau[i, 0], tau[i, 1], tau[i, 2])
-            kappa[i] = math.sqrt(((tau[hi, 0] - tau[lo, 0]) / span + kt[0]) ** 2
-                                 + ((tau[hi, 1] - tau[lo, 1]) / span + kt[1]) ** 2
-                                 + ((tau[hi, 2] - tau[lo, 2]) / span + kt[2]) ** 2)
+            bend = physics.add(physics.scale(1.0 / span, physics.sub(_row(tau, hi), _row(tau, lo))),
+                               physics.cross(_row(k, i), _row(tau, i)))
+            kappa[i] = math.sqrt(physics.dot(bend, bend))
         beyond = 0.0
         for i in range(n - 1, -1, -1):  # the path's stretch from cell i to the anchor
             beyond += weights[c, i] * stretch[i] * ds
