@@ -131,6 +131,16 @@ def write_markdown(path, title, header, sections):
     return path
 
 
+def write_results(args, name, title, header, rows, sections):
+    """``name``.csv (``rows``) and ``name``.md (``title``, ``sections`` as for
+    :func:`write_markdown`) in ``args.out``; says so and returns the common stem."""
+    base = os.path.join(args.out, name)
+    write_csv(base + ".csv", rows, header)
+    write_markdown(base + ".md", title, header, sections)
+    print(f"wrote {base}.{{csv,md}}")
+    return base
+
+
 def n_axis(ax, sizes):
     """Label a log N axis with the sizes themselves (no overlapping minor labels)."""
     ax.set_xticks(list(sizes))

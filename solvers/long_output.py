@@ -104,11 +104,8 @@ def main(argv=None):
         print(f"t_end = {t_end:g} s, {fmt}: solver {row['solver_s']:.2f} s, writing {row['writing_s']:.2f} s "
               f"({row['writing_over_solver']:.2f}x), peak {row['peak_rss_mb']:.0f} MB, {row['files']} files, "
               f"{row['megabytes']:.0f} MB (plain writes of as many bytes: {row['raw_disk_s']:.2f} s)", flush=True)
-    base = os.path.join(args.out, "long_output")
-    C.write_csv(base + ".csv", rows, header)
-    C.write_markdown(base + ".md", "Long runs and output (examples/fetching.toml)", header,
-                     [("Solver and writing wall time, peak memory, files", C.markdown_table(rows))])
-    print(f"wrote {base}.{{csv,md}}")
+    C.write_results(args, "long_output", "Long runs and output (examples/fetching.toml)", header, rows,
+                    [("Solver and writing wall time, peak memory, files", C.markdown_table(rows))])
 
 
 if __name__ == "__main__":

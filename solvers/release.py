@@ -9,7 +9,6 @@ Both are timed in the same run, solver only, median of --reps runs.
     python solvers/release.py [--quick | --smoke] [--out DIR] [--reps K]
 """
 
-import os
 
 import _common as C
 from _common import rodmol
@@ -37,11 +36,8 @@ def main(argv=None):
                          rk23_horizon_s=t_rk, rk23_wall_per_sim_s=per_r, rk23_steps=raw_r.stats["steps"],
                          cvode_speedup_over_rk23=per_r / per_c))
         print(f"N={n}: CVODE {per_c:.4f} s/s, RK23 {per_r:.3f} s/s ({per_r / per_c:.0f}x)", flush=True)
-    base = os.path.join(args.out, "release")
-    C.write_csv(base + ".csv", rows, header)
-    C.write_markdown(base + ".md", "Released from straight, in water", header,
-                     [("Wall time per simulated second (solver only)", C.markdown_table(rows))])
-    print(f"wrote {base}.{{csv,md}}")
+    C.write_results(args, "release", "Released from straight, in water", header, rows,
+                    [("Wall time per simulated second (solver only)", C.markdown_table(rows))])
 
 
 if __name__ == "__main__":

@@ -18,7 +18,6 @@ at the end: numerical damping, with mu = 0.
     python solvers/stiff_cantilever.py [--quick | --smoke] [--out DIR] [--reps K]
 """
 
-import os
 import time
 
 import _common as C
@@ -114,19 +113,16 @@ def main(argv=None):
             rows.append(row)
             print({k: (round(v, 5) if isinstance(v, float) else v) for k, v in row.items()}, flush=True)
 
-    base = os.path.join(args.out, "stiff_cantilever")
-    C.write_csv(base + ".csv", rows, header)
     formats = dict(cpu_s=".3f", cpu_over_till=".2f", period_s=".5f", period_error_pct=".3f",
                    amplitude_start_mm=".2f", amplitude_end_mm=".2f", t_reached=".4g",
                    swing_energy_kept_pct=".2f")
     columns = ["mu_Pa_s", "start", "configuration", "success", "t_reached", "cpu_s", "cpu_over_till",
                "steps", "period_s", "period_error_pct", "amplitude_start_mm", "amplitude_end_mm",
                "swing_energy_kept_pct"]
-    C.write_markdown(base + ".md", "Steel cantilever, stiff and lightly damped", header, [
+    C.write_results(args, "stiff_cantilever", "Steel cantilever, stiff and lightly damped", header, rows, [
         (f"N = {n}, {t_end:g} s; Euler-Bernoulli period {PERIOD_EB:.5f} s; Till's C++ "
          f"{TILL_CPU} s CPU for 25 s (cpu_over_till scales to 25 s)",
          C.markdown_table(rows, columns, formats))])
-    print(f"wrote {base}.{{csv,md}}")
 
 
 if __name__ == "__main__":

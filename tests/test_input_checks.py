@@ -6,6 +6,7 @@ import sys
 
 import numpy as np
 import pytest
+from scenario_texts import MINIMAL
 
 import rodmol
 from rodmol.errors import MAX_LINE, ParameterError
@@ -102,21 +103,6 @@ def test_nul_byte_paths():
 
 # ------------------------------------------------------------------ scenario files
 
-ARM = """
-name = "check"
-[rod]
-length = 0.3
-radius = 0.01
-[material]
-E = 1e5
-nu = 0.5
-mu = 100.0
-rho = 1000.0
-[solver]
-t_end = 1.0
-"""
-
-
 @pytest.mark.parametrize("extra, match", [
     ("rtol = 2.0", r"\[solver\] `rtol` must lie in \[1e-14, 0.1\], got 2.0"),
     ("output_dt = 1e-15", r"output frames; at most \d+ are allowed"),
@@ -127,12 +113,12 @@ t_end = 1.0
 ])
 def test_scenario_solver_rules_match_python(extra, match):
     with pytest.raises(ScenarioError, match=match) as info:
-        parse_scenario(ARM.replace("[solver]", "[solver]\n" + extra))
+        parse_scenario(MINIMAL.replace("[solver]", "[solver]\n" + extra))
     assert all(len(line) <= MAX_LINE + 40 for line in str(info.value).splitlines())
 
 
 def test_scenario_max_wall_time_reaches_simulate():
-    spec = parse_scenario(ARM.replace("[solver]", "[solver]\nmax_wall_time = 30.0"))
+    spec = parse_scenario(MINIMAL.replace("[solver]", "[solver]\nmax_wall_time = 30.0"))
     assert spec.solver["max_wall_time"] == 30.0
 
 
@@ -142,11 +128,11 @@ def test_scenario_nested_too_deeply():
 
 
 def test_scenario_marker_off_the_body():
-    text = ARM + '[[marker]]\nname = "far"\ns = 0.1\noffset = [1.0, 0.0]\n'
+    text = MINIMAL + '[[marker]]\nname = "far"\ns = 0.1\noffset = [1.0, 0.0]\n'
     with pytest.raises(ScenarioError, match=r"marker 'far'.*lies outside the body"):
         parse_scenario(text)
 
 
 def test_scenario_output_directory_with_nul():
     with pytest.raises(ScenarioError, match="without NUL characters"):
-        parse_scenario(ARM + '[output]\ndirectory = "a\\u0000b"\n')
+        parse_scenario(MINIMAL + '[output]\ndirectory = "a\\u0000b"\n')

@@ -47,6 +47,21 @@ def assert_interrupted_run(out, stdout):
     assert assert_valid_views(out) == pytest.approx(list(result.t))
 
 
+def slow_run(out, frames_written=False):
+    """``rodmol run`` of the fetching example on the explicit backend and a fine
+    grid (minutes: a signal lands in the solver), started and its first
+    progress line read (with ``frames_written``: the first past 0%)."""
+    command = [sys.executable, "-u", "-m", "rodmol.io.cli", "run", "--example", "fetching",
+               "--backend", "rk23", "--n-elements", "60", "--out", str(out)]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    line = ""
+    while "integrating:" not in line or (frames_written and "  0%" in line):
+        line = process.stdout.readline()
+        if not line and process.poll() is not None:
+            raise AssertionError(process.stderr.read())
+    return process
+
+
 def test_version():
     proc = rodmol_cli("--version")
     assert proc.returncode == 0 and proc.stdout.strip() == f"rodmol {rodmol.__version__}"
@@ -121,15 +136,8 @@ def test_bad_command_line_value_exit_2(tmp_path):
 @pytest.mark.subprocess
 def test_ctrl_c_keeps_a_valid_partial_run(tmp_path):
     out = tmp_path / "stopped"
-    # The explicit backend on this grid takes minutes: the interrupt lands in the solver.
-    command = [sys.executable, "-u", "-m", "rodmol.io.cli", "run", "--example", "fetching",
-               "--backend", "rk23", "--n-elements", "60", "--out", str(out)]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    process = slow_run(out, frames_written=True)
     try:
-        line = ""
-        while "integrating:" not in line or "  0%" in line:  # output frames exist
-            line = process.stdout.readline()
-            assert line or process.poll() is None, process.stderr.read()
         time.sleep(1.0)
         process.send_signal(signal.SIGINT)
         stdout, stderr = process.communicate(timeout=60)

@@ -14,7 +14,7 @@ import threading
 
 import numpy as np
 import pytest
-from test_cli import EXAMPLES, assert_interrupted_run, assert_valid_series
+from test_cli import EXAMPLES, assert_interrupted_run, assert_valid_series, slow_run
 from views import assert_valid_views
 
 import rodmol
@@ -29,19 +29,6 @@ def run_cli(capsys, *args):
     captured = capsys.readouterr()
     assert "Traceback" not in captured.err
     return code, captured.err
-
-
-def slow_run(out):
-    """A run that takes minutes (explicit backend, fine grid), with progress lines."""
-    command = [sys.executable, "-u", "-m", "rodmol.io.cli", "run", "--example", "fetching",
-               "--backend", "rk23", "--n-elements", "60", "--out", str(out)]
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    line = ""
-    while "integrating:" not in line:  # the first progress line: the solver is running
-        line = process.stdout.readline()
-        if not line and process.poll() is not None:
-            raise AssertionError(process.stderr.read())
-    return process
 
 
 @pytest.mark.subprocess
