@@ -1,8 +1,9 @@
 """Linearisation for control design: dy/dt ~ A dy + B dT about a state."""
 
+from dataclasses import replace
+
 import numpy as np
 
-from ..cables import Cable
 from ..discretise.schemes import DEFAULT_SCHEME
 from ..discretise.system import SemiDiscrete
 from ..errors import ParameterError
@@ -48,10 +49,9 @@ def linearize(model, state, t=0.0, scheme=DEFAULT_SCHEME):
     tensions = model.tensions(t, probe.state_view(t, y) if model.feedback else None)
     # The same model with every cable active and its tension set by hand: a
     # constant nonzero tension keeps each cable in the kernel.
-    # Friction stays: its factors depend on the state, and scale the tension.
-    held = model.replace(cables=[Cable(c.offset, c.anchor, 1.0, name=c.name, outside_body=c.outside_body,
-                                       friction=c.friction, slip_speed=c.slip_speed)
-                                 for c in model.cables])
+    # Everything else of each cable (routing, friction) stays as it is.
+    held = model.replace(cables=[replace(c, tension=1.0, displacement=None, compliance=None,
+                                         base_to_actuator=0.0, rest_length=None) for c in model.cables])
     system = SemiDiscrete(held, scheme)
 
     def rates(x, cable_tensions):
