@@ -44,16 +44,17 @@ def marker_offsets(markers, rod):
     return out
 
 
-def track(markers, offsets, s_nodes, positions, rotations):
-    """Global marker positions (n_t, n_markers, 3) from nodal poses.
+def track(s_markers, offsets, s_nodes, positions, rotations):
+    """Global marker positions (n_t, n_markers, 3) from nodal poses, for markers
+    at arc lengths ``s_markers`` [m] with local ``offsets`` (n_markers, 3) [m].
 
     Each marker is ``u + R p`` evaluated at the two nodes around it and
     interpolated linearly in s.
     """
-    out = np.empty(positions.shape[:1] + (len(markers), 3))
-    for i, m in enumerate(markers):
-        j = int(np.clip(np.searchsorted(s_nodes, m.s, side="right") - 1, 0, len(s_nodes) - 2))
-        f = (m.s - s_nodes[j]) / (s_nodes[j + 1] - s_nodes[j])
+    out = np.empty(positions.shape[:1] + (len(s_markers), 3))
+    for i, s in enumerate(s_markers):
+        j = int(np.clip(np.searchsorted(s_nodes, s, side="right") - 1, 0, len(s_nodes) - 2))
+        f = (s - s_nodes[j]) / (s_nodes[j + 1] - s_nodes[j])
         a = positions[:, j] + rotations[:, j] @ offsets[i]
         b = positions[:, j + 1] + rotations[:, j + 1] @ offsets[i]
         out[:, i] = (1.0 - f) * a + f * b

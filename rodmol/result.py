@@ -8,6 +8,7 @@ import numpy as np
 from . import markers
 from ._files import write_atomically
 from .discretise import centreline, physics, rotations
+from .discretise.layout import BLOCK, HEADER, StateLayout
 from .model import Q_STAR
 
 #: Arrays of a Result, with their units (also the keys of the .npz file).
@@ -79,9 +80,12 @@ class Result:
     def __init__(self, arrays, success=True, message="", stats=None, meta=None, deferred=None):
         for name, value in arrays.items():
             setattr(self, name, np.asarray(value))
-        # Arrays derived from the states are computed on first access:
-        # name -> function returning a dict of arrays (a group computed together).
+        # Arrays computed on first access: name -> function of the Result
+        # returning a dict of arrays (a group computed together).
         self._deferred = dict(deferred or {})
+        for needs, function, gives in DERIVED.values():
+            if all(n in arrays or n in self._deferred for n in needs):
+                self._deferred.update({n: function for n in gives if n not in arrays and n not in self._deferred})
         missing = set(ARRAYS) - set(arrays) - set(self._deferred)
         if missing:
             raise ValueError(f"Result lacks the arrays {sorted(missing)}")
@@ -94,10 +98,19 @@ class Result:
         deferred = self.__dict__.get("_deferred", {})
         if name not in deferred:
             raise AttributeError(f"'Result' object has no attribute {name!r}")
-        for key, value in deferred[name]().items():
-            setattr(self, key, value)
-            deferred.pop(key, None)
+        for key, value in deferred[name](self).items():
+            if key in deferred:
+                setattr(self, key, value)
+                deferred.pop(key)
         return self.__dict__[name]
+
+    def select(self, frames):
+        """The Result of the frames ``frames`` (indices or a slice) only."""
+        arrays = {name: getattr(self, name) for name in STATIC}
+        for name in (*STORED, *ARRAYS):
+            if name not in arrays and (name in self.__dict__ or name in STORED and name in self._deferred):
+                arrays[name] = getattr(self, name)[frames]
+        return Result(arrays, self.success, self.message, self.stats, self.meta)
 
     def __repr__(self):
         return (f"Result(n_t={len(self.t)}, t_end={self.t[-1] if len(self.t) else None} s, "
@@ -117,39 +130,43 @@ class Result:
         write_atomically(path, lambda handle: np.savez_compressed(handle, info=json.dumps(info), **arrays))
 
 
-#: The arrays each deferred group of :func:`from_states` computes.
-_GROUPS = {
-    "mechanics": ("linear_strain", "curvature", "velocity", "angular_velocity", "internal_force",
-                  "internal_moment", "external_force", "external_moment"),
-    "pose": ("positions", "rotations", "integrated_positions", "markers"),
-}
+#: Arrays of a Result that do not change in time.
+STATIC = ("s", "radius", "node_length")
+#: What a Result holds besides its static arrays and ``meta``: the states, and
+#: what follows from the model rather than from the states alone (tensions,
+#: path lengths, actuator positions, stresses, loads, and the ``BOUNDARY`` rows
+#: of the strains and velocities). Every other array is derived from these on
+#: first access (``DERIVED``), the same way in memory and from a file: the
+#: result file stores only these.
+STORED = ("t", "states", "tensions", "cable_lengths", "actuator_positions", "internal_force",
+          "internal_moment", "external_force", "external_moment", "boundary_rows")
+#: (n_t, 12) the rows of the strains and velocities that are not state fields:
+#: the base's velocity v0 [m/s] and angular velocity w0 [rad/s] (prescribed) and
+#: the tip's strains q [-] and k [1/m] (from the tip load), local frame.
+BOUNDARY = "boundary_rows"
 
 
 def from_states(system, t, y, success, message, stats):
     """Build a :class:`Result` from raw states ``y`` (n_t, size) of ``system``.
 
-    Times, tensions and the quaternion drift are filled at once; the strains,
-    stresses, loads and poses of every frame are computed on first access
-    (most runs need only a few of them, and they cost about half the
-    integration), by the same compiled kernel as the integration. Until then
-    the result holds the system and the states, and pickles as them.
+    Times and tensions are filled at once; the stresses and loads of every
+    frame, by the same compiled kernel as the integration, and the arrays
+    derived from the states are computed on first access (most runs need only
+    a few of them, and they cost about half the integration). Until then the
+    result holds the system and the states, and pickles as them.
     """
     model, layout = system.model, system.layout
+    t, y = np.asarray(t, dtype=float), np.asarray(y)
     n_t = len(t)
-    quat_all = layout.quaternions(y)
     tensions = np.array([system.tensions(ti, yi) for ti, yi in zip(t, y)]).reshape(n_t, -1)
-    q_all, k_all = layout.field(y, "q"), layout.field(y, "k")
-    lengths = system.routing.lengths(q_all, k_all).reshape(n_t, -1)
+    lengths = system.routing.lengths(layout.field(y, "q"), layout.field(y, "k")).reshape(n_t, -1)
     actuated = [c for c in model.cables if c.actuated]
     actuators = np.array([[c.displacement.value(ti) for c in actuated] for ti in t]).reshape(n_t, len(actuated))
-    arrays = dict(
-        t=t, tensions=tensions, **static_arrays(system),
-        cable_lengths=lengths, actuator_positions=actuators,
-        states=np.asarray(y),
-        quaternion_norm_error=np.max(np.abs(np.linalg.norm(quat_all, axis=-1) - 1.0), axis=-1),
-    )
-    groups = {"mechanics": partial(_mechanics, system, t, y, tensions), "pose": partial(_pose, system, y)}
-    deferred = {name: groups[group] for group, names in _GROUPS.items() for name in names}
+    arrays = dict(t=t, tensions=tensions, **static_arrays(system), cable_lengths=lengths,
+                  actuator_positions=actuators, states=y)
+    loads = partial(_loads, system)
+    deferred = {name: loads for name in ("internal_force", "internal_moment", "external_force",
+                                         "external_moment", BOUNDARY)}
     return Result(arrays, success, message, stats, run_meta(system), deferred)
 
 
@@ -174,15 +191,13 @@ def run_meta(system):
                 loads=[repr(load) for load in model.loads])
 
 
-def _mechanics(system, t, y, tensions):
-    """Strains, velocities, stresses and external loads at all nodes."""
+def _loads(system, result):
+    """Stresses and external loads at all nodes, and the boundary rows of the strains and velocities."""
     model, layout = system.model, system.layout
+    t, y, tensions = result.t, result.states, result.tensions
     n_t = len(t)
     q, k = layout.field(y, "q"), layout.field(y, "k")
-    v, w = layout.field(y, "v"), layout.field(y, "w")
-    base = [model.base.velocities(ti) for ti in t]
-    v0 = np.array([b[0] for b in base]).reshape(n_t, 3)
-    w0 = np.array([b[1] for b in base]).reshape(n_t, 3)
+    base = np.array([np.concatenate(model.base.velocities(ti)) for ti in t]).reshape(n_t, 6)
     stress, loads = system.frames(t, y)
     # Tip node: the body carries the load concentrated on the tip node (a
     # point load at s = L; distributed loads give an O(ds) share) minus the
@@ -204,27 +219,47 @@ def _mechanics(system, t, y, tensions):
     kl_tip, kth_tip = model.rod.stiffness(model.rod.length)
     rots = rotations.matrices(layout.quaternions(y)[:, 1:])
     zero = np.zeros((n_t, 1, 3))
-    return dict(
-        linear_strain=np.concatenate([q, (Q_STAR + n_tip / kl_tip)[:, None]], axis=1),
-        curvature=np.concatenate([k, (m_tip / kth_tip)[:, None]], axis=1),
-        velocity=np.concatenate([v0[:, None], v], axis=1),
-        angular_velocity=np.concatenate([w0[:, None], w], axis=1),
-        internal_force=np.concatenate([stress[..., :3], n_tip[:, None]], axis=1),
-        internal_moment=np.concatenate([stress[..., 3:], m_tip[:, None]], axis=1),
-        external_force=np.concatenate([zero, np.einsum("tnij,tnj->tni", rots, loads[..., :3])], axis=1),
-        external_moment=np.concatenate([zero, np.einsum("tnij,tnj->tni", rots, loads[..., 3:])], axis=1),
-    )
+    return {
+        "internal_force": np.concatenate([stress[..., :3], n_tip[:, None]], axis=1),
+        "internal_moment": np.concatenate([stress[..., 3:], m_tip[:, None]], axis=1),
+        "external_force": np.concatenate([zero, np.einsum("tnij,tnj->tni", rots, loads[..., :3])], axis=1),
+        "external_moment": np.concatenate([zero, np.einsum("tnij,tnj->tni", rots, loads[..., 3:])], axis=1),
+        BOUNDARY: np.concatenate([base, Q_STAR + n_tip / kl_tip, m_tip / kth_tip], axis=1),
+    }
 
 
-def _pose(system, y):
-    """Positions rebuilt from the strains, rotations, markers, integrated positions."""
-    model, layout = system.model, system.layout
+def _kinematics(result):
+    """Strains and velocities at all nodes: the state's fields and the boundary rows."""
+    y, rows = result.states, getattr(result, BOUNDARY)
+    layout = StateLayout((y.shape[-1] - HEADER) // BLOCK)
+    field = partial(layout.field, y)
+    return dict(linear_strain=np.concatenate([field("q"), rows[:, None, 6:9]], axis=1),
+                curvature=np.concatenate([field("k"), rows[:, None, 9:12]], axis=1),
+                velocity=np.concatenate([rows[:, None, 0:3], field("v")], axis=1),
+                angular_velocity=np.concatenate([rows[:, None, 3:6], field("w")], axis=1))
+
+
+def _pose(result):
+    """Positions rebuilt from the strains, rotations, markers, integrated positions, quaternion drift."""
+    y, meta = result.states, result.meta
+    layout = StateLayout((y.shape[-1] - HEADER) // BLOCK)
     quat_all = layout.quaternions(y)
     positions = centreline.positions(layout.base_position(y), quat_all, layout.field(y, "q"),
-                                     layout.field(y, "k"), model.ds)
+                                     layout.field(y, "k"), meta["length"] / layout.n_elements)
     rots = rotations.matrices(quat_all)
+    marks = meta.get("markers", [])
+    offsets = np.array([[0.0, *m["offset"]] for m in marks]).reshape(-1, 3)
     return dict(
         positions=positions, rotations=rots,
         integrated_positions=layout.integrated_positions(y),
-        markers=markers.track(model.markers, model.marker_offsets, model.s_nodes, positions, rots),
+        markers=markers.track([m["s"] for m in marks], offsets, result.s, positions, rots),
+        quaternion_norm_error=np.max(np.abs(np.linalg.norm(quat_all, axis=-1) - 1.0), axis=-1),
     )
+
+
+#: The arrays derived from ``STORED`` ones: group -> (what it needs, its function, what it gives).
+DERIVED = {
+    "kinematics": ((BOUNDARY,), _kinematics, ("linear_strain", "curvature", "velocity", "angular_velocity")),
+    "pose": (("states",), _pose, ("positions", "rotations", "integrated_positions", "markers",
+                                  "quaternion_norm_error")),
+}

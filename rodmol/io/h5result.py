@@ -8,11 +8,13 @@ A run directory holds
   ``t``, the chunk files in order and, as JSON in the attribute ``info``,
   ``success``, ``message``, ``stats``, ``meta`` and ``complete`` (False while
   the run goes or after it was killed);
-* ``frames/chunk_NNNNNN.h5``: the frames of one chunk: every time-series
-  array of :data:`rodmol.result.ARRAYS` (``states`` included, so each chunk's
-  last frame is a restart point) and the extra arrays the ParaView views
-  reference (:mod:`rodmol.io.xdmf`). Each is written under a temporary name
-  and renamed when complete, and never changed after.
+* ``frames/chunk_NNNNNN.h5``: the frames of one chunk: the arrays of
+  :data:`rodmol.result.STORED` (``states`` included, so each chunk's last
+  frame is a restart point; the Result's other arrays are derived from them
+  on reading, exactly as in memory; the stresses and loads in single
+  precision, :data:`SINGLE`) and, in the group ``view``, the arrays
+  the ParaView views reference (:mod:`rodmol.io.xdmf`). Each is written under
+  a temporary name and renamed when complete, and never changed after.
 
 HDF5 files are not crash-safe while open for writing; here no file is ever
 open for writing under its real name, so a killed run leaves an index that
@@ -26,15 +28,18 @@ from pathlib import Path
 import numpy as np
 
 from .._files import atomic_path
-from ..result import ARRAYS, Result
+from ..discretise.layout import BLOCK, HEADER
+from ..result import ARRAYS, STATIC, STORED, Result
 
 INDEX = "result.h5"
 FRAMES = "frames"
 FORMAT = "rodmol-result"
-#: Arrays of a Result that do not change in time (stored in the index).
-STATIC = ("s", "radius", "node_length")
-#: The time-series arrays of a Result (stored in the chunks).
-SERIES = tuple(name for name in ARRAYS if name not in STATIC)
+#: The group of a chunk holding the views' arrays.
+VIEW_GROUP = "view"
+#: Stored in single precision (7 digits), read back as float64: the stresses and
+#: loads, which only the model could recompute. The states stay double, so the
+#: kinematics derived from them and a restart are exact.
+SINGLE = ("internal_force", "internal_moment", "external_force", "external_moment")
 #: HDF5 format versions readable by the HDF5 1.10 of ParaView 5.11 (Debian).
 LIBVER = ("earliest", "v110")
 
@@ -51,17 +56,18 @@ def chunk_name(index):
     return f"{FRAMES}/chunk_{index:06d}.h5"
 
 
-def write_chunk(directory, index, arrays, extras=None):
-    """Write chunk ``index``: ``arrays`` (name -> time-first array) and ``extras``; returns its relative name."""
-    name = chunk_name(index)
+def write_chunk(directory, name, arrays, views=None):
+    """Write the chunk ``name`` (:func:`chunk_name`): ``arrays`` (name -> time-first array) and
+    the ``views``' arrays (in the group ``view``)."""
     (Path(directory) / FRAMES).mkdir(parents=True, exist_ok=True)
 
     def fill(handle):
-        for key, value in {**arrays, **(extras or {})}.items():
-            handle.create_dataset(key, data=np.asarray(value))
+        for key, value in arrays.items():
+            handle.create_dataset(key, data=np.asarray(value, dtype=np.float32 if key in SINGLE else None))
+        for key, value in (views or {}).items():
+            handle.create_dataset(f"{VIEW_GROUP}/{key}", data=np.asarray(value))
 
     atomic_h5(Path(directory) / name, fill)
-    return name
 
 
 def write_index(directory, static, t_out, t, chunks, info):
@@ -103,7 +109,7 @@ def read_series(directory, chunks, name):
     for chunk in chunks:
         with h5py.File(Path(directory) / chunk, "r") as handle:
             parts.append(handle[name][()])
-    return np.concatenate(parts) if parts else np.zeros((0,))
+    return np.asarray(np.concatenate(parts), dtype=float) if parts else np.zeros((0,))
 
 
 def last_state(directory, chunks):
@@ -124,10 +130,12 @@ def read_result(path):
 
     def loader(name):
         if not chunks:  # nothing was written: empty arrays of the right rank
-            return lambda: {name: np.zeros((0,) + _empty_shape(name, len(arrays["s"]), info))}
-        return lambda: {name: read_series(folder, chunks, name)}
+            return lambda result: {name: np.zeros((0,) + _empty_shape(name, len(arrays["s"]), info))}
+        return lambda result: {name: read_series(folder, chunks, name)}
 
-    deferred = {name: loader(name) for name in SERIES if name != "t"}
+    # What the chunks hold is read from them (files of older versions held every array);
+    # the Result derives the rest.
+    deferred = {name: loader(name) for name in _stored(folder, chunks) if name != "t"}
     message = info["message"]
     if not info.get("complete", True):
         message = (f"the run was stopped before it finished (killed?): {len(arrays['t'])} frames up to "
@@ -138,9 +146,19 @@ def read_result(path):
     return result
 
 
+def _stored(folder, chunks):
+    """The Result's arrays the chunks hold (all of :data:`STORED` when there are none)."""
+    import h5py
+
+    if not chunks:
+        return STORED
+    with h5py.File(folder / chunks[0], "r") as handle:
+        return tuple(name for name in (*STORED, *ARRAYS) if name in handle and name not in STATIC)
+
+
 def _empty_shape(name, n_nodes, info):
     meta = info.get("meta") or {}
-    shapes = {"tensions": (len(meta.get("cables", [])),), "quaternion_norm_error": (),
-              "markers": (len(meta.get("markers", [])), 3), "rotations": (n_nodes, 3, 3),
-              "states": (0,)}
+    cables = (len(meta.get("cables", [])),)
+    shapes = {"tensions": cables, "cable_lengths": cables, "actuator_positions": (len(meta.get("actuators", [])),),
+              "states": (HEADER + BLOCK * (n_nodes - 1),), "boundary_rows": (12,)}
     return shapes.get(name, (n_nodes, 3))

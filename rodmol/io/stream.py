@@ -8,7 +8,8 @@ Result's arrays for each chunk, and writes
 
 * the chunk's HDF5 file and the index ``result.h5`` (:mod:`rodmol.io.h5result`),
 * the ParaView views ``rod.xdmf``, ``cables.xdmf``, ``markers.xdmf``
-  (:mod:`rodmol.io.xdmf`; only every ``every``-th frame and the last).
+  (:mod:`rodmol.io.xdmf`): every ``every``-th frame and the last of each
+  chunk, in single precision; by default at most :data:`VIEW_FRAMES` frames.
 
 Memory stays bounded by one chunk. Every file appears complete under its
 real name or not at all, so a run killed at any moment leaves a directory
@@ -17,19 +18,27 @@ chunk, and whose last frame is the restart point of ``resume=True``.
 """
 
 import time
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import ParameterError
+from ..result import STATIC
 from ..solve.chunked import merge_stats
 from . import h5result, xdmf
-from .h5result import INDEX, SERIES, STATIC
-from .parts import cable_points
+from .h5result import INDEX
+from .parts import ROD_ARRAYS, cable_points
 
-#: Number type of the arrays only the views use (the Result's own stay float64):
-#: single precision halves the largest of them, the cables' points.
+#: Number type of the views' arrays (the result file's stay float64): what a
+#: picture needs, at half the bytes.
 VIEW = np.float32
+#: Frames the views show at most when ``every`` is not given: ParaView 5.11
+#: takes about a second per thousand frames to open a view (docs/performance.md),
+#: and a long run's result file keeps every frame anyway.
+VIEW_FRAMES = 6000
 #: Output frames per chunk by default: bounded memory (about 50 kB a frame at
 #: N = 100), fewer than 100 files for 600 s at 100 frames/s.
 CHUNK_FRAMES = 2000
@@ -43,9 +52,11 @@ class RunWriter:
     directory : path
     views : bool
         Write the XDMF views for ParaView (False: only ``result.h5`` and the chunks).
-    every : int
-        The views show every ``every``-th output frame (and the last); the
-        result file keeps all.
+    every : int, optional
+        The views show every ``every``-th output frame (and the last of each
+        chunk); the result file keeps all. Default: 1, or for runs of more
+        than :data:`VIEW_FRAMES` output frames the smallest step that keeps
+        the views within that many.
     chunk_frames : int
         Output frames per chunk file. With ``simulate(..., out=...)`` the
         solver also restarts at every chunk boundary (the restart points),
@@ -57,16 +68,19 @@ class RunWriter:
         Added to the Result's ``meta`` (e.g. the scenario's name).
     """
 
-    def __init__(self, directory, *, views=True, every=1, chunk_frames=CHUNK_FRAMES, resume=False,
+    def __init__(self, directory, *, views=True, every=None, chunk_frames=CHUNK_FRAMES, resume=False,
                  meta=None):
-        if int(every) < 1 or int(chunk_frames) < 1:
+        if (every is not None and int(every) < 1) or int(chunk_frames) < 1:
             raise ParameterError(f"`every` and `chunk_frames` must be >= 1, got {every!r}, {chunk_frames!r}")
         self.directory = Path(directory)
         self.directory.mkdir(parents=True, exist_ok=True)
-        self.views, self.every, self.chunk_frames = bool(views), int(every), int(chunk_frames)
+        self.views, self.chunk_frames = bool(views), int(chunk_frames)
+        self.every = None if every is None else int(every)
         self.extra_meta = dict(meta or {})
         self.chunks, self.t, self.t_out, self.seconds = {}, [], None, 0.0
-        self.static, self.meta, self.system, self.last = None, None, None, None
+        self.static, self.meta, self.system = None, None, None
+        self._pool, self._pending = None, None  # the writer's thread, and the chunk it writes
+        self._depth = 0  # of nested _timed blocks
         self.previous = None
         if resume:
             self._reopen()
@@ -84,61 +98,104 @@ class RunWriter:
             self.t_out = np.asarray(t_out, dtype=float)
         if self.static is None:
             self.static, self.meta = static_arrays(system), dict(run_meta(system), **self.extra_meta)
+        self._plan_views(len(self.t_out))
 
     def frames(self, t, y):
         """Store the states ``y`` (n, size) at output times ``t`` (n,) as one chunk."""
         from ..result import from_states
 
-        started = time.perf_counter()
-        chunk = from_states(self.system, np.asarray(t, dtype=float), np.asarray(y), True, "", {})
-        self.store({name: getattr(chunk, name) for name in SERIES})
-        self.seconds += time.perf_counter() - started
+        with self._timed():
+            self.store(from_states(self.system, np.asarray(t, dtype=float), np.asarray(y), True, "", {}))
+
+    def flush(self):
+        """Wait until the chunks stored so far are on disk; raises the ``OSError`` of one that
+        could not be written."""
+        pending, self._pending = self._pending, None
+        if pending is None:
+            return
+        job, name = pending
+        with self._timed():
+            try:
+                job.result()
+            except OSError:  # the chunk is not on disk: nothing may list it
+                del self.t[len(self.t) - self.chunks.pop(name):]
+                raise
 
     def end(self, success, message, stats):
-        """Finish: the last frame in the views, the final index; returns the Result (read lazily)."""
-        started = time.perf_counter()
-        if self.last is not None and self.views:
-            name, t, start = self.last
-            frames = self._shown(start, len(t), last=True)
-            if frames != self._shown(start, len(t)):  # the run's last frame was not shown yet
-                self._fragment(name, t, frames, len(t))
-        if self.previous is not None:  # a resumed run: the statistics of both parts
-            stats = merge_stats([self.previous.get("stats", {}), stats])
-        self._index(dict(success=bool(success), message=str(message), stats=dict(stats),
-                         complete=True))
-        self.seconds += time.perf_counter() - started
+        """Finish: the final index; returns the Result (read lazily)."""
+        with self._timed():
+            try:
+                self.flush()
+            finally:
+                if self._pool is not None:
+                    self._pool.shutdown()
+                    self._pool = None
+            if self.previous is not None:  # a resumed run: the statistics of both parts
+                stats = merge_stats([self.previous.get("stats", {}), stats])
+            h5result.write_index(*self._index(dict(success=bool(success), message=str(message),
+                                                    stats=dict(stats), complete=True)))
         return self.result()
 
     # ----------------------------------------------------------------- other uses
 
-    def store(self, arrays, static=None, meta=None):
-        """Write one chunk from the Result arrays of its frames (``SERIES`` names, time first);
-        ``static`` arrays and ``meta`` of the Result, unless :meth:`begin` gave them."""
+    def store(self, chunk):
+        """Write the :class:`rodmol.Result` ``chunk`` (the next frames of the run) as one chunk."""
+        from ..result import STORED
+
         if self.static is None:
-            self.static, self.meta = static, dict(meta, **self.extra_meta)
-        index = len(self.chunks)
-        name = h5result.write_chunk(self.directory, index, arrays, self._extras(arrays) if self.views else None)
-        n = len(arrays["t"])
-        start = len(self.t)
+            self.static = {key: getattr(chunk, key) for key in STATIC}
+            self.meta = dict(chunk.meta, **self.extra_meta)
+        n, start = len(chunk.t), len(self.t)
+        stored = {key: getattr(chunk, key) for key in STORED}
+        shown = chunk.select(self._shown(start, n)) if self.views else None
+        views = self._view_arrays(shown) if self.views else None
+        name = h5result.chunk_name(len(self.chunks))
         self.chunks[name] = n
-        self.t.extend(np.asarray(arrays["t"], dtype=float).tolist())
-        self.last = (name, np.asarray(arrays["t"]), start)
-        if self.views:
-            self._fragment(name, arrays["t"], self._shown(start, n), n)
-            fragments = [c[:-3] + ".xmf" for c in self.chunks]
+        self.t.extend(np.asarray(chunk.t, dtype=float).tolist())
+        index = self._index(dict(success=True, message="running", stats={}, complete=False))
+        self._write_behind(name, partial(self._write, name, stored, views, None if shown is None else shown.t,
+                                         list(self.chunks), index))
+
+    @contextmanager
+    def _timed(self):
+        """Add the time inside to ``seconds`` (the writer's share of the run's wall time),
+        once when nested."""
+        self._depth += 1
+        started = time.perf_counter()
+        try:
+            yield
+        finally:
+            self._depth -= 1
+            if self._depth == 0:
+                self.seconds += time.perf_counter() - started
+
+    def _write_behind(self, name, job):
+        """Run ``job`` (the writing of a chunk) in the writer's thread while the run goes on;
+        first wait for the chunk before (so at most two chunks are in memory, and they land
+        in order)."""
+        self.flush()
+        if self._pool is None:
+            self._pool = ThreadPoolExecutor(1, thread_name_prefix="rodmol-writer")
+        self._pending = (self._pool.submit(job), name)
+
+    def _write(self, name, stored, views, t_shown, chunks, index):
+        """Write a chunk file, its views and the index that lists it (in the writer's thread:
+        h5py and file writes let the solver run meanwhile)."""
+        h5result.write_chunk(self.directory, name, stored, views)
+        if views is not None:
+            self._fragment(name, t_shown)
+            fragments = [c[:-3] + ".xmf" for c in chunks]
             for view in self.view_names():
                 xdmf.write_view(self.directory / f"{view}.xdmf", view, fragments)
-        self._index(dict(success=True, message="running", stats={}, complete=False))
+        h5result.write_index(*index)
 
     def write_result(self, result):
         """Write a finished in-memory :class:`rodmol.Result`, chunk by chunk; returns the path of ``rod.xdmf``."""
-        started = time.perf_counter()
         self.t_out = np.asarray(result.t, dtype=float)
-        static = {key: getattr(result, key) for key in STATIC}
-        for k0 in range(0, len(result.t), self.chunk_frames):
-            frames = slice(k0, k0 + self.chunk_frames)
-            self.store({name: getattr(result, name)[frames] for name in SERIES}, static, result.meta)
-        self.seconds += time.perf_counter() - started
+        self._plan_views(len(self.t_out))
+        with self._timed():
+            for k0 in range(0, len(result.t), self.chunk_frames):
+                self.store(result.select(slice(k0, k0 + self.chunk_frames)))
         self.end(result.success, result.message, result.stats)
         return self.directory / "rod.xdmf"
 
@@ -167,7 +224,7 @@ class RunWriter:
         self.meta = dict(index["info"].get("meta") or {}, **self.extra_meta)
         # The restart points of the run being resumed, whatever this writer was given.
         self.chunk_frames = int(index["info"].get("chunk_frames", self.chunk_frames))
-        self.every = int(index["info"].get("every", self.every))
+        self.every = index["info"].get("every") or self.every
         self.previous = index["info"]
 
     def _clear(self):
@@ -183,44 +240,48 @@ class RunWriter:
             names.append("markers")
         return names
 
-    def _shown(self, start, n, last=False):
-        """Chunk frames shown in the views: global index a multiple of ``every``, and the run's last."""
-        frames = [k for k in range(n) if (start + k) % self.every == 0]
-        if last and (not frames or frames[-1] != n - 1):
-            frames.append(n - 1)
-        return frames
+    def _plan_views(self, n_frames):
+        if self.every is None:
+            self.every = max(1, -(-n_frames // VIEW_FRAMES))
 
-    def _fragment(self, name, t, frames, n):
+    def _shown(self, start, n):
+        """Chunk frames shown in the views: global index a multiple of ``every``, and the chunk's
+        last (so the run's last frame is always shown, and a chunk's views never change)."""
+        return [k for k in range(n) if (start + k) % self.every == 0 or k == n - 1]
+
+    def _fragment(self, name, t):
         h5 = name  # relative to the views, which sit in the run directory
         n_nodes = len(self.static["s"])
-        views = {"rod": xdmf.rod_grids(h5, t, frames, n_nodes, n)}
+        views = {"rod": xdmf.rod_grids(h5, t, n_nodes)}
         if self.meta.get("cables"):
             n_points = sum(len(s) for s, _ in self._cable_layout())
-            views["cables"] = xdmf.cable_grids(h5, t, frames, n_points, n_points - len(self.meta["cables"]), n)
+            views["cables"] = xdmf.cable_grids(h5, t, n_points, n_points - len(self.meta["cables"]))
         if self.meta.get("markers"):
-            views["markers"] = xdmf.marker_grids(h5, t, frames, len(self.meta["markers"]), n)
+            views["markers"] = xdmf.marker_grids(h5, t, len(self.meta["markers"]))
         xdmf.write_fragment(self.directory / (name[:-3] + ".xmf"), views)
 
     def _cable_layout(self):
         one = np.zeros((1, len(self.static["s"]), 3))
         return cable_points(self.static["s"], one, np.broadcast_to(np.eye(3), one.shape[:2] + (3, 3)), self.meta)
 
-    def _extras(self, arrays):
-        """The arrays the views need besides the Result's: global velocity, cable and marker geometry."""
+    def _view_arrays(self, shown):
+        """The views' arrays of the Result ``shown`` (the frames they show): rod, cables, markers."""
         n_nodes = len(self.static["s"])
-        rotations = np.asarray(arrays["rotations"])
-        extras = {"s": self.static["s"], "radius": self.static["radius"],
+        rotations = shown.rotations
+        arrays = {"s": self.static["s"], "radius": self.static["radius"],
                   "rod_cells": np.arange(n_nodes, dtype=np.int64)[None],
-                  "velocity_global": np.einsum("tnij,tnj->tni", rotations, arrays["velocity"]).astype(VIEW)}
-        paths = cable_points(self.static["s"], np.asarray(arrays["positions"]), rotations, self.meta)
+                  "positions": shown.positions.astype(VIEW), "rotations": rotations.astype(VIEW),
+                  "velocity_global": np.einsum("tnij,tnj->tni", rotations, shown.velocity).astype(VIEW)}
+        arrays.update({attribute: getattr(shown, attribute).astype(VIEW) for attribute, _ in ROD_ARRAYS.values()})
+        paths = cable_points(self.static["s"], shown.positions, rotations, self.meta)
         if paths:
             sizes = [len(s) for s, _ in paths]
             starts = np.concatenate([[0], np.cumsum(sizes)])
             cells = np.concatenate([np.stack([np.arange(a, b - 1), np.arange(a + 1, b)], axis=1)
                                     for a, b in zip(starts[:-1], starts[1:])])
-            tension = np.asarray(arrays["tensions"], dtype=VIEW).reshape(len(arrays["t"]), -1)
+            tension = np.asarray(shown.tensions, dtype=VIEW).reshape(len(shown.t), -1)
             cell_cable = np.concatenate([np.full(n - 1, i) for i, n in enumerate(sizes)])
-            extras.update(cable_points=np.concatenate([p.astype(VIEW) for _, p in paths], axis=1),
+            arrays.update(cable_points=np.concatenate([p.astype(VIEW) for _, p in paths], axis=1),
                           cable_s=np.concatenate([s for s, _ in paths]),
                           cable_index=np.repeat(np.arange(len(paths)), sizes),
                           cable_cells=cells, cable_cell_index=cell_cable,
@@ -228,17 +289,19 @@ class RunWriter:
                           cable_cell_tension=tension[:, cell_cable])
         markers = self.meta.get("markers", [])
         if markers:
-            extras.update(marker_cells=np.arange(len(markers), dtype=np.int64)[:, None],
+            arrays.update(markers=shown.markers.astype(VIEW),
+                          marker_cells=np.arange(len(markers), dtype=np.int64)[:, None],
                           marker_s=np.array([float(m["s"]) for m in markers]),
                           marker_index=np.arange(len(markers), dtype=np.int64))
-        return extras
+        return arrays
 
     def _index(self, info):
+        """The arguments of :func:`h5result.write_index` now (copies: the run goes on)."""
         if self.previous is not None and not info.get("complete"):
             info["stats"] = self.previous.get("stats", {})
         info.update(meta=self.meta or {}, chunk_frames=self.chunk_frames, every=self.every)
-        h5result.write_index(self.directory, self.static, self.t_out if self.t_out is not None else self.t,
-                             self.t, self.chunks, info)
+        t = np.array(self.t)
+        return self.directory, self.static, self.t_out if self.t_out is not None else t, t, dict(self.chunks), info
 
 
 def clear_outputs(directory):

@@ -5,7 +5,9 @@ multiples of ``sink.chunk_frames``, counted from the first planned output),
 so the boundaries are restart points: a run resumed from the last frame of a
 chunk integrates exactly what the uninterrupted run did. Memory is bounded by
 one chunk's states. Any sink with ``chunk_frames``, ``begin(system, t_out)``,
-``frames(t, y)`` and ``end(success, message, stats)`` works
+``frames(t, y)`` and ``end(success, message, stats)`` works (and ``flush()``,
+if it has one, is called before ``end``: where a sink that writes behind the
+run reports a failed write)
 (:class:`rodmol.io.stream.RunWriter` is the one rodmol ships).
 """
 
@@ -61,12 +63,21 @@ def _chunks(run, system, y, t_out, sink, k, size, report, started, parts, max_wa
         parts.append(raw.stats)
         keep = 0 if k == 0 else 1  # a chunk's first frame is the previous chunk's last
         if len(raw.t) > keep:
-            try:
-                sink.frames(raw.t[keep:], raw.y[keep:])
-            except OSError as exc:  # a full disk: the chunks stored before stay valid
-                return False, f"cannot store the frames after t = {t_out[k]:.6g} s: {exc}", \
-                    merge_stats(parts), exc
+            failed = _store(parts, sink.frames, raw.t[keep:], raw.y[keep:])
+            if failed:
+                return failed
         if not raw.success:
             return False, raw.message, merge_stats(parts), raw.error
         k, y = stop, raw.y[-1]
-    return True, "The solver reached the end time.", merge_stats(parts), None
+    return _store(parts, getattr(sink, "flush", lambda: None)) or \
+        (True, "The solver reached the end time.", merge_stats(parts), None)
+
+
+def _store(parts, call, *args):
+    """``call(*args)``, a sink's storing; on an ``OSError`` (a full disk: the chunks stored
+    before stay valid) the run's outcome saying so, else None."""
+    try:
+        call(*args)
+    except OSError as exc:
+        return False, f"cannot store the frames: {exc}", merge_stats(parts), exc
+    return None

@@ -63,7 +63,7 @@ def test_write_series_leaves_a_directory_load_result_reads(model, tmp_path):
 
 
 class Killed(BaseException):
-    """Stands for a SIGKILL between two chunks."""
+    """Stands for a SIGKILL between two chunks, once the chunks before are on disk."""
 
 
 class DiesAfter(RunWriter):
@@ -73,6 +73,7 @@ class DiesAfter(RunWriter):
 
     def frames(self, t, y):
         if self.left == 0:
+            self.flush()
             raise Killed
         self.left -= 1
         super().frames(t, y)
