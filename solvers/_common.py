@@ -91,22 +91,28 @@ def header_lines(args, script):
 
 
 def write_csv(path, rows, header):
-    """rows: list of dicts (same keys); header lines go first as '# ...' comments."""
+    """rows: list of dicts (a key missing from a row leaves its cell empty); header
+    lines go first as '# ...' comments."""
     with open(path, "w", newline="") as f:
         for line in header:
             f.write(f"# {line}\n")
         if rows:
-            writer = csv.DictWriter(f, fieldnames=list(rows[0]))
+            writer = csv.DictWriter(f, fieldnames=_columns(rows))
             writer.writeheader()
             writer.writerows(rows)
     return path
+
+
+def _columns(rows):
+    """The keys of all ``rows``, in the order they first appear."""
+    return list(dict.fromkeys(key for row in rows for key in row))
 
 
 def markdown_table(rows, columns=None, formats=None):
     """A Markdown table of dict rows; ``formats`` maps a column to a format spec."""
     if not rows:
         return "(no rows)\n"
-    columns = columns or list(rows[0])
+    columns = columns or _columns(rows)
     formats = formats or {}
 
     def cell(row, c):

@@ -4,11 +4,15 @@ Each case runs ``examples/fetching.toml`` (N = 100, default settings, output
 every 10 ms) in a fresh subprocess as ``rodmol run`` does (the scenario's
 ``simulate`` with a :class:`rodmol.io.stream.RunWriter`), after a short
 warm-up run there (numba's cache). It reports the solver's own wall time
-(``stats["wall_time_s"]``), the writer's (deriving the Result's arrays of each
-chunk and writing the chunk files, views and index), the peak resident memory
-of the subprocess and the files and bytes left. ``--format vtp`` cases (the
-old path: the whole Result in memory, then result.npz and one .vtp per frame
-and part) are timed for the README run only.
+(``stats["wall_time_s"]``), the writer's (the time the run spends in the
+writer: computing each chunk's stresses, loads and view arrays, handing the
+chunk to the writer's thread, and waiting for it), the peak resident memory
+of the subprocess and the files and bytes left. The same run without output
+(``none``: the Result in memory) gives the wall time the output adds to the
+whole run, ``added_s`` (the writer's thread runs beside the solver, and the
+two share the machine). ``--format vtp`` cases (the old path: the whole
+Result in memory, then result.npz and one .vtp per frame and part) are timed
+for the README run only.
 
     python solvers/long_output.py [--quick | --smoke] [--out DIR]
 """
@@ -44,6 +48,8 @@ CHILD = textwrap.dedent("""
         writer = RunWriter(out)
         result = spec.simulate(out=writer)
         writing = writer.seconds
+    elif fmt == "none":
+        result, writing = spec.simulate(), 0.0
     else:
         from rodmol.io.writers import write_series
         result = spec.simulate()
@@ -67,7 +73,8 @@ def run_case(t_end, fmt, n_elements=0):
         row = json.loads(proc.stdout.strip().splitlines()[-1])
         files = [os.path.join(d, f) for d, _, names in os.walk(out) for f in names]
         sizes = [os.path.getsize(f) for f in files]
-        row.update(files=len(files), megabytes=sum(sizes) / 1e6, raw_disk_s=raw_disk_time(sizes, tmp))
+        row.update(files=len(files), megabytes=sum(sizes) / 1e6,
+                   raw_disk_s=raw_disk_time(sizes, tmp) if sizes else 0.0)
     return row
 
 
@@ -90,19 +97,26 @@ def main(argv=None):
     args = C.parse_args(__doc__.splitlines()[0], argv)
     header = C.header_lines(args, SCRIPT)
     n = C.pick(args, 0, 0, 10)  # 0: the file's N = 100
-    cases = C.pick(args, [(8.0, "vtp"), (8.0, "xdmf"), (600.0, "xdmf")],
-                   [(8.0, "vtp"), (8.0, "xdmf"), (60.0, "xdmf")],
-                   [(0.5, "vtp"), (0.5, "xdmf"), (2.0, "xdmf")])
-    rows = []
+    long = C.pick(args, 600.0, 60.0, 2.0)
+    short = C.pick(args, 8.0, 8.0, 0.5)
+    cases = [(short, "vtp"), (short, "none"), (short, "xdmf"), (long, "none"), (long, "xdmf")]
+    rows, plain = [], {}
     for t_end, fmt in cases:
         row = dict(t_end_s=t_end, format=fmt, N=n or 100, **run_case(t_end, fmt, n))
+        if fmt == "none":
+            plain[t_end] = row
         row["writing_over_solver"] = row["writing_s"] / row["solver_s"]
+        # What the output adds to the whole run's wall time, against the solver's time without output.
+        if fmt == "xdmf" and t_end in plain:
+            row["added_s"] = row["total_s"] - plain[t_end]["total_s"]
+            row["added_over_plain_solver"] = row["added_s"] / plain[t_end]["solver_s"]
         # The disk's share, and what the exact state history alone (7 + 19 N doubles a frame) weighs.
         row["raw_disk_over_solver"] = row["raw_disk_s"] / row["solver_s"]
         row["states_mb"] = row["frames"] * (7 + 19 * row["N"]) * 8 / 1e6
         rows.append(row)
+        added = f", {row['added_s']:.2f} s added to the run" if "added_s" in row else ""
         print(f"t_end = {t_end:g} s, {fmt}: solver {row['solver_s']:.2f} s, writing {row['writing_s']:.2f} s "
-              f"({row['writing_over_solver']:.2f}x), peak {row['peak_rss_mb']:.0f} MB, {row['files']} files, "
+              f"({row['writing_over_solver']:.2f}x{added}), peak {row['peak_rss_mb']:.0f} MB, {row['files']} files, "
               f"{row['megabytes']:.0f} MB (plain writes of as many bytes: {row['raw_disk_s']:.2f} s)", flush=True)
     C.write_results(args, "long_output", "Long runs and output (examples/fetching.toml)", header, rows,
                     [("Solver and writing wall time, peak memory, files", C.markdown_table(rows))])

@@ -4,6 +4,7 @@ core_speed.py also checks out the pre-refactor commit into a temporary git
 worktree (skipped outside a git checkout that has it)."""
 
 import os
+import shutil
 import subprocess
 import sys
 
@@ -26,6 +27,7 @@ SCRIPTS = {
     "fetching_hold.py": ["fetching_hold.csv", "fetching_hold.md", "fetching_hold.png"],
     "long_output.py": ["long_output.csv", "long_output.md"],
     "stiff_cantilever.py": ["stiff_cantilever.csv", "stiff_cantilever.md"],
+    "view_open.py": ["view_open.csv", "view_open.md"],
 }
 
 
@@ -35,6 +37,8 @@ def test_script_smoke_run(script, tmp_path):
     if script == "core_speed.py" and subprocess.run(
             ["git", "-C", ROOT, "cat-file", "-e", "9fce6d7^{commit}"], capture_output=True).returncode != 0:
         pytest.skip("needs a git checkout holding commit 9fce6d7")
+    if script == "view_open.py" and shutil.which("pvpython") is None:
+        pytest.skip("needs ParaView's pvpython")
     proc = subprocess.run([sys.executable, os.path.join(ROOT, "solvers", script), "--smoke",
                            "--out", str(tmp_path)], capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-4000:]

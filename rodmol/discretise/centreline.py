@@ -10,18 +10,28 @@ so at rest both positions agree.
 
 import numpy as np
 
-from . import rotations
+from .physics import chord, jit
 
 
 def chords(quat, q, k, ds):
     """Element chords (..., N, 3) [m], global: element j runs from node j to
     node j+1 with constant strains q_j, k_j, and its chord is taken as
-    ds R(mid) q_j with R(mid) = R_j exp(ds k_j / 2).
+    ds R(mid) q_j with R(mid) = R_j exp(ds k_j / 2) (``physics.chord``).
 
     ``quat`` (..., N, 4) are the orientations of nodes 0..N-1.
     """
-    mid = rotations.multiply(quat, rotations.from_rotation_vector(0.5 * ds * k))
-    return ds * np.einsum("...ij,...j->...i", rotations.matrices(mid), q)
+    quat, q, k = (np.ascontiguousarray(a, dtype=float) for a in (quat, q, k))
+    out = np.empty(q.shape)
+    _chords(quat.reshape(-1, 4), q.reshape(-1, 3), k.reshape(-1, 3), float(ds), out.reshape(-1, 3))
+    return out
+
+
+@jit
+def _chords(quat, q, k, ds, out):
+    for n in range(q.shape[0]):
+        c = chord((quat[n, 0], quat[n, 1], quat[n, 2], quat[n, 3]), (q[n, 0], q[n, 1], q[n, 2]),
+                  (k[n, 0], k[n, 1], k[n, 2]), ds)
+        out[n, 0], out[n, 1], out[n, 2] = c
 
 
 def positions(u0, quat, q, k, ds):

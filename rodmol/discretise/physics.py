@@ -107,6 +107,36 @@ def to_local(r, x):
 
 
 @jit
+def quaternion_product(p, q):
+    """p (x) q of quaternions (a, b, c, d), scalar first."""
+    a1, b1, c1, d1 = p
+    a2, b2, c2, d2 = q
+    return (a1 * a2 - b1 * b2 - c1 * c2 - d1 * d2,
+            a1 * b2 + b1 * a2 + c1 * d2 - d1 * c2,
+            a1 * c2 - b1 * d2 + c1 * a2 + d1 * b2,
+            a1 * d2 + b1 * c2 - c1 * b2 + d1 * a2)
+
+
+@jit
+def rotation_vector_quaternion(theta):
+    """The quaternion of the rotation exp([theta]x), theta [rad]."""
+    angle = np.sqrt(dot(theta, theta))
+    half = 0.5 * angle
+    # sin(x/2)/x without the 0/0 at x = 0
+    f = np.sin(half) / angle if angle > 1e-8 else 0.5 - angle * angle / 48.0
+    return (np.cos(half), f * theta[0], f * theta[1], f * theta[2])
+
+
+@jit
+def chord(quat, q, k, ds):
+    """Chord [m], global, of an element of length ds from a node of orientation
+    ``quat`` with constant strains q, k: ds R(mid) q with R(mid) = R exp(ds k / 2)
+    (the midpoint rule: second order, exact for the straight rod)."""
+    mid = quaternion_product(quat, rotation_vector_quaternion(scale(0.5 * ds, k)))
+    return scale(ds, to_global(rotation(mid), q))
+
+
+@jit
 def quaternion_rate(quat, w, restoring):
     """Q_t = Q (x) (0, w) / 2 + restoring (1 - |Q|^2) Q: the exact kinematics
     keep |Q| = 1, the second term only damps integration drift."""

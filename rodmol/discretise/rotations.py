@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from .physics import jit
+from .physics import jit, quaternion_product, rotation, rotation_vector_quaternion
 
 
 def matrices(quat):
@@ -22,17 +22,9 @@ def _matrices(quat, out):
     # One pass over the rows (the numpy version made nine temporaries per
     # entry): post-processing calls this on every frame of long runs.
     for n in range(quat.shape[0]):
-        a, b, c, d = quat[n, 0], quat[n, 1], quat[n, 2], quat[n, 3]
-        f = 2.0 / (a * a + b * b + c * c + d * d)
-        out[n, 0, 0] = 1.0 - f * (c * c + d * d)
-        out[n, 0, 1] = f * (b * c - a * d)
-        out[n, 0, 2] = f * (b * d + a * c)
-        out[n, 1, 0] = f * (b * c + a * d)
-        out[n, 1, 1] = 1.0 - f * (b * b + d * d)
-        out[n, 1, 2] = f * (c * d - a * b)
-        out[n, 2, 0] = f * (b * d - a * c)
-        out[n, 2, 1] = f * (c * d + a * b)
-        out[n, 2, 2] = 1.0 - f * (b * b + c * c)
+        r = rotation((quat[n, 0], quat[n, 1], quat[n, 2], quat[n, 3]))
+        for i in range(3):
+            out[n, i, 0], out[n, i, 1], out[n, i, 2] = r[3 * i], r[3 * i + 1], r[3 * i + 2]
 
 
 def rate(quat, omega):
@@ -48,25 +40,34 @@ def rate(quat, omega):
 
 
 def multiply(p, q):
-    """Quaternion product p (x) q, rows broadcast."""
-    a1, b1, c1, d1 = (p[..., i] for i in range(4))
-    a2, b2, c2, d2 = (q[..., i] for i in range(4))
-    return np.stack([
-        a1 * a2 - b1 * b2 - c1 * c2 - d1 * d2,
-        a1 * b2 + b1 * a2 + c1 * d2 - d1 * c2,
-        a1 * c2 - b1 * d2 + c1 * a2 + d1 * b2,
-        a1 * d2 + b1 * c2 - c1 * b2 + d1 * a2,
-    ], axis=-1)
+    """Quaternion product p (x) q, rows broadcast (``physics.quaternion_product``)."""
+    p, q = np.broadcast_arrays(np.asarray(p, dtype=float), np.asarray(q, dtype=float))
+    out = np.empty(p.shape)
+    _rows(np.ascontiguousarray(p).reshape(-1, 4), np.ascontiguousarray(q).reshape(-1, 4), out.reshape(-1, 4))
+    return out
+
+
+@jit
+def _rows(p, q, out):
+    for n in range(p.shape[0]):
+        out[n, 0], out[n, 1], out[n, 2], out[n, 3] = quaternion_product(
+            (p[n, 0], p[n, 1], p[n, 2], p[n, 3]), (q[n, 0], q[n, 1], q[n, 2], q[n, 3]))
 
 
 def from_rotation_vector(theta):
-    """Quaternion of the rotation exp([theta]x), theta (..., 3) [rad]."""
-    angle = np.linalg.norm(theta, axis=-1)
-    half = 0.5 * angle
-    # sin(x/2)/x without the 0/0 at x = 0
-    scale = np.where(angle > 1e-8, np.sin(half) / np.where(angle > 1e-8, angle, 1.0),
-                     0.5 - angle**2 / 48.0)
-    return np.concatenate([np.cos(half)[..., None], scale[..., None] * theta], axis=-1)
+    """Quaternion of the rotation exp([theta]x), theta (..., 3) [rad]
+    (``physics.rotation_vector_quaternion``)."""
+    theta = np.ascontiguousarray(theta, dtype=float)
+    out = np.empty(theta.shape[:-1] + (4,))
+    _exp_rows(theta.reshape(-1, 3), out.reshape(-1, 4))
+    return out
+
+
+@jit
+def _exp_rows(theta, out):
+    for n in range(theta.shape[0]):
+        out[n, 0], out[n, 1], out[n, 2], out[n, 3] = rotation_vector_quaternion(
+            (theta[n, 0], theta[n, 1], theta[n, 2]))
 
 
 def from_matrix(r):

@@ -6,6 +6,16 @@ import numpy as np
 
 #: The drawn parts, one view or series each.
 PARTS = ("rod", "cables", "markers")
+#: Frames a view or series shows at most when ``every`` is not given: ParaView
+#: 5.11 takes about a second per thousand frames to open an XDMF view
+#: (docs/performance.md), and the result file keeps every frame anyway.
+MAX_SHOWN = 6000
+
+
+def view_step(n_frames, every=None):
+    """Show every ``every``-th of ``n_frames`` output frames; by default all of
+    them up to :data:`MAX_SHOWN`, else the smallest step that keeps within it."""
+    return int(every) if every is not None else max(1, -(-int(n_frames) // MAX_SHOWN))
 
 #: Point arrays of the centreline: VTK name -> (Result attribute, frame).
 ROD_ARRAYS = {

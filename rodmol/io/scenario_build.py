@@ -147,7 +147,7 @@ def _output(data, ctx):
     values = dict(format=ctx.read(table, path, "format", read.choice(FORMATS), "xdmf"),
                   vtk=ctx.read(table, path, "vtk", read.boolean, True),
                   npz=ctx.read(table, path, "npz", read.boolean, True),
-                  every=ctx.read(table, path, "every", read.integer(1), 1),
+                  every=ctx.read(table, path, "every", read.integer(1), None),
                   chunk_frames=ctx.read(table, path, "chunk_frames", read.integer(1), CHUNK_FRAMES))
     if failed(directory, *values.values()):
         return None

@@ -18,13 +18,13 @@ class OutputOptions:
     ``format`` (``"xdmf"``: streamed ``result.h5`` and XDMF views in chunks
     of ``chunk_frames`` frames; ``"vtp"``: ``result.npz`` if ``npz`` and a
     .pvd series after the run), the ParaView views or series (``vtk``; every
-    ``every``-th output frame, and the last)."""
+    ``every``-th output frame, and the last; None: ``rodmol.io.parts.view_step``)."""
 
     directory: object = None
     format: str = "xdmf"
     vtk: bool = True
     npz: bool = True
-    every: int = 1
+    every: int = None
     chunk_frames: int = CHUNK_FRAMES
 
 

@@ -9,7 +9,8 @@ Result's arrays for each chunk, and writes
 * the chunk's HDF5 file and the index ``result.h5`` (:mod:`rodmol.io.h5result`),
 * the ParaView views ``rod.xdmf``, ``cables.xdmf``, ``markers.xdmf``
   (:mod:`rodmol.io.xdmf`): every ``every``-th frame and the last of each
-  chunk, in single precision; by default at most :data:`VIEW_FRAMES` frames.
+  chunk, in single precision; by default at most
+  :data:`rodmol.io.parts.MAX_SHOWN` frames.
 
 Memory stays bounded by one chunk. Every file appears complete under its
 real name or not at all, so a run killed at any moment leaves a directory
@@ -30,15 +31,11 @@ from ..result import STATIC
 from ..solve.chunked import merge_stats
 from . import h5result, xdmf
 from .h5result import INDEX
-from .parts import ROD_ARRAYS, cable_points
+from .parts import ROD_ARRAYS, cable_points, view_step
 
 #: Number type of the views' arrays (the result file's stay float64): what a
 #: picture needs, at half the bytes.
 VIEW = np.float32
-#: Frames the views show at most when ``every`` is not given: ParaView 5.11
-#: takes about a second per thousand frames to open a view (docs/performance.md),
-#: and a long run's result file keeps every frame anyway.
-VIEW_FRAMES = 6000
 #: Output frames per chunk by default: bounded memory (about 50 kB a frame at
 #: N = 100), fewer than 100 files for 600 s at 100 frames/s.
 CHUNK_FRAMES = 2000
@@ -54,9 +51,8 @@ class RunWriter:
         Write the XDMF views for ParaView (False: only ``result.h5`` and the chunks).
     every : int, optional
         The views show every ``every``-th output frame (and the last of each
-        chunk); the result file keeps all. Default: 1, or for runs of more
-        than :data:`VIEW_FRAMES` output frames the smallest step that keeps
-        the views within that many.
+        chunk); the result file keeps all. Default: all of them up to
+        :data:`rodmol.io.parts.MAX_SHOWN` frames (:func:`rodmol.io.parts.view_step`).
     chunk_frames : int
         Output frames per chunk file. With ``simulate(..., out=...)`` the
         solver also restarts at every chunk boundary (the restart points),
@@ -241,8 +237,7 @@ class RunWriter:
         return names
 
     def _plan_views(self, n_frames):
-        if self.every is None:
-            self.every = max(1, -(-n_frames // VIEW_FRAMES))
+        self.every = view_step(n_frames, self.every)
 
     def _shown(self, start, n):
         """Chunk frames shown in the views: global index a multiple of ``every``, and the chunk's

@@ -28,7 +28,7 @@ import numpy as np
 
 from .._files import write_atomically
 from ..errors import ParameterError
-from .parts import PARTS, ROD_ARRAYS, cable_points
+from .parts import PARTS, ROD_ARRAYS, cable_points, view_step
 
 SUBDIRECTORY = "vtk"
 
@@ -245,14 +245,14 @@ class SeriesWriter:
     close = flush
 
 
-def frame_indices(n_frames, every=1):
-    """Indices of every ``every``-th frame, always including the last."""
+def frame_indices(n_frames, every=None):
+    """Indices of every ``every``-th frame (:func:`view_step`), always including the last."""
     if n_frames == 0:
         return []
-    return sorted(set(range(0, n_frames, int(every))) | {n_frames - 1})
+    return sorted(set(range(0, n_frames, view_step(n_frames, every))) | {n_frames - 1})
 
 
-def write_series(result, directory, every=1, format="xdmf"):
+def write_series(result, directory, every=None, format="xdmf"):
     """Write a finished :class:`rodmol.Result` for ParaView into ``directory``.
 
     ``format="xdmf"`` (default): ``result.h5`` and the XDMF views
@@ -260,7 +260,8 @@ def write_series(result, directory, every=1, format="xdmf"):
     ``"vtp"``: ``result.npz`` and the ``.pvd``/``.vtp`` series, returns the
     path of ``rod.pvd``. Either directory is read back by
     :func:`rodmol.load_result`, ``rodmol render`` and ``rodmol plot``.
-    ``every``: show every n-th output frame (and the last).
+    ``every``: show every n-th output frame (and the last); by default all
+    of them up to :data:`rodmol.io.parts.MAX_SHOWN` frames.
     """
     if format == "xdmf":
         from .stream import RunWriter

@@ -37,7 +37,8 @@ K, T = "@K@", "@T@"
 
 def _frames(template, t):
     """The grid ``template`` (one text for all frames) at each frame of the chunk's views."""
-    return [template.replace(K, str(k)).replace(T, repr(float(tk))) for k, tk in enumerate(t)]
+    text = template.replace("%", "%%").replace(K, "%(k)d").replace(T, "%(t)r")
+    return [text % {"k": k, "t": float(tk)} for k, tk in enumerate(t)]
 
 
 def _item(h5, name, dims, n_frames=None, integer=False):

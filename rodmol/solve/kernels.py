@@ -6,7 +6,7 @@ install) and later processes load the machine code from the disk cache
 (well under a second). :func:`prepare` makes those first calls with a run
 of a microsecond by the run's own backend and options, so every kernel it
 will use (right-hand side, Jacobian, preconditioner, Newton loop, state
-scan) is ready; once per backend and options in a process. (User inputs are
+scan, post-processing) is ready; once per backend and options in a process. (User inputs are
 read at the preparing run's times too, as the initial equilibrium reads them.)
 """
 
@@ -14,7 +14,7 @@ import contextlib
 
 import numpy as np
 
-from ..discretise import rotations
+from ..result import ARRAYS, from_states
 
 #: Span [s] of the preparing run.
 SPAN = 1e-6
@@ -36,7 +36,7 @@ def prepare(system, t, y, run, rtol, atol, options):
     if key in _prepared:
         return
     y = np.array(y, dtype=float)
-    run(system, y, np.array([t, t + SPAN]), rtol=rtol, atol=atol, **options)
+    raw = run(system, y, np.array([t, t + SPAN]), rtol=rtol, atol=atol, **options)
     # A run that short may not need a linear solve (the Newton residual of a
     # rod at rest can vanish): call the preconditioner's kernels directly.
     with contextlib.suppress(ValueError):  # structures the block elimination does not take
@@ -44,7 +44,8 @@ def prepare(system, t, y, run, rtol, atol, options):
         fy = system(t, y)
         preconditioner.setup(t, y, fy, False, np.zeros(1, dtype=int), 1e-3)
         preconditioner.apply(fy)
-    # The post-processing of the frames (poses, cable path lengths).
-    rotations.matrices(system.layout.quaternions(y))
-    system.routing.lengths(system.layout.field(y, "q"), system.layout.field(y, "k"))
+    # The post-processing of the frames: every array of a Result (stresses, loads, poses, path lengths).
+    result = from_states(system, raw.t, raw.y, raw.success, raw.message, raw.stats)
+    for name in ARRAYS:
+        getattr(result, name)
     _prepared.add(key)
