@@ -57,14 +57,15 @@ def chunk_name(index):
 
 
 def write_chunk(directory, name, arrays, views=None):
-    """Write the chunk ``name`` (:func:`chunk_name`): ``arrays`` (name -> time-first array) and
-    the ``views``' arrays (in the group ``view``)."""
+    """Write the chunk ``name`` (:func:`chunk_name`): ``arrays`` (name -> time-first array), then
+    the views' arrays (in the group ``view``) that ``views()`` returns, if given (called once
+    ``arrays`` are written: they may still be computed meanwhile)."""
     (Path(directory) / FRAMES).mkdir(parents=True, exist_ok=True)
 
     def fill(handle):
         for key, value in arrays.items():
             handle.create_dataset(key, data=np.asarray(value, dtype=np.float32 if key in SINGLE else None))
-        for key, value in (views or {}).items():
+        for key, value in (views() if views is not None else {}).items():
             handle.create_dataset(f"{VIEW_GROUP}/{key}", data=np.asarray(value))
 
     atomic_h5(Path(directory) / name, fill)

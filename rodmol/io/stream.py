@@ -19,7 +19,7 @@ chunk, and whose last frame is the restart point of ``resume=True``.
 """
 
 import time
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import contextmanager
 from functools import partial
 from pathlib import Path
@@ -106,6 +106,11 @@ class RunWriter:
     def flush(self):
         """Wait until the chunks stored so far are on disk; raises the ``OSError`` of one that
         could not be written."""
+        self._settle(True)
+
+    def _settle(self, report):
+        """Wait for the chunk being written; if it failed, unlist it (it is not on disk) and,
+        if ``report``, raise why."""
         pending, self._pending = self._pending, None
         if pending is None:
             return
@@ -113,9 +118,10 @@ class RunWriter:
         with self._timed():
             try:
                 job.result()
-            except OSError:  # the chunk is not on disk: nothing may list it
+            except BaseException:
                 del self.t[len(self.t) - self.chunks.pop(name):]
-                raise
+                if report:
+                    raise
 
     def end(self, success, message, stats):
         """Finish: the final index; returns the Result (read lazily)."""
@@ -144,13 +150,21 @@ class RunWriter:
         n, start = len(chunk.t), len(self.t)
         stored = {key: getattr(chunk, key) for key in STORED}
         shown = chunk.select(self._shown(start, n)) if self.views else None
-        views = self._view_arrays(shown) if self.views else None
         name = h5result.chunk_name(len(self.chunks))
         self.chunks[name] = n
         self.t.extend(np.asarray(chunk.t, dtype=float).tolist())
         index = self._index(dict(success=True, message="running", stats={}, complete=False))
+        # The thread writes the stored arrays while this one computes the views' arrays.
+        views = Future() if self.views else None
         self._write_behind(name, partial(self._write, name, stored, views, None if shown is None else shown.t,
                                          list(self.chunks), index))
+        if views is not None:
+            try:
+                views.set_result(self._view_arrays(shown))
+            except BaseException as exc:  # an interrupt, say: the chunk is dropped
+                views.set_exception(exc)
+                self._settle(False)
+                raise
 
     @contextmanager
     def _timed(self):
@@ -175,9 +189,10 @@ class RunWriter:
         self._pending = (self._pool.submit(job), name)
 
     def _write(self, name, stored, views, t_shown, chunks, index):
-        """Write a chunk file, its views and the index that lists it (in the writer's thread:
-        h5py and file writes let the solver run meanwhile)."""
-        h5result.write_chunk(self.directory, name, stored, views)
+        """Write a chunk file, its views (``views``: a Future of their arrays, or None) and the
+        index that lists it (in the writer's thread: h5py and file writes let the solver run
+        meanwhile)."""
+        h5result.write_chunk(self.directory, name, stored, None if views is None else views.result)
         if views is not None:
             self._fragment(name, t_shown)
             fragments = [c[:-3] + ".xmf" for c in chunks]
