@@ -20,18 +20,21 @@ def chords(quat, q, k, ds):
 
     ``quat`` (..., N, 4) are the orientations of nodes 0..N-1.
     """
-    quat, q, k = (np.ascontiguousarray(a, dtype=float) for a in (quat, q, k))
+    # (frames, N, width) views, no copies: the strain fields are strided views of the states.
+    quat, q, k = (np.asarray(a, dtype=float) for a in (quat, q, k))
+    n = q.shape[-2]
     out = np.empty(q.shape)
-    _chords(quat.reshape(-1, 4), q.reshape(-1, 3), k.reshape(-1, 3), float(ds), out.reshape(-1, 3))
+    _chords(quat.reshape(-1, n, 4), q.reshape(-1, n, 3), k.reshape(-1, n, 3), float(ds), out.reshape(-1, n, 3))
     return out
 
 
 @jit
 def _chords(quat, q, k, ds, out):
-    for n in range(q.shape[0]):
-        c = chord((quat[n, 0], quat[n, 1], quat[n, 2], quat[n, 3]), (q[n, 0], q[n, 1], q[n, 2]),
-                  (k[n, 0], k[n, 1], k[n, 2]), ds)
-        out[n, 0], out[n, 1], out[n, 2] = c
+    for f in range(q.shape[0]):
+        for j in range(q.shape[1]):
+            out[f, j, 0], out[f, j, 1], out[f, j, 2] = chord(
+                (quat[f, j, 0], quat[f, j, 1], quat[f, j, 2], quat[f, j, 3]), (q[f, j, 0], q[f, j, 1], q[f, j, 2]),
+                (k[f, j, 0], k[f, j, 1], k[f, j, 2]), ds)
 
 
 def positions(u0, quat, q, k, ds):

@@ -4,6 +4,8 @@ paths."""
 
 import numpy as np
 
+from ..discretise.physics import jit
+
 #: The drawn parts, one view or series each.
 PARTS = ("rod", "cables", "markers")
 #: Frames a view or series shows at most when ``every`` is not given: ParaView
@@ -36,19 +38,46 @@ def cable_points(s_nodes, positions, rotations, meta):
     The nodes with s below the anchor, then the anchor itself, with ``u + R p``
     interpolated linearly in s between the nodes around it.
     """
-    paths = []
+    plan = _cable_plan(np.asarray(s_nodes, dtype=float), meta)
+    if not plan:
+        return []
+    nodes = np.concatenate([p[1] for p in plan])
+    weights = np.concatenate([p[2] for p in plan])
+    offsets = np.concatenate([p[3] for p in plan])
+    positions, rotations = np.asarray(positions, dtype=float), np.asarray(rotations, dtype=float)
+    points = np.empty((len(positions), len(nodes), 3))
+    _surface_points(positions, rotations, nodes, weights, offsets, points)
+    ends = np.cumsum([len(p[0]) for p in plan])
+    return [(p[0], points[:, end - len(p[0]):end]) for p, end in zip(plan, ends)]
+
+
+def _cable_plan(s_nodes, meta):
+    """Per cable: (s of its points, the two nodes (n, 2) each point lies between, their
+    weights (n, 2), the cable's offsets (local y, z) at those nodes (n, 2, 2))."""
+    plan = []
     for cable in meta.get("cables", []):
         # The routing p(s) (local y, z) at the nodes; a constant offset in older results.
         offsets = np.broadcast_to(np.asarray(cable.get("node_offsets", [cable["offset"]]), dtype=float),
                                   (len(s_nodes), 2))
         anchor = min(float(cable["anchor"]), float(s_nodes[-1]))
         on_path = int(np.count_nonzero(s_nodes < anchor))  # the nodes below the anchor come first
-        s = np.append(s_nodes[:on_path], anchor)
         j = min(int(np.searchsorted(s_nodes, anchor, side="right")) - 1, len(s_nodes) - 2)
-        used = slice(0, max(on_path, j + 2))
-        points = (positions[:, used] + offsets[used, 0, None] * rotations[:, used, :, 1]
-                  + offsets[used, 1, None] * rotations[:, used, :, 2])
         w = (anchor - s_nodes[j]) / (s_nodes[j + 1] - s_nodes[j])
-        at_anchor = (1.0 - w) * points[:, j] + w * points[:, j + 1]
-        paths.append((s, np.concatenate([points[:, :on_path], at_anchor[:, None]], axis=1)))
-    return paths
+        nodes = np.array([[i, i] for i in range(on_path)] + [[j, j + 1]], dtype=np.int64).reshape(-1, 2)
+        weights = np.array([[1.0, 0.0]] * on_path + [[1.0 - w, w]]).reshape(-1, 2)
+        plan.append((np.append(s_nodes[:on_path], anchor), nodes, weights, offsets[nodes]))
+    return plan
+
+
+@jit
+def _surface_points(positions, rotations, nodes, weights, offsets, out):
+    # u + R p at two nodes, weighted: one pass over frames and points.
+    for f in range(positions.shape[0]):
+        for i in range(nodes.shape[0]):
+            for c in range(3):
+                total = 0.0
+                for e in range(2):
+                    n = nodes[i, e]
+                    total += weights[i, e] * (positions[f, n, c] + offsets[i, e, 0] * rotations[f, n, c, 1]
+                                              + offsets[i, e, 1] * rotations[f, n, c, 2])
+                out[f, i, c] = total
