@@ -1,5 +1,7 @@
 """Shared reference solutions for the physics tests (test_point_loads, test_beams)."""
 
+import sys
+
 import numpy as np
 import pytest
 from scipy.integrate import solve_bvp
@@ -65,3 +67,19 @@ def elastica():
 def observed_orders():
     """Observed convergence orders of errors on grids refined by 2."""
     return _observed_orders
+
+
+class ChecksPassed(Exception):
+    """Raised where ``rodmol.simulate`` would start its work (building the system)."""
+
+
+@pytest.fixture
+def checks_only(monkeypatch):
+    """``rodmol.simulate`` checks its arguments, then stops with :class:`ChecksPassed`
+    instead of working; returns that class."""
+
+    def stop(*args, **kwargs):
+        raise ChecksPassed
+
+    monkeypatch.setattr(sys.modules["rodmol.simulate"], "SemiDiscrete", stop)
+    return ChecksPassed

@@ -7,7 +7,8 @@ numbers, so they are that scheme's; (2) the scheme converges at its orders,
 2 in dt and 1 in ds; (3) refined, it meets rodmol's trajectory, so the
 2.7 mm between rodmol and Till's 0.2086 m are his discretisation errors.
 
-Slow: numba compiles the shooting kernels (20-30 s in a fresh checkout).
+numba compiles the shooting kernels once (20-30 s in a fresh checkout; the
+module takes about 35 s then, 16 s with the cache).
 """
 
 import os
@@ -22,7 +23,6 @@ sys.path.insert(0, SOLVERS)
 
 import till_reference as TR  # noqa: E402
 
-pytestmark = pytest.mark.slow
 T_END = 10.5  # s: past Till's t = 10 s
 I10 = 200  # the 0.05 s frame of t = 10 s
 

@@ -31,6 +31,12 @@ class ErrorTable:
     actuated: np.ndarray
     name: str = ""
 
+    @classmethod
+    def unknown(cls, t, name=""):
+        """The table of a run that gave no frame at all: NaN at every time ``t`` [s]."""
+        nan = np.full(len(t), np.nan)
+        return cls(np.asarray(t, dtype=float), nan, nan.copy(), np.ones(len(t), bool), name)
+
     @property
     def tip_average(self):
         return _average(self.tip)

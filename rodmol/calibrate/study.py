@@ -4,8 +4,6 @@ measured markers."""
 
 from dataclasses import dataclass
 
-import numpy as np
-
 from .paper_errors import ErrorTable, as_tracks, plot_errors, table
 from .parallel import SERIAL, check_picklable, executor
 from .runs import Errors, Task
@@ -60,9 +58,8 @@ def worsened_models(spec, measured, *, client=None, variants=None, progress=None
     with executor(client, n_workers) as ex:
         outcomes = ex.map(_run_variant, [(task, variants[name]) for name, task in tasks], progress)
     named = dict(zip(variants, outcomes))
-    nan = np.full(len(tracks.t), np.nan)
-    errors = {name: o.value if o.value is not None else ErrorTable(tracks.t, nan, nan, np.ones(len(nan), bool), name)
-              for name, o in named.items()}  # a run that failed before its first frame: no errors
+    errors = {name: o.value if o.value is not None else ErrorTable.unknown(tracks.t, name)
+              for name, o in named.items()}  # a run that failed before its first frame
     return Study(errors, named)
 
 
