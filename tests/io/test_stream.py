@@ -38,6 +38,23 @@ def test_one_chunk_is_the_in_memory_run_and_reads_back_from_any_path(model, tmp_
         assert_same(rodmol.load_result(path), memory)
     assert assert_valid_views(tmp_path) == pytest.approx(memory.t)
     np.testing.assert_array_equal(rodmol.energy(model, streamed)["kinetic"], rodmol.energy(model, memory)["kinetic"])
+    # The stresses and loads are stored in single precision: 7 digits.
+    for name in h5result.SINGLE:
+        np.testing.assert_allclose(getattr(streamed, name), getattr(memory, name), rtol=2e-7, atol=0, err_msg=name)
+    assert np.abs(streamed.internal_moment).max() > 0
+
+
+def test_views_of_long_runs_show_at_most_max_shown_frames(model, tmp_path, monkeypatch):
+    from rodmol.io import parts
+
+    assert [parts.view_step(n) for n in (1, 6000, 6001, 60001)] == [1, 1, 2, 11]
+    assert parts.view_step(60001, every=1) == 1
+    monkeypatch.setattr(parts, "MAX_SHOWN", 10)
+    memory = rodmol.simulate(model, 0.3)  # 31 frames: every 4th, and the last of each chunk
+    rodmol.simulate(model, 0.3, out=RunWriter(tmp_path, chunk_frames=12))
+    shown = [0, 4, 8, 12, 16, 20, 24, 28, 30]  # chunks: frames 0-12, 13-24, 25-30
+    assert assert_valid_views(tmp_path) == pytest.approx(memory.t[shown])
+    np.testing.assert_array_equal(rodmol.load_result(tmp_path).t, memory.t)  # the result file keeps all
 
 
 def test_chunks_restart_the_solver_within_its_tolerance(model, tmp_path):
