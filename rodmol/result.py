@@ -132,18 +132,19 @@ class Result:
 
 #: Arrays of a Result that do not change in time.
 STATIC = ("s", "radius", "node_length")
+#: (n_t, 12) the rows of the strains and velocities that are not state fields:
+#: the base's velocity v0 [m/s] and angular velocity w0 [rad/s] (prescribed) and
+#: the tip's strains q [-] and k [1/m] (from the tip load), local frame.
+BOUNDARY = "boundary_rows"
+#: The stresses and loads (computed together with the ``BOUNDARY`` rows).
+FORCES = ("internal_force", "internal_moment", "external_force", "external_moment")
 #: What a Result holds besides its static arrays and ``meta``: the states, and
 #: what follows from the model rather than from the states alone (tensions,
 #: path lengths, actuator positions, stresses, loads, and the ``BOUNDARY`` rows
 #: of the strains and velocities). Every other array is derived from these on
 #: first access (``DERIVED``), the same way in memory and from a file: the
 #: result file stores only these.
-STORED = ("t", "states", "tensions", "cable_lengths", "actuator_positions", "internal_force",
-          "internal_moment", "external_force", "external_moment", "boundary_rows")
-#: (n_t, 12) the rows of the strains and velocities that are not state fields:
-#: the base's velocity v0 [m/s] and angular velocity w0 [rad/s] (prescribed) and
-#: the tip's strains q [-] and k [1/m] (from the tip load), local frame.
-BOUNDARY = "boundary_rows"
+STORED = ("t", "states", "tensions", "cable_lengths", "actuator_positions", *FORCES, BOUNDARY)
 
 
 def from_states(system, t, y, success, message, stats):
@@ -165,8 +166,7 @@ def from_states(system, t, y, success, message, stats):
     arrays = dict(t=t, tensions=tensions, **static_arrays(system), cable_lengths=lengths,
                   actuator_positions=actuators, states=y)
     loads = partial(_loads, system)
-    deferred = {name: loads for name in ("internal_force", "internal_moment", "external_force",
-                                         "external_moment", BOUNDARY)}
+    deferred = {name: loads for name in (*FORCES, BOUNDARY)}
     return Result(arrays, success, message, stats, run_meta(system), deferred)
 
 

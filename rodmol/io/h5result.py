@@ -29,7 +29,7 @@ import numpy as np
 
 from .._files import atomic_path
 from ..discretise.layout import BLOCK, HEADER
-from ..result import ARRAYS, STATIC, STORED, Result
+from ..result import ARRAYS, FORCES, STATIC, STORED, Result
 
 INDEX = "result.h5"
 FRAMES = "frames"
@@ -39,7 +39,7 @@ VIEW_GROUP = "view"
 #: Stored in single precision (7 digits), read back as float64: the stresses and
 #: loads, which only the model could recompute. The states stay double, so the
 #: kinematics derived from them and a restart are exact.
-SINGLE = ("internal_force", "internal_moment", "external_force", "external_moment")
+SINGLE = FORCES
 #: HDF5 format versions readable by the HDF5 1.10 of ParaView 5.11 (Debian).
 LIBVER = ("earliest", "v110")
 

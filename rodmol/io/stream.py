@@ -12,7 +12,8 @@ Result's arrays for each chunk, and writes
   chunk, in single precision; by default at most
   :data:`rodmol.io.parts.MAX_SHOWN` frames.
 
-Memory stays bounded by one chunk. Every file appears complete under its
+A background thread writes each chunk while the run goes on with the next,
+so memory stays bounded by two chunks. Every file appears complete under its
 real name or not at all, so a run killed at any moment leaves a directory
 that ParaView and :func:`rodmol.load_result` read up to the last complete
 chunk, and whose last frame is the restart point of ``resume=True``.
@@ -36,8 +37,8 @@ from .parts import ROD_ARRAYS, cable_points, view_step
 #: Number type of the views' arrays (the result file's stay float64): what a
 #: picture needs, at half the bytes.
 VIEW = np.float32
-#: Output frames per chunk by default: bounded memory (about 50 kB a frame at
-#: N = 100), fewer than 100 files for 600 s at 100 frames/s.
+#: Output frames per chunk by default: bounded memory (about 45 kB a frame at
+#: N = 100 with the views), fewer than 100 files for 600 s at 100 frames/s.
 CHUNK_FRAMES = 2000
 
 
