@@ -8,7 +8,7 @@ import numpy as np
 from . import markers
 from ._files import write_atomically
 from .discretise import centreline, physics, rotations
-from .discretise.layout import BLOCK, HEADER, StateLayout
+from .discretise.layout import StateLayout
 from .model import Q_STAR
 
 #: Arrays of a Result, with their units (also the keys of the .npz file).
@@ -231,7 +231,7 @@ def _loads(system, result):
 def _kinematics(result):
     """Strains and velocities at all nodes: the state's fields and the boundary rows."""
     y, rows = result.states, getattr(result, BOUNDARY)
-    layout = StateLayout((y.shape[-1] - HEADER) // BLOCK)
+    layout = StateLayout(result.meta["n_elements"])
     field = partial(layout.field, y)
     return dict(linear_strain=np.concatenate([field("q"), rows[:, None, 6:9]], axis=1),
                 curvature=np.concatenate([field("k"), rows[:, None, 9:12]], axis=1),
@@ -242,7 +242,7 @@ def _kinematics(result):
 def _pose(result):
     """Positions rebuilt from the strains, rotations, markers, integrated positions, quaternion drift."""
     y, meta = result.states, result.meta
-    layout = StateLayout((y.shape[-1] - HEADER) // BLOCK)
+    layout = StateLayout(meta["n_elements"])
     quat_all = layout.quaternions(y)
     positions = centreline.positions(layout.base_position(y), quat_all, layout.field(y, "q"),
                                      layout.field(y, "k"), meta["length"] / layout.n_elements)

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from .._files import atomic_path
-from ..discretise.layout import BLOCK, HEADER
+from ..discretise.layout import StateLayout
 from ..result import ARRAYS, FORCES, STATIC, STORED, Result
 
 INDEX = "result.h5"
@@ -142,9 +142,8 @@ def read_result(path):
         message = (f"the run was stopped before it finished (killed?): {len(arrays['t'])} frames up to "
                    f"t = {arrays['t'][-1] if len(arrays['t']) else 0.0:.6g} s were kept; resume it with "
                    "`rodmol run ... --resume` or simulate(..., out=DIR, resume=True)")
-    result = Result(arrays, info["success"] and info.get("complete", True), message, info["stats"],
-                    info.get("meta"), deferred)
-    return result
+    return Result(arrays, info["success"] and info.get("complete", True), message, info["stats"],
+                  info.get("meta"), deferred)
 
 
 def _stored(folder, chunks):
@@ -154,12 +153,12 @@ def _stored(folder, chunks):
     if not chunks:
         return STORED
     with h5py.File(folder / chunks[0], "r") as handle:
-        return tuple(name for name in (*STORED, *ARRAYS) if name in handle and name not in STATIC)
+        return tuple(name for name in dict.fromkeys((*STORED, *ARRAYS)) if name in handle and name not in STATIC)
 
 
 def _empty_shape(name, n_nodes, info):
     meta = info.get("meta") or {}
     cables = (len(meta.get("cables", [])),)
     shapes = {"tensions": cables, "cable_lengths": cables, "actuator_positions": (len(meta.get("actuators", [])),),
-              "states": (HEADER + BLOCK * (n_nodes - 1),), "boundary_rows": (12,)}
+              "states": (StateLayout(n_nodes - 1).size,), "boundary_rows": (12,)}
     return shapes.get(name, (n_nodes, 3))

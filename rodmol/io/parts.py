@@ -19,6 +19,7 @@ def view_step(n_frames, every=None):
     them up to :data:`MAX_SHOWN`, else the smallest step that keeps within it."""
     return int(every) if every is not None else max(1, -(-int(n_frames) // MAX_SHOWN))
 
+
 #: Point arrays of the centreline: VTK name -> (Result attribute, frame).
 ROD_ARRAYS = {
     "linear strain [-]": ("linear_strain", "local"),
@@ -49,6 +50,11 @@ def cable_points(s_nodes, positions, rotations, meta):
     _surface_points(positions, rotations, nodes, weights, offsets, points)
     ends = np.cumsum([len(p[0]) for p in plan])
     return [(p[0], points[:, end - len(p[0]):end]) for p, end in zip(plan, ends)]
+
+
+def cable_arc_lengths(s_nodes, meta):
+    """The arc lengths s [m] of each cable's points (those of :func:`cable_points`)."""
+    return [plan[0] for plan in _cable_plan(np.asarray(s_nodes, dtype=float), meta)]
 
 
 def _cable_plan(s_nodes, meta):

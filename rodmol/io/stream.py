@@ -32,7 +32,7 @@ from ..result import STATIC
 from ..solve.chunked import merge_stats
 from . import h5result, xdmf
 from .h5result import INDEX
-from .parts import ROD_ARRAYS, cable_points, view_step
+from .parts import ROD_ARRAYS, cable_arc_lengths, cable_points, view_step
 
 #: Number type of the views' arrays (the result file's stay float64): what a
 #: picture needs, at half the bytes.
@@ -78,6 +78,7 @@ class RunWriter:
         self.static, self.meta, self.system = None, None, None
         self._pool, self._pending = None, None  # the writer's thread, and the chunk it writes
         self._depth = 0  # of nested _timed blocks
+        self._fixed_views = None  # the views' static arrays, made once
         self.previous = None
         if resume:
             self._reopen()
@@ -262,48 +263,51 @@ class RunWriter:
 
     def _fragment(self, name, t):
         h5 = name  # relative to the views, which sit in the run directory
-        n_nodes = len(self.static["s"])
-        views = {"rod": xdmf.rod_grids(h5, t, n_nodes)}
-        if self.meta.get("cables"):
-            n_points = sum(len(s) for s, _ in self._cable_layout())
-            views["cables"] = xdmf.cable_grids(h5, t, n_points, n_points - len(self.meta["cables"]))
-        if self.meta.get("markers"):
-            views["markers"] = xdmf.marker_grids(h5, t, len(self.meta["markers"]))
+        fixed = self._static_views()
+        views = {"rod": xdmf.rod_grids(h5, t, len(fixed["s"]))}
+        if "cable_s" in fixed:
+            views["cables"] = xdmf.cable_grids(h5, t, len(fixed["cable_s"]), len(fixed["cable_cells"]))
+        if "marker_s" in fixed:
+            views["markers"] = xdmf.marker_grids(h5, t, len(fixed["marker_s"]))
         xdmf.write_fragment(self.directory / (name[:-3] + ".xmf"), views)
 
-    def _cable_layout(self):
-        one = np.zeros((1, len(self.static["s"]), 3))
-        return cable_points(self.static["s"], one, np.broadcast_to(np.eye(3), one.shape[:2] + (3, 3)), self.meta)
+    def _static_views(self):
+        """The views' arrays that do not change in time (made once: every chunk file holds them)."""
+        if self._fixed_views is None:
+            s = self.static["s"]
+            fixed = {"s": s, "radius": self.static["radius"], "rod_cells": np.arange(len(s), dtype=np.int64)[None]}
+            paths = cable_arc_lengths(s, self.meta)
+            if paths:
+                sizes = [len(path) for path in paths]
+                starts = np.concatenate([[0], np.cumsum(sizes)])
+                fixed.update(
+                    cable_s=np.concatenate(paths), cable_index=np.repeat(np.arange(len(sizes)), sizes),
+                    cable_cells=np.concatenate([np.stack([np.arange(a, b - 1), np.arange(a + 1, b)], axis=1)
+                                                for a, b in zip(starts[:-1], starts[1:])]),
+                    cable_cell_index=np.concatenate([np.full(n - 1, i) for i, n in enumerate(sizes)]))
+            markers = self.meta.get("markers", [])
+            if markers:
+                fixed.update(marker_cells=np.arange(len(markers), dtype=np.int64)[:, None],
+                             marker_s=np.array([float(m["s"]) for m in markers]),
+                             marker_index=np.arange(len(markers), dtype=np.int64))
+            self._fixed_views = fixed
+        return self._fixed_views
 
     def _view_arrays(self, shown):
         """The views' arrays of the Result ``shown`` (the frames they show): rod, cables, markers."""
-        n_nodes = len(self.static["s"])
+        fixed = self._static_views()
         rotations = shown.rotations
-        arrays = {"s": self.static["s"], "radius": self.static["radius"],
-                  "rod_cells": np.arange(n_nodes, dtype=np.int64)[None],
-                  "positions": shown.positions.astype(VIEW), "rotations": rotations.astype(VIEW),
-                  "velocity_global": np.einsum("tnij,tnj->tni", rotations, shown.velocity).astype(VIEW)}
+        arrays = dict(fixed, positions=shown.positions.astype(VIEW), rotations=rotations.astype(VIEW),
+                      velocity_global=np.einsum("tnij,tnj->tni", rotations, shown.velocity).astype(VIEW))
         arrays.update({attribute: getattr(shown, attribute).astype(VIEW) for attribute, _ in ROD_ARRAYS.values()})
         paths = cable_points(self.static["s"], shown.positions, rotations, self.meta)
         if paths:
-            sizes = [len(s) for s, _ in paths]
-            starts = np.concatenate([[0], np.cumsum(sizes)])
-            cells = np.concatenate([np.stack([np.arange(a, b - 1), np.arange(a + 1, b)], axis=1)
-                                    for a, b in zip(starts[:-1], starts[1:])])
             tension = np.asarray(shown.tensions, dtype=VIEW).reshape(len(shown.t), -1)
-            cell_cable = np.concatenate([np.full(n - 1, i) for i, n in enumerate(sizes)])
             arrays.update(cable_points=np.concatenate([p.astype(VIEW) for _, p in paths], axis=1),
-                          cable_s=np.concatenate([s for s, _ in paths]),
-                          cable_index=np.repeat(np.arange(len(paths)), sizes),
-                          cable_cells=cells, cable_cell_index=cell_cable,
-                          cable_point_tension=np.repeat(tension, sizes, axis=1),
-                          cable_cell_tension=tension[:, cell_cable])
-        markers = self.meta.get("markers", [])
-        if markers:
-            arrays.update(markers=shown.markers.astype(VIEW),
-                          marker_cells=np.arange(len(markers), dtype=np.int64)[:, None],
-                          marker_s=np.array([float(m["s"]) for m in markers]),
-                          marker_index=np.arange(len(markers), dtype=np.int64))
+                          cable_point_tension=tension[:, fixed["cable_index"]],
+                          cable_cell_tension=tension[:, fixed["cable_cell_index"]])
+        if "marker_s" in fixed:
+            arrays["markers"] = shown.markers.astype(VIEW)
         return arrays
 
     def _index(self, info):
