@@ -59,14 +59,18 @@ def chunk_name(index):
 def write_chunk(directory, name, arrays, views=None):
     """Write the chunk ``name`` (:func:`chunk_name`): ``arrays`` (name -> time-first array), then
     the views' arrays (in the group ``view``) that ``views()`` returns, if given (called once
-    ``arrays`` are written: they may still be computed meanwhile)."""
+    ``arrays`` are written: they may still be computed meanwhile). A view of every frame of
+    a single-precision array is a link to it, not a copy."""
     (Path(directory) / FRAMES).mkdir(parents=True, exist_ok=True)
 
     def fill(handle):
         for key, value in arrays.items():
             handle.create_dataset(key, data=np.asarray(value, dtype=np.float32 if key in SINGLE else None))
         for key, value in (views() if views is not None else {}).items():
-            handle.create_dataset(f"{VIEW_GROUP}/{key}", data=np.asarray(value))
+            if key in SINGLE and key in arrays and len(value) == len(arrays[key]):
+                handle[f"{VIEW_GROUP}/{key}"] = handle[key]  # an HDF5 hard link: the same numbers
+            else:
+                handle.create_dataset(f"{VIEW_GROUP}/{key}", data=np.asarray(value))
 
     atomic_h5(Path(directory) / name, fill)
 

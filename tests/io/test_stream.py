@@ -44,6 +44,25 @@ def test_one_chunk_is_the_in_memory_run_and_reads_back_from_any_path(model, tmp_
     assert np.abs(streamed.internal_moment).max() > 0
 
 
+def _chunk_forces(directory):
+    """(stored, view) internal force arrays of the first chunk, and whether they are one dataset."""
+    import h5py
+
+    with h5py.File(directory / h5result.chunk_name(0), "r") as handle:
+        stored, view = handle["internal_force"], handle[f"{h5result.VIEW_GROUP}/internal_force"]
+        return stored[()], view[()], stored == view
+
+
+def test_views_of_every_frame_link_the_stored_forces_else_copy_the_shown(model, tmp_path):
+    rodmol.simulate(model, 0.2, out=tmp_path / "all")
+    stored, view, same = _chunk_forces(tmp_path / "all")
+    assert same and view.shape == stored.shape  # one dataset, two names: written once
+    rodmol.simulate(model, 0.2, out=RunWriter(tmp_path / "some", every=3))
+    stored, view, same = _chunk_forces(tmp_path / "some")
+    assert not same and len(view) == 8  # frames 0, 3, ..., 18 and the last, 20
+    np.testing.assert_array_equal(view, stored[[0, 3, 6, 9, 12, 15, 18, 20]])
+
+
 def test_views_of_long_runs_show_at_most_max_shown_frames(model, tmp_path, monkeypatch):
     from rodmol.io import parts
 
