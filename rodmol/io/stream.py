@@ -82,6 +82,7 @@ class RunWriter:
         self.previous = None
         if resume:
             self._reopen()
+            remove_temporaries(self.directory)
         else:
             self._clear()
 
@@ -328,3 +329,13 @@ def clear_outputs(directory):
     if frames.is_dir():
         for file in frames.glob("chunk_*"):
             file.unlink()
+    remove_temporaries(directory)
+
+
+def remove_temporaries(directory):
+    """Remove the half-written files a killed run left (hidden ``.part`` files, never listed)."""
+    directory = Path(directory)
+    names = (INDEX, *(f"{v}.xdmf" for v in xdmf.VIEWS))
+    for file in [*directory.glob(".*.part"), *(directory / h5result.FRAMES).glob(".chunk_*.part")]:
+        if file.name.startswith(".chunk_") or any(file.name.startswith(f".{name}.") for name in names):
+            file.unlink(missing_ok=True)

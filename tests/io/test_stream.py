@@ -122,9 +122,14 @@ def test_resume_after_a_kill_repeats_the_uninterrupted_run(model, tmp_path):
     cut = rodmol.load_result(tmp_path / "cut")
     assert not cut.success and "resume" in cut.message and len(cut.t) == 25
     assert assert_valid_views(tmp_path / "cut") == pytest.approx(cut.t)
+    # What a kill in the middle of a write leaves: half-written temporaries (and a file not ours).
+    left = [tmp_path / "cut" / "frames" / ".chunk_000003.h5.k3x9.part", tmp_path / "cut" / ".result.h5.q1.part"]
+    for file in (*left, tmp_path / "cut" / ".notes.part"):
+        file.write_bytes(b"half")
     resumed = rodmol.simulate(model, 0.5, out=tmp_path / "cut", resume=True)
     assert resumed.success
     assert_same(resumed, whole)
+    assert not any(file.exists() for file in left) and (tmp_path / "cut" / ".notes.part").exists()
     assert assert_valid_views(tmp_path / "cut") == pytest.approx(whole.t)
     with pytest.raises(rodmol.ParameterError, match="nothing to resume.*finished"):
         rodmol.simulate(model, 0.5, out=tmp_path / "cut", resume=True)
