@@ -320,10 +320,14 @@ class RunWriter:
         return self.directory, self.static, self.t_out if self.t_out is not None else t, t, dict(self.chunks), info
 
 
+#: The files a run writes in its directory (the chunks are in ``frames/``).
+_RUN_FILES = (INDEX, *(f"{view}.xdmf" for view in xdmf.VIEWS))
+
+
 def clear_outputs(directory):
     """Remove the streamed outputs of an earlier run in ``directory``, so nothing stale is listed or read."""
     directory = Path(directory)
-    for name in (INDEX, *(f"{v}.xdmf" for v in xdmf.VIEWS)):
+    for name in _RUN_FILES:
         (directory / name).unlink(missing_ok=True)
     frames = directory / h5result.FRAMES
     if frames.is_dir():
@@ -335,7 +339,6 @@ def clear_outputs(directory):
 def remove_temporaries(directory):
     """Remove the half-written files a killed run left (hidden ``.part`` files, never listed)."""
     directory = Path(directory)
-    names = (INDEX, *(f"{v}.xdmf" for v in xdmf.VIEWS))
     for file in [*directory.glob(".*.part"), *(directory / h5result.FRAMES).glob(".chunk_*.part")]:
-        if file.name.startswith(".chunk_") or any(file.name.startswith(f".{name}.") for name in names):
+        if file.name.startswith(".chunk_") or any(file.name.startswith(f".{name}.") for name in _RUN_FILES):
             file.unlink(missing_ok=True)
