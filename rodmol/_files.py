@@ -3,6 +3,12 @@
 import contextlib
 import os
 import tempfile
+from pathlib import Path
+
+
+def _temporary_name(name):
+    """(prefix, suffix) of the temporaries of a file called ``name``: hidden, ``.part``."""
+    return f".{name}.", ".part"
 
 
 def _umask():
@@ -22,7 +28,8 @@ def atomic_path(path):
     """
     path = os.fspath(path)
     folder, name = os.path.split(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=f".{name}.", suffix=".part", dir=folder)
+    prefix, suffix = _temporary_name(name)
+    fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=suffix, dir=folder)
     os.close(fd)
     try:
         yield tmp
@@ -38,3 +45,12 @@ def write_atomically(path, write):
     """Call ``write(handle)`` on a binary file, then move it to ``path`` (see :func:`atomic_path`)."""
     with atomic_path(path) as tmp, open(tmp, "wb") as handle:
         write(handle)
+
+
+def leftover_temporaries(pattern):
+    """The temporaries :func:`atomic_path` made for the files matching ``pattern`` (a path
+    whose name may hold glob wildcards) that were never moved to their names: what a
+    killed writer leaves (they are leftovers only while no writer works in that folder)."""
+    folder = Path(pattern).parent
+    prefix, suffix = _temporary_name(Path(pattern).name)
+    return sorted(folder.glob(f"{prefix}*{suffix}")) if folder.is_dir() else []

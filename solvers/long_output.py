@@ -58,8 +58,10 @@ CHILD = textwrap.dedent("""
         writing = time.perf_counter() - begun
     total = time.perf_counter() - started
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # kB -> MB (Linux)
+    from rodmol.discretise.layout import StateLayout
     print(json.dumps(dict(frames=len(result.t), success=result.success, solver_s=result.stats["wall_time_s"],
-                          writing_s=writing, total_s=total, peak_rss_mb=peak)))
+                          writing_s=writing, total_s=total, peak_rss_mb=peak, N=spec.model.n_elements,
+                          state_size=StateLayout(spec.model.n_elements).size)))
 """)
 
 
@@ -104,7 +106,7 @@ def main(argv=None):
     cases = [(short, "vtp"), (short, "none"), *[(short, "xdmf")] * repeats, (long, "none"), (long, "xdmf")]
     rows, plain = [], {}
     for t_end, fmt in cases:
-        row = dict(t_end_s=t_end, format=fmt, N=n or 100, **run_case(t_end, fmt, n))
+        row = dict(t_end_s=t_end, format=fmt, **run_case(t_end, fmt, n))
         if fmt == "none":
             plain[t_end] = row
         row["writing_over_solver"] = row["writing_s"] / row["solver_s"]
@@ -112,9 +114,9 @@ def main(argv=None):
         if fmt == "xdmf" and t_end in plain:
             row["added_s"] = row["total_s"] - plain[t_end]["total_s"]
             row["added_over_plain_solver"] = row["added_s"] / plain[t_end]["solver_s"]
-        # The disk's share, and what the exact state history alone (7 + 19 N doubles a frame) weighs.
+        # The disk's share, and what the exact state history alone (float64) weighs.
         row["raw_disk_over_solver"] = row["raw_disk_s"] / row["solver_s"]
-        row["states_mb"] = row["frames"] * (7 + 19 * row["N"]) * 8 / 1e6
+        row["states_mb"] = row["frames"] * row.pop("state_size") * 8 / 1e6
         rows.append(row)
         added = f", {row['added_s']:.2f} s added to the run" if "added_s" in row else ""
         print(f"t_end = {t_end:g} s, {fmt}: solver {row['solver_s']:.2f} s, writing {row['writing_s']:.2f} s "

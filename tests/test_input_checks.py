@@ -2,7 +2,6 @@
 parameter and the value (cut when long), before any work is done; the same
 rules in Python and in scenario files."""
 
-
 import numpy as np
 import pytest
 from scenario_texts import MINIMAL

@@ -2,7 +2,6 @@
 Marker, Model and simulate either give a valid object (or an accepted call) or
 raise rodmol's ParameterError, never a raw Python error or a huge allocation."""
 
-
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings

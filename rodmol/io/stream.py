@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._files import leftover_temporaries
 from ..errors import ParameterError
 from ..result import STATIC
 from ..solve.chunked import merge_stats
@@ -339,6 +340,6 @@ def clear_outputs(directory):
 def remove_temporaries(directory):
     """Remove the half-written files a killed run left (hidden ``.part`` files, never listed)."""
     directory = Path(directory)
-    for file in [*directory.glob(".*.part"), *(directory / h5result.FRAMES).glob(".chunk_*.part")]:
-        if file.name.startswith(".chunk_") or any(file.name.startswith(f".{name}.") for name in _RUN_FILES):
+    for pattern in (*_RUN_FILES, f"{h5result.FRAMES}/chunk_*"):
+        for file in leftover_temporaries(directory / pattern):
             file.unlink(missing_ok=True)

@@ -57,8 +57,7 @@ def test_paraview_loads_the_series_and_renders_the_tube(tmp_path):
     write_series(result, tmp_path, format="vtp")
     script, png = tmp_path / "render.py", tmp_path / "frame.png"
     script.write_text(SCRIPT)
-    run = xserver.run([XVFB, *xserver.XVFB_ARGS, PVPYTHON, str(script),
-                          str(tmp_path), str(png)], timeout=120)
+    run = xserver.run([XVFB, *xserver.XVFB_ARGS, PVPYTHON, str(script), str(tmp_path), str(png)], timeout=120)
     assert run.returncode == 0, run.stderr[-2000:]
     report = json.loads(run.stdout.strip().splitlines()[-1])
     np.testing.assert_allclose(report["times"], result.t)
@@ -124,8 +123,8 @@ def test_paraview_opens_the_streamed_views_with_moving_geometry(tmp_path):
     result = rodmol.simulate(model, 0.5, output_dt=0.05, out=RunWriter(out, chunk_frames=4))
     script, png = tmp_path / "open.py", tmp_path / "frame.png"
     script.write_text(XDMF_SCRIPT)
-    run = xserver.run([XVFB, *xserver.XVFB_ARGS, PVPYTHON, str(script),
-                          str(out.resolve()), str(png)], timeout=180)
+    run = xserver.run([XVFB, *xserver.XVFB_ARGS, PVPYTHON, str(script), str(out.resolve()), str(png)],
+                      timeout=180)
     assert run.returncode == 0, run.stderr[-2000:]
     report = json.loads(run.stdout.strip().splitlines()[-1])
     rod, cables, markers = report["rod"], report["cables"], report["markers"]
