@@ -145,6 +145,8 @@ FORCES = ("internal_force", "internal_moment", "external_force", "external_momen
 #: first access (``DERIVED``), the same way in memory and from a file: the
 #: result file stores only these.
 STORED = ("t", "states", "tensions", "cable_lengths", "actuator_positions", *FORCES, BOUNDARY)
+#: The stored arrays one pass of the model over the frames computes (on first access).
+LOADS = (*FORCES, BOUNDARY)
 
 
 def from_states(system, t, y, success, message, stats):
@@ -159,14 +161,14 @@ def from_states(system, t, y, success, message, stats):
     model, layout = system.model, system.layout
     t, y = np.asarray(t, dtype=float), np.asarray(y)
     n_t = len(t)
-    tensions = np.array([system.tensions(ti, yi) for ti, yi in zip(t, y)]).reshape(n_t, -1)
+    tensions = system.tension_history(t, y)
     lengths = system.routing.lengths(layout.field(y, "q"), layout.field(y, "k")).reshape(n_t, -1)
     actuated = [c for c in model.cables if c.actuated]
     actuators = np.array([[c.displacement.value(ti) for c in actuated] for ti in t]).reshape(n_t, len(actuated))
     arrays = dict(t=t, tensions=tensions, **static_arrays(system), cable_lengths=lengths,
                   actuator_positions=actuators, states=y)
     loads = partial(_loads, system)
-    deferred = {name: loads for name in (*FORCES, BOUNDARY)}
+    deferred = {name: loads for name in LOADS}
     return Result(arrays, success, message, stats, run_meta(system), deferred)
 
 

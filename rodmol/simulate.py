@@ -147,6 +147,7 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
                 kernels.ready(run, backend_options)):
         system = SemiDiscrete(model, scheme)  # the one system of this run
         kernels.prepare(system, t0, straight_state(model), run, rtol, atol, backend_options)
+        getattr(sink, "prepare", lambda system: None)(system)
     with _stage(progress, f"solving the initial equilibrium at t = {t0:g} s", timings, "equilibrium_s",
                 not (isinstance(initial, str) and initial == "equilibrium")):
         y0 = _initial_state(system, initial, t0)

@@ -232,6 +232,22 @@ class SemiDiscrete:
         state = self.state_view(t, y) if self.global_coupling and y is not None else None
         return self.model.tensions(t, state)
 
+    def tension_history(self, t, states):
+        """Tensions (n_t, n_cables) [N] of all cables at the frames ``states`` (n_t, size) at
+        times ``t`` (n_t,), as :meth:`tensions` gives them one frame at a time (a constant
+        tension is read once)."""
+        cables = self.model.cables
+        out = np.empty((len(t), len(cables)))
+        varying = [c for c, cable in enumerate(cables) if cable.tension.constant is None]
+        for c, cable in enumerate(cables):
+            if c not in varying:
+                out[:, c] = cable.tension_at(0.0)
+        if varying:
+            for i, (ti, yi) in enumerate(zip(np.asarray(t, dtype=float), states)):
+                state = self.state_view(ti, yi) if self.global_coupling else None
+                out[i, varying] = [cables[c].tension_at(ti, state) for c in varying]
+        return out
+
     def state_view(self, t, y):
         """A :class:`StateView` of ``y`` at t, with the cables' path lengths."""
         return StateView(self.layout, t, y, self.model.ds, self.routing)

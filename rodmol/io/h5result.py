@@ -56,21 +56,24 @@ def chunk_name(index):
     return f"{FRAMES}/chunk_{index:06d}.h5"
 
 
-def write_chunk(directory, name, arrays, views=None):
-    """Write the chunk ``name`` (:func:`chunk_name`): ``arrays`` (name -> time-first array), then
-    the views' arrays (in the group ``view``) that ``views()`` returns, if given (called once
-    ``arrays`` are written: they may still be computed meanwhile). A view of every frame of
-    a single-precision array is a link to it, not a copy."""
+def write_chunk(directory, name, batches, views=()):
+    """Write the chunk ``name`` (:func:`chunk_name`): ``batches``, then ``views`` (the views'
+    arrays, in the group ``view``), in order. Each batch is a dict (name -> time-first array)
+    or a function returning one, called once the batches before it are written (so it may
+    still be computed meanwhile). A view of every frame of a single-precision array is a
+    link to it, not a copy."""
     (Path(directory) / FRAMES).mkdir(parents=True, exist_ok=True)
 
     def fill(handle):
-        for key, value in arrays.items():
-            handle.create_dataset(key, data=np.asarray(value, dtype=np.float32 if key in SINGLE else None))
-        for key, value in (views() if views is not None else {}).items():
-            if key in SINGLE and key in arrays and len(value) == len(arrays[key]):
-                handle[f"{VIEW_GROUP}/{key}"] = handle[key]  # an HDF5 hard link: the same numbers
-            else:
-                handle.create_dataset(f"{VIEW_GROUP}/{key}", data=np.asarray(value))
+        for batch in batches:
+            for key, value in (batch() if callable(batch) else batch).items():
+                handle.create_dataset(key, data=np.asarray(value, dtype=np.float32 if key in SINGLE else None))
+        for batch in views:
+            for key, value in (batch() if callable(batch) else batch).items():
+                if key in SINGLE and key in handle and len(value) == len(handle[key]):
+                    handle[f"{VIEW_GROUP}/{key}"] = handle[key]  # an HDF5 hard link: the same numbers
+                else:
+                    handle.create_dataset(f"{VIEW_GROUP}/{key}", data=np.asarray(value))
 
     atomic_h5(Path(directory) / name, fill)
 

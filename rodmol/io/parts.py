@@ -39,17 +39,21 @@ def cable_points(s_nodes, positions, rotations, meta):
     The nodes with s below the anchor, then the anchor itself, with ``u + R p``
     interpolated linearly in s between the nodes around it.
     """
+    points = cable_point_array(s_nodes, positions, rotations, meta)
+    paths = cable_arc_lengths(s_nodes, meta)
+    ends = np.cumsum([len(s) for s in paths])
+    return [(s, points[:, end - len(s):end]) for s, end in zip(paths, ends)]
+
+
+def cable_point_array(s_nodes, positions, rotations, meta, dtype=float):
+    """The points of :func:`cable_points` of all cables in one array (n_t, n_points, 3) [m] of
+    ``dtype``, global, cable after cable."""
     plan = _cable_plan(np.asarray(s_nodes, dtype=float), meta)
-    if not plan:
-        return []
-    nodes = np.concatenate([p[1] for p in plan])
-    weights = np.concatenate([p[2] for p in plan])
-    offsets = np.concatenate([p[3] for p in plan])
-    positions, rotations = np.asarray(positions, dtype=float), np.asarray(rotations, dtype=float)
-    points = np.empty((len(positions), len(nodes), 3))
-    _surface_points(positions, rotations, nodes, weights, offsets, points)
-    ends = np.cumsum([len(p[0]) for p in plan])
-    return [(p[0], points[:, end - len(p[0]):end]) for p, end in zip(plan, ends)]
+    points = np.empty((len(positions), sum(len(p[0]) for p in plan), 3), dtype=dtype)
+    if plan:
+        _surface_points(np.asarray(positions, dtype=float), np.asarray(rotations, dtype=float),
+                        *(np.concatenate([p[i] for p in plan]) for i in (1, 2, 3)), points)
+    return points
 
 
 def cable_arc_lengths(s_nodes, meta):

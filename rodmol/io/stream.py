@@ -3,7 +3,8 @@
 :class:`RunWriter` receives the states at the output times in chunks while
 the run goes (``simulate(..., out=DIR)``; the sink protocol is
 ``begin(system, t_out)``, ``frames(t, y)``, ``end(success, message, stats)``
-returning the :class:`rodmol.Result`, and ``chunk_frames``), derives the
+returning the :class:`rodmol.Result`, ``chunk_frames`` and, optionally,
+``prepare(system)``; see :mod:`rodmol.solve.chunked`), derives the
 Result's arrays for each chunk, and writes
 
 * the chunk's HDF5 file and the index ``result.h5`` (:mod:`rodmol.io.h5result`),
@@ -19,6 +20,7 @@ that ParaView and :func:`rodmol.load_result` read up to the last complete
 chunk, and whose last frame is the restart point of ``resume=True``.
 """
 
+import functools
 import time
 from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import contextmanager
@@ -33,7 +35,7 @@ from ..result import STATIC
 from ..solve.chunked import merge_stats
 from . import h5result, xdmf
 from .h5result import INDEX
-from .parts import ROD_ARRAYS, cable_arc_lengths, cable_points, view_step
+from .parts import ROD_ARRAYS, cable_arc_lengths, cable_point_array, view_step
 
 #: Number type of the views' arrays (the result file's stay float64): what a
 #: picture needs, at half the bytes.
@@ -79,6 +81,7 @@ class RunWriter:
         self.static, self.meta, self.system = None, None, None
         self._pool, self._pending = None, None  # the writer's thread, and the chunk it writes
         self._depth = 0  # of nested _timed blocks
+        self._ending = False  # end() writes the last index
         self._fixed_views = None  # the views' static arrays, made once
         self.previous = None
         if resume:
@@ -88,6 +91,12 @@ class RunWriter:
             self._clear()
 
     # ----------------------------------------------------------------- the sink protocol
+
+    def prepare(self, system):
+        """Load what writing needs, once per process, before the run (``simulate`` books it
+        with the compiled kernels' preparation): loaded by the first chunk in the writer's
+        thread, it would hold the GIL against the run."""
+        _load_once()
 
     def begin(self, system, t_out):
         """Start (or, resuming, continue) a run of ``system`` with output times ``t_out``."""
@@ -130,6 +139,7 @@ class RunWriter:
     def end(self, success, message, stats):
         """Finish: the final index; returns the Result (read lazily)."""
         with self._timed():
+            self._ending = True
             try:
                 self.flush()
             finally:
@@ -146,29 +156,35 @@ class RunWriter:
 
     def store(self, chunk):
         """Write the :class:`rodmol.Result` ``chunk`` (the next frames of the run) as one chunk."""
-        from ..result import STORED
+        from ..result import LOADS, STORED
 
         if self.static is None:
             self.static = {key: getattr(chunk, key) for key in STATIC}
             self.meta = dict(chunk.meta, **self.extra_meta)
         n, start = len(chunk.t), len(self.t)
-        stored = {key: getattr(chunk, key) for key in STORED}
-        shown = chunk.select(self._shown(start, n)) if self.views else None
+        frames = self._shown(start, n)
+        shown = chunk if len(frames) == n else chunk.select(frames)
         name = h5result.chunk_name(len(self.chunks))
         self.chunks[name] = n
         self.t.extend(np.asarray(chunk.t, dtype=float).tolist())
         index = self._index(dict(success=True, message="running", stats={}, complete=False))
-        # The thread writes the stored arrays while this one computes the views' arrays.
-        views = Future() if self.views else None
-        self._write_behind(name, partial(self._write, name, stored, views, None if shown is None else shown.t,
-                                         list(self.chunks), index))
-        if views is not None:
-            try:
-                views.set_result(self._view_arrays(shown))
-            except BaseException as exc:  # an interrupt, say: the chunk is dropped
-                views.set_exception(exc)
-                self._settle(False)
-                raise
+        # The thread writes each batch of arrays while this one computes the next.
+        makers = [lambda: {key: getattr(chunk, key) for key in LOADS}]
+        views = self._view_batches(shown) if self.views else []
+        handed = [Future() for _ in makers + views]
+        at_hand = {key: getattr(chunk, key) for key in STORED if key not in LOADS}
+        self._write_behind(name, partial(
+            self._write, name, [at_hand, *(f.result for f in handed[:len(makers)])],
+            [f.result for f in handed[len(makers):]], shown.t if self.views else None, list(self.chunks), index))
+        try:
+            for future, make in zip(handed, makers + views):
+                future.set_result(make())
+        except BaseException as exc:  # an interrupt, say: the chunk is dropped
+            for future in handed:
+                if not future.done():
+                    future.set_exception(exc)
+            self._settle(False)
+            raise
 
     @contextmanager
     def _timed(self):
@@ -192,17 +208,19 @@ class RunWriter:
             self._pool = ThreadPoolExecutor(1, thread_name_prefix="rodmol-writer")
         self._pending = (self._pool.submit(job), name)
 
-    def _write(self, name, stored, views, t_shown, chunks, index):
-        """Write a chunk file, its views (``views``: a Future of their arrays, or None) and the
-        index that lists it (in the writer's thread: h5py and file writes let the solver run
-        meanwhile)."""
-        h5result.write_chunk(self.directory, name, stored, None if views is None else views.result)
-        if views is not None:
+    def _write(self, name, batches, views, t_shown, chunks, index):
+        """Write a chunk file (see :func:`h5result.write_chunk`), its views (``t_shown``: the
+        times they show, or None without views) and the index that lists it, in the writer's
+        thread (h5py lets the solver run meanwhile). The index is left to :meth:`end` if the
+        run ends meanwhile."""
+        h5result.write_chunk(self.directory, name, batches, views)
+        if t_shown is not None:
             self._fragment(name, t_shown)
             fragments = [c[:-3] + ".xmf" for c in chunks]
             for view in self.view_names():
                 xdmf.write_view(self.directory / f"{view}.xdmf", view, fragments)
-        h5result.write_index(*index)
+        if not self._ending:
+            h5result.write_index(*index)
 
     def write_result(self, result):
         """Write a finished in-memory :class:`rodmol.Result`, chunk by chunk; returns the path of ``rod.xdmf``."""
@@ -271,7 +289,9 @@ class RunWriter:
             views["cables"] = xdmf.cable_grids(h5, t, len(fixed["cable_s"]), len(fixed["cable_cells"]))
         if "marker_s" in fixed:
             views["markers"] = xdmf.marker_grids(h5, t, len(fixed["marker_s"]))
-        xdmf.write_fragment(self.directory / (name[:-3] + ".xmf"), views)
+        path = self.directory / (name[:-3] + ".xmf")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        xdmf.write_fragment(path, views)
 
     def _static_views(self):
         """The views' arrays that do not change in time (made once: every chunk file holds them)."""
@@ -295,22 +315,32 @@ class RunWriter:
             self._fixed_views = fixed
         return self._fixed_views
 
-    def _view_arrays(self, shown):
-        """The views' arrays of the Result ``shown`` (the frames they show): rod, cables, markers."""
+    def _view_batches(self, shown):
+        """The views' arrays of the Result ``shown`` (the frames they show), in batches: functions
+        returning the rod's, the cables' and the markers' arrays."""
         fixed = self._static_views()
-        rotations = shown.rotations
-        arrays = dict(fixed, positions=shown.positions.astype(VIEW), rotations=rotations.astype(VIEW),
-                      velocity_global=np.einsum("tnij,tnj->tni", rotations, shown.velocity).astype(VIEW))
-        arrays.update({attribute: getattr(shown, attribute).astype(VIEW) for attribute, _ in ROD_ARRAYS.values()})
-        paths = cable_points(self.static["s"], shown.positions, rotations, self.meta)
-        if paths:
+
+        def rod():
+            rotations = shown.rotations
+            velocity = np.einsum("tnij,tnj->tni", rotations, shown.velocity)
+            arrays = {key: fixed[key] for key in ("s", "radius", "rod_cells")}
+            arrays.update(positions=shown.positions.astype(VIEW), rotations=rotations.astype(VIEW),
+                          velocity_global=velocity.astype(VIEW))
+            arrays.update({attribute: getattr(shown, attribute).astype(VIEW) for attribute, _ in ROD_ARRAYS.values()})
+            return arrays
+
+        def cables():
             tension = np.asarray(shown.tensions, dtype=VIEW).reshape(len(shown.t), -1)
-            arrays.update(cable_points=np.concatenate([p.astype(VIEW) for _, p in paths], axis=1),
-                          cable_point_tension=tension[:, fixed["cable_index"]],
-                          cable_cell_tension=tension[:, fixed["cable_cell_index"]])
-        if "marker_s" in fixed:
-            arrays["markers"] = shown.markers.astype(VIEW)
-        return arrays
+            points = cable_point_array(self.static["s"], shown.positions, shown.rotations, self.meta, VIEW)
+            arrays = {key: fixed[key] for key in ("cable_s", "cable_index", "cable_cells", "cable_cell_index")}
+            return dict(arrays, cable_points=points, cable_point_tension=tension[:, fixed["cable_index"]],
+                        cable_cell_tension=tension[:, fixed["cable_cell_index"]])
+
+        def markers():
+            arrays = {key: fixed[key] for key in ("marker_cells", "marker_s", "marker_index")}
+            return dict(arrays, markers=shown.markers.astype(VIEW))
+
+        return [rod] + ([cables] if "cable_s" in fixed else []) + ([markers] if "marker_s" in fixed else [])
 
     def _index(self, info):
         """The arguments of :func:`h5result.write_index` now (copies: the run goes on)."""
@@ -319,6 +349,15 @@ class RunWriter:
         info.update(meta=self.meta or {}, chunk_frames=self.chunk_frames, every=self.every)
         t = np.array(self.t)
         return self.directory, self.static, self.t_out if self.t_out is not None else t, t, dict(self.chunks), info
+
+
+@functools.cache
+def _load_once():
+    import h5py  # noqa: F401  (imported, not used here)
+
+    # The views' compiled kernel for their number type: a cable over a two-node rod.
+    cable_point_array(np.array([0.0, 1.0]), np.zeros((1, 2, 3)), np.tile(np.eye(3), (1, 2, 1, 1)),
+                      {"cables": [{"anchor": 1.0, "offset": [0.0, 0.0]}]}, VIEW)
 
 
 #: The files a run writes in its directory (the chunks are in ``frames/``).

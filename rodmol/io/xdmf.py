@@ -37,8 +37,8 @@ K, T = "@K@", "@T@"
 
 def _frames(template, t):
     """The grid ``template`` (one text for all frames) at each frame of the chunk's views."""
-    text = template.replace("%", "%%").replace(K, "%(k)d").replace(T, "%(t)r")
-    return [text % {"k": k, "t": float(tk)} for k, tk in enumerate(t)]
+    pieces = [part.split(K) for part in template.split(T)]  # joined by str.join: the fastest way
+    return [repr(float(tk)).join(str(k).join(piece) for piece in pieces) for k, tk in enumerate(t)]
 
 
 def _item(h5, name, dims, n_frames=None, integer=False):
@@ -112,12 +112,11 @@ def write_fragment(path, views):
     """Write a chunk's grids, ``views`` (view name -> list of grid texts), atomically."""
     text = [HEADER.format(ns="")]
     for name, grids in views.items():
-        text.append(f'<Grid Name="{name}" GridType="Collection" CollectionType="Temporal">\n')
-        text.extend(g + "\n" for g in grids)
-        text.append("</Grid>\n")
+        text += [f'<Grid Name="{name}" GridType="Collection" CollectionType="Temporal">\n', "\n".join(grids),
+                 "\n</Grid>\n"]
     text.append(FOOTER)
-    data = "".join(text).encode()
-    write_atomically(path, lambda handle: handle.write(data))
+    data = [piece.encode() for piece in text]  # megabytes: no copy into one string
+    write_atomically(path, lambda handle: handle.writelines(data))
 
 
 def write_view(path, name, fragments):

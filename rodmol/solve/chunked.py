@@ -7,7 +7,8 @@ chunk integrates exactly what the uninterrupted run did. Memory is bounded by
 one chunk's states. Any sink with ``chunk_frames``, ``begin(system, t_out)``,
 ``frames(t, y)`` and ``end(success, message, stats)`` works (and ``flush()``,
 if it has one, is called before ``end``: where a sink that writes behind the
-run reports a failed write)
+run reports a failed write; ``prepare(system)``, if it has one, is called by
+:func:`rodmol.simulate` while the compiled kernels are prepared)
 (:class:`rodmol.io.stream.RunWriter` is the one rodmol ships).
 """
 

@@ -173,6 +173,21 @@ def test_tensions_match_the_model():
         np.testing.assert_allclose(system.tensions(t, None), model.tensions(t), rtol=1e-15)
 
 
+@pytest.mark.parametrize("name", ["paper arm, cables", "timed tensions (knots, callable)", "feedback and constant"])
+def test_tension_history_is_the_tensions_frame_by_frame(name):
+    # A constant is read once for all frames, so the history must still match the
+    # frame-by-frame evaluation (feedback laws read each frame's own state).
+    model = MODELS.get(name) or rodmol.paper_arm(6, tensions={2: 0.7, 11: lambda t, state: 1.0 + state.tip[1] * t})
+    system = rodmol.SemiDiscrete(model)
+    rng = np.random.default_rng(5)
+    t = np.array([0.0, 0.4, 1.3])
+    states = np.array([generic_state(model, rng) for _ in t])
+    expected = np.array([system.tensions(ti, yi) for ti, yi in zip(t, states)])
+    assert np.any(np.ptp(expected, axis=0) > 0) == (name != "paper arm, cables")  # some vary in time
+    np.testing.assert_array_equal(system.tension_history(t, states), expected)
+    assert system.tension_history(t[:0], states[:0]).shape == (0, len(model.cables))
+
+
 # ----------------------------------------------------------------------------- unit tests
 
 RNG = np.random.default_rng(42)
