@@ -41,9 +41,10 @@ def atomic_path(path):
         raise
 
 
-def write_atomically(path, write):
-    """Call ``write(handle)`` on a binary file, then move it to ``path`` (see :func:`atomic_path`)."""
-    with atomic_path(path) as tmp, open(tmp, "wb") as handle:
+def write_atomically(path, write, buffering=-1):
+    """Call ``write(handle)`` on a binary file (``buffering`` as :func:`open`'s), then move it to
+    ``path`` (see :func:`atomic_path`)."""
+    with atomic_path(path) as tmp, open(tmp, "wb", buffering=buffering) as handle:
         write(handle)
 
 

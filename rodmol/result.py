@@ -219,13 +219,14 @@ def _loads(system, result):
             n_tip[i] -= n_a
             m_tip[i] -= m_a
     kl_tip, kth_tip = model.rod.stiffness(model.rod.length)
-    rots = rotations.matrices(layout.quaternions(y)[:, 1:])
-    zero = np.zeros((n_t, 1, 3))
+    rots = result.rotations[:, 1:]  # the pose's (a writer needs both)
+    external_force, external_moment = np.zeros((2, n_t, len(result.s), 3))  # none at the clamp, node 0
+    rotations.rotate(rots, loads[..., :3], external_force[:, 1:])
+    rotations.rotate(rots, loads[..., 3:], external_moment[:, 1:])
     return {
         "internal_force": np.concatenate([stress[..., :3], n_tip[:, None]], axis=1),
         "internal_moment": np.concatenate([stress[..., 3:], m_tip[:, None]], axis=1),
-        "external_force": np.concatenate([zero, np.einsum("tnij,tnj->tni", rots, loads[..., :3])], axis=1),
-        "external_moment": np.concatenate([zero, np.einsum("tnij,tnj->tni", rots, loads[..., 3:])], axis=1),
+        "external_force": external_force, "external_moment": external_moment,
         BOUNDARY: np.concatenate([base, Q_STAR + n_tip / kl_tip, m_tip / kth_tip], axis=1),
     }
 
@@ -242,7 +243,7 @@ def _kinematics(result):
 
 
 def _pose(result):
-    """Positions rebuilt from the strains, rotations, markers, integrated positions, quaternion drift."""
+    """Positions rebuilt from the strains, rotations, markers."""
     y, meta = result.states, result.meta
     layout = StateLayout(meta["n_elements"])
     quat_all = layout.quaternions(y)
@@ -253,15 +254,21 @@ def _pose(result):
     offsets = np.array([[0.0, *m["offset"]] for m in marks]).reshape(-1, 3)
     return dict(
         positions=positions, rotations=rots,
-        integrated_positions=layout.integrated_positions(y),
         markers=markers.track([m["s"] for m in marks], offsets, result.s, positions, rots),
-        quaternion_norm_error=np.max(np.abs(np.linalg.norm(quat_all, axis=-1) - 1.0), axis=-1),
     )
+
+
+def _drift(result):
+    """The positions integrated in time, and the quaternions' drift off the unit sphere."""
+    layout = StateLayout(result.meta["n_elements"])
+    quat_all = layout.quaternions(result.states)
+    return dict(integrated_positions=layout.integrated_positions(result.states),
+                quaternion_norm_error=np.max(np.abs(np.linalg.norm(quat_all, axis=-1) - 1.0), axis=-1))
 
 
 #: The arrays derived from ``STORED`` ones: group -> (what it needs, its function, what it gives).
 DERIVED = {
     "kinematics": ((BOUNDARY,), _kinematics, ("linear_strain", "curvature", "velocity", "angular_velocity")),
-    "pose": (("states",), _pose, ("positions", "rotations", "integrated_positions", "markers",
-                                  "quaternion_norm_error")),
+    "pose": (("states",), _pose, ("positions", "rotations", "markers")),
+    "drift": (("states",), _drift, ("integrated_positions", "quaternion_norm_error")),
 }

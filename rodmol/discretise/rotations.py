@@ -27,6 +27,23 @@ def _matrices(quat, out):
             out[n, i, 0], out[n, i, 1], out[n, i, 2] = r[3 * i], r[3 * i + 1], r[3 * i + 2]
 
 
+def rotate(matrices, vectors, out=None):
+    """R v (n_t, n, 3) for rotation matrices R (n_t, n, 3, 3) and vectors v (n_t, n, 3): local
+    vectors to the global frame. Strided arrays are read, and ``out`` written, in place."""
+    matrices, vectors = np.asarray(matrices, dtype=float), np.asarray(vectors, dtype=float)
+    out = np.empty(vectors.shape) if out is None else out
+    _rotate(matrices, vectors, out)
+    return out
+
+
+@jit
+def _rotate(m, v, out):
+    for f in range(v.shape[0]):
+        for n in range(v.shape[1]):
+            for i in range(3):
+                out[f, n, i] = m[f, n, i, 0] * v[f, n, 0] + m[f, n, i, 1] * v[f, n, 1] + m[f, n, i, 2] * v[f, n, 2]
+
+
 def rate(quat, omega):
     """dQ/dt = Q (x) (0, omega) / 2 for a body-frame angular velocity omega (..., 3)."""
     a, b, c, d = (quat[..., i] for i in range(4))

@@ -40,6 +40,9 @@ VIEW_GROUP = "view"
 #: loads, which only the model could recompute. The states stay double, so the
 #: kinematics derived from them and a restart are exact.
 SINGLE = FORCES
+#: Number type of the views' floating arrays (the result's own keep theirs): what a
+#: picture needs, at half the bytes.
+VIEW = np.float32
 #: HDF5 format versions readable by the HDF5 1.10 of ParaView 5.11 (Debian).
 LIBVER = ("earliest", "v110")
 
@@ -60,20 +63,23 @@ def write_chunk(directory, name, batches, views=()):
     """Write the chunk ``name`` (:func:`chunk_name`): ``batches``, then ``views`` (the views'
     arrays, in the group ``view``), in order. Each batch is a dict (name -> time-first array)
     or a function returning one, called once the batches before it are written (so it may
-    still be computed meanwhile). A view of every frame of a single-precision array is a
-    link to it, not a copy."""
+    still be computed meanwhile). The views' floating arrays are written as :data:`VIEW`,
+    and a view of every frame of a single-precision array is a link to it, not a copy. (HDF5
+    converts number types while writing, through a small buffer of its own: no copies.)"""
     (Path(directory) / FRAMES).mkdir(parents=True, exist_ok=True)
 
     def fill(handle):
         for batch in batches:
             for key, value in (batch() if callable(batch) else batch).items():
-                handle.create_dataset(key, data=np.asarray(value, dtype=np.float32 if key in SINGLE else None))
+                handle.create_dataset(key, data=np.asarray(value), dtype=np.float32 if key in SINGLE else None)
         for batch in views:
             for key, value in (batch() if callable(batch) else batch).items():
                 if key in SINGLE and key in handle and len(value) == len(handle[key]):
                     handle[f"{VIEW_GROUP}/{key}"] = handle[key]  # an HDF5 hard link: the same numbers
                 else:
-                    handle.create_dataset(f"{VIEW_GROUP}/{key}", data=np.asarray(value))
+                    value = np.asarray(value)
+                    handle.create_dataset(f"{VIEW_GROUP}/{key}", data=value,
+                                          dtype=VIEW if value.dtype.kind == "f" else None)
 
     atomic_h5(Path(directory) / name, fill)
 

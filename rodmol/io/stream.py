@@ -30,16 +30,14 @@ from pathlib import Path
 import numpy as np
 
 from .._files import leftover_temporaries
+from ..discretise.rotations import rotate
 from ..errors import ParameterError
 from ..result import STATIC
 from ..solve.chunked import merge_stats
 from . import h5result, xdmf
-from .h5result import INDEX
+from .h5result import INDEX, VIEW
 from .parts import ROD_ARRAYS, cable_arc_lengths, cable_point_array, view_step
 
-#: Number type of the views' arrays (the result file's stay float64): what a
-#: picture needs, at half the bytes.
-VIEW = np.float32
 #: Output frames per chunk by default: bounded memory (about 45 kB a frame at
 #: N = 100 with the views), fewer than 100 files for 600 s at 100 frames/s.
 CHUNK_FRAMES = 2000
@@ -81,7 +79,6 @@ class RunWriter:
         self.static, self.meta, self.system = None, None, None
         self._pool, self._pending = None, None  # the writer's thread, and the chunk it writes
         self._depth = 0  # of nested _timed blocks
-        self._ending = False  # end() writes the last index
         self._fixed_views = None  # the views' static arrays, made once
         self.previous = None
         if resume:
@@ -139,7 +136,6 @@ class RunWriter:
     def end(self, success, message, stats):
         """Finish: the final index; returns the Result (read lazily)."""
         with self._timed():
-            self._ending = True
             try:
                 self.flush()
             finally:
@@ -167,17 +163,20 @@ class RunWriter:
         name = h5result.chunk_name(len(self.chunks))
         self.chunks[name] = n
         self.t.extend(np.asarray(chunk.t, dtype=float).tolist())
-        index = self._index(dict(success=True, message="running", stats={}, complete=False))
-        # The thread writes each batch of arrays while this one computes the next.
-        makers = [lambda: {key: getattr(chunk, key) for key in LOADS}]
+        # The chunk that ends the planned run leaves the index to end() (a kill before it: resumed there).
+        final = self.t_out is not None and len(self.t) == len(self.t_out)
+        index = None if final else self._index(dict(success=True, message="running", stats={}, complete=False))
+        # The thread writes each batch of arrays while this one computes the next, then the views' text.
         views = self._view_batches(shown) if self.views else []
-        handed = [Future() for _ in makers + views]
+        fragment = [partial(self._fragment, shown.t, name)] if self.views else []
+        makers = [lambda: {key: getattr(chunk, key) for key in LOADS}, *views, *fragment]
+        handed = [Future() for _ in makers]
+        made = [future.result for future in handed]
         at_hand = {key: getattr(chunk, key) for key in STORED if key not in LOADS}
-        self._write_behind(name, partial(
-            self._write, name, [at_hand, *(f.result for f in handed[:len(makers)])],
-            [f.result for f in handed[len(makers):]], shown.t if self.views else None, list(self.chunks), index))
+        self._write_behind(name, partial(self._write, name, [at_hand, made[0]], made[1:1 + len(views)],
+                                         made[-1] if fragment else None, list(self.chunks), index))
         try:
-            for future, make in zip(handed, makers + views):
+            for future, make in zip(handed, makers):
                 future.set_result(make())
         except BaseException as exc:  # an interrupt, say: the chunk is dropped
             for future in handed:
@@ -208,18 +207,18 @@ class RunWriter:
             self._pool = ThreadPoolExecutor(1, thread_name_prefix="rodmol-writer")
         self._pending = (self._pool.submit(job), name)
 
-    def _write(self, name, batches, views, t_shown, chunks, index):
-        """Write a chunk file (see :func:`h5result.write_chunk`), its views (``t_shown``: the
-        times they show, or None without views) and the index that lists it, in the writer's
-        thread (h5py lets the solver run meanwhile). The index is left to :meth:`end` if the
-        run ends meanwhile."""
+    def _write(self, name, batches, views, fragment, chunks, index):
+        """Write a chunk file (see :func:`h5result.write_chunk`), its views (``fragment``: a
+        function returning their XDMF text, or None without views) and the index that lists
+        it (``index``: the arguments of :func:`h5result.write_index`, or None), in the writer's
+        thread (h5py lets the solver run meanwhile)."""
         h5result.write_chunk(self.directory, name, batches, views)
-        if t_shown is not None:
-            self._fragment(name, t_shown)
+        if fragment is not None:
+            xdmf.write_fragment(self.directory / (name[:-3] + ".xmf"), fragment())
             fragments = [c[:-3] + ".xmf" for c in chunks]
             for view in self.view_names():
                 xdmf.write_view(self.directory / f"{view}.xdmf", view, fragments)
-        if not self._ending:
+        if index is not None:
             h5result.write_index(*index)
 
     def write_result(self, result):
@@ -281,7 +280,8 @@ class RunWriter:
         last (so the run's last frame is always shown, and a chunk's views never change)."""
         return [k for k in range(n) if (start + k) % self.every == 0 or k == n - 1]
 
-    def _fragment(self, name, t):
+    def _fragment(self, t, name):
+        """The XDMF text of the chunk ``name``'s views, showing times ``t`` (:func:`xdmf.fragment`)."""
         h5 = name  # relative to the views, which sit in the run directory
         fixed = self._static_views()
         views = {"rod": xdmf.rod_grids(h5, t, len(fixed["s"]))}
@@ -289,9 +289,7 @@ class RunWriter:
             views["cables"] = xdmf.cable_grids(h5, t, len(fixed["cable_s"]), len(fixed["cable_cells"]))
         if "marker_s" in fixed:
             views["markers"] = xdmf.marker_grids(h5, t, len(fixed["marker_s"]))
-        path = self.directory / (name[:-3] + ".xmf")
-        path.parent.mkdir(parents=True, exist_ok=True)
-        xdmf.write_fragment(path, views)
+        return xdmf.fragment(views)
 
     def _static_views(self):
         """The views' arrays that do not change in time (made once: every chunk file holds them)."""
@@ -322,11 +320,10 @@ class RunWriter:
 
         def rod():
             rotations = shown.rotations
-            velocity = np.einsum("tnij,tnj->tni", rotations, shown.velocity)
+            velocity = rotate(rotations, shown.velocity)
             arrays = {key: fixed[key] for key in ("s", "radius", "rod_cells")}
-            arrays.update(positions=shown.positions.astype(VIEW), rotations=rotations.astype(VIEW),
-                          velocity_global=velocity.astype(VIEW))
-            arrays.update({attribute: getattr(shown, attribute).astype(VIEW) for attribute, _ in ROD_ARRAYS.values()})
+            arrays.update(positions=shown.positions, rotations=rotations, velocity_global=velocity)
+            arrays.update({attribute: getattr(shown, attribute) for attribute, _ in ROD_ARRAYS.values()})
             return arrays
 
         def cables():
@@ -338,7 +335,7 @@ class RunWriter:
 
         def markers():
             arrays = {key: fixed[key] for key in ("marker_cells", "marker_s", "marker_index")}
-            return dict(arrays, markers=shown.markers.astype(VIEW))
+            return dict(arrays, markers=shown.markers)
 
         return [rod] + ([cables] if "cable_s" in fixed else []) + ([markers] if "marker_s" in fixed else [])
 

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from .._files import write_atomically
+from ..discretise.rotations import rotate
 from ..errors import ParameterError
 from .parts import PARTS, ROD_ARRAYS, cable_points, view_step
 
@@ -84,7 +85,7 @@ def rod_mesh(result, k):
     rotation = result.rotations[k]
     data = {"s [m]": result.s, "radius [m]": result.radius}
     data.update({name: getattr(result, attribute)[k] for name, (attribute, _) in ROD_ARRAYS.items()})
-    data["velocity (global) [m/s]"] = np.einsum("nij,nj->ni", rotation, result.velocity[k])
+    data["velocity (global) [m/s]"] = rotate(rotation[None], result.velocity[k][None])[0]
     data.update({f"frame {axis} [-]": rotation[:, :, i] for i, axis in enumerate("xyz")})
     return polydata(result.positions[k], lines=[np.arange(len(result.s))], point_data=data,
                     field_data={"time [s]": [float(result.t[k])]})

@@ -21,31 +21,34 @@ two-point segments with ``tension [N]`` (point and cell data), ``s [m]`` and
 
 from pathlib import Path
 
+import numpy as np
+
 from .._files import write_atomically
-from .h5result import VIEW_GROUP
+from .h5result import VIEW, VIEW_GROUP
 from .parts import PARTS, ROD_ARRAYS
 
 VIEWS = PARTS  # one view per drawn part
 HEADER = '<?xml version="1.0" encoding="utf-8"?>\n<Xdmf Version="3.0"{ns}>\n<Domain>\n'
 FOOTER = "</Domain>\n</Xdmf>\n"
 XI = ' xmlns:xi="http://www.w3.org/2001/XInclude"'
-
+#: The number type of every floating view array.
+FLOAT = f'NumberType="Float" Precision="{np.dtype(VIEW).itemsize}"'
 
 #: Placeholders of a grid's frame index and time in a grid template.
 K, T = "@K@", "@T@"
 
 
 def _frames(template, t):
-    """The grid ``template`` (one text for all frames) at each frame of the chunk's views."""
-    pieces = [part.split(K) for part in template.split(T)]  # joined by str.join: the fastest way
-    return [repr(float(tk)).join(str(k).join(piece) for piece in pieces) for k, tk in enumerate(t)]
+    """The grid ``template`` (one text for all frames) at each frame of the chunk's views: encoded
+    lines."""
+    pieces = [part.split(K.encode()) for part in (template + "\n").encode().split(T.encode())]  # joined: fastest
+    return [repr(float(tk)).encode().join(str(k).encode().join(piece) for piece in pieces) for k, tk in enumerate(t)]
 
 
 def _item(h5, name, dims, n_frames=None, integer=False):
-    """A DataItem of the view array ``name`` in ``h5``: static (float64 or ``integer``), or with
-    ``n_frames`` the frame K of a time-first float32 array (see :data:`rodmol.io.stream.VIEW`)."""
-    kind = 'NumberType="Int" Precision="8"' if integer else \
-        f'NumberType="Float" Precision="{8 if n_frames is None else 4}"'
+    """A DataItem of the view array ``name`` in ``h5``: static (floating or ``integer``), or with
+    ``n_frames`` the frame K of a time-first floating array (floats: :data:`h5result.VIEW`)."""
+    kind = 'NumberType="Int" Precision="8"' if integer else FLOAT
     where = f"{h5}:/{VIEW_GROUP}/{name}"
     if n_frames is not None:
         rank = len(dims) + 1
@@ -73,7 +76,7 @@ def rod_grids(h5, t, n_nodes):
         parts.append(_attribute(label, _item(h5, attribute, (n, 3), frames), vector=True))
     parts.append(_attribute("velocity (global) [m/s]", _item(h5, "velocity_global", (n, 3), frames), vector=True))
     for i, axis in enumerate("xyz"):  # column i of the rotation: a one-wide hyperslab
-        item = (f'<DataItem Dimensions="{n} 3" NumberType="Float" Precision="4" Format="HDF">'
+        item = (f'<DataItem Dimensions="{n} 3" {FLOAT} Format="HDF">'
                 f"{h5}:/{VIEW_GROUP}/rotations|{K} 0 0 {i}:1 1 1 1:1 {n} 3 1:{frames} {n} 3 3</DataItem>")
         parts.append(_attribute(f"frame {axis} [-]", item, vector=True))
     parts.append("</Grid>")
@@ -108,15 +111,21 @@ def marker_grids(h5, t, n_markers):
     return _frames(grid, t)
 
 
-def write_fragment(path, views):
-    """Write a chunk's grids, ``views`` (view name -> list of grid texts), atomically."""
-    text = [HEADER.format(ns="")]
+def fragment(views):
+    """A chunk's grids, ``views`` (view name -> list of encoded grid lines), as an XDMF file's
+    text (a list of encoded pieces: megabytes, not copied into one)."""
+    text = [HEADER.format(ns="").encode()]
     for name, grids in views.items():
-        text += [f'<Grid Name="{name}" GridType="Collection" CollectionType="Temporal">\n', "\n".join(grids),
-                 "\n</Grid>\n"]
-    text.append(FOOTER)
-    data = [piece.encode() for piece in text]  # megabytes: no copy into one string
-    write_atomically(path, lambda handle: handle.writelines(data))
+        text += [f'<Grid Name="{name}" GridType="Collection" CollectionType="Temporal">\n'.encode(), *grids,
+                 b"</Grid>\n"]
+    text.append(FOOTER.encode())
+    return text
+
+
+def write_fragment(path, text):
+    """Write a chunk's :func:`fragment` ``text`` to ``path``, atomically."""
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    write_atomically(path, lambda handle: handle.writelines(text), buffering=1 << 20)  # few system calls
 
 
 def write_view(path, name, fragments):

@@ -52,3 +52,15 @@ def test_rate_is_the_body_frame_angular_velocity(quats):
               - rotations.matrices(q - h * rotations.rate(q, w))) / (2 * h)
         skew = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
         np.testing.assert_allclose(dr, rotations.matrices(q) @ skew, atol=1e-7)
+
+
+def test_rotate_applies_the_rotations_to_strided_vectors_in_place(quats):
+    # The frames' rotations of nodes 1..4 applied to a strided slice, written into a slice of a
+    # larger array: what the loads in the global frame need, without copies.
+    matrices = rotations.matrices(quats).reshape(4, 5, 3, 3)
+    vectors = np.random.default_rng(1).normal(size=(4, 5, 6))
+    out = np.zeros((4, 5, 3))
+    got = rotations.rotate(matrices[:, 1:], vectors[:, 1:, 3:], out[:, 1:])
+    scipy_r = Rotation.from_quat(quats[:, [1, 2, 3, 0]]).apply(vectors[..., 3:].reshape(20, 3)).reshape(4, 5, 3)
+    np.testing.assert_allclose(out[:, 1:], scipy_r[:, 1:], atol=1e-14)
+    assert np.shares_memory(got, out) and not out[:, 0].any()
