@@ -51,7 +51,7 @@ def atomic_h5(path, fill):
     """Write an HDF5 file with ``fill(h5py.File)`` under a temporary name, then rename it to ``path``."""
     import h5py
 
-    with atomic_path(path) as tmp, h5py.File(tmp, "w", libver=LIBVER) as handle:
+    with atomic_path(path) as tmp, h5py.File(tmp, "x", libver=LIBVER) as handle:
         fill(handle)
 
 
@@ -59,29 +59,33 @@ def chunk_name(index):
     return f"{FRAMES}/chunk_{index:06d}.h5"
 
 
-def write_chunk(directory, name, batches, views=()):
-    """Write the chunk ``name`` (:func:`chunk_name`): ``batches``, then ``views`` (the views'
-    arrays, in the group ``view``), in order. Each batch is a dict (name -> time-first array)
-    or a function returning one, called once the batches before it are written (so it may
-    still be computed meanwhile). The views' floating arrays are written as :data:`VIEW`,
-    and a view of every frame of a single-precision array is a link to it, not a copy. (HDF5
-    converts number types while writing, through a small buffer of its own: no copies.)"""
+def write_chunk(directory, name, batches):
+    """Write the chunk ``name`` (:func:`chunk_name`): ``batches`` in order, each a dict (dataset
+    path -> time-first array; the views' arrays under ``view/``, :func:`views`) or a function
+    returning one, called once the batches before it are written (so it may still be computed
+    meanwhile). The views' floating arrays are written as :data:`VIEW`, and a view of every
+    frame of a stored single-precision array is a link to it, not a copy. (HDF5 converts
+    number types while writing, through a small buffer of its own: no copies.)"""
     (Path(directory) / FRAMES).mkdir(parents=True, exist_ok=True)
 
     def fill(handle):
         for batch in batches:
-            for key, value in (batch() if callable(batch) else batch).items():
-                handle.create_dataset(key, data=np.asarray(value), dtype=np.float32 if key in SINGLE else None)
-        for batch in views:
-            for key, value in (batch() if callable(batch) else batch).items():
-                if key in SINGLE and key in handle and len(value) == len(handle[key]):
-                    handle[f"{VIEW_GROUP}/{key}"] = handle[key]  # an HDF5 hard link: the same numbers
+            for path, value in (batch() if callable(batch) else batch).items():
+                group, _, key = path.rpartition("/")
+                value = np.asarray(value)
+                if group == VIEW_GROUP and key in SINGLE and key in handle and len(value) == len(handle[key]):
+                    handle[path] = handle[key]  # an HDF5 hard link: the same numbers
+                elif group == VIEW_GROUP:
+                    handle.create_dataset(path, data=value, dtype=VIEW if value.dtype.kind == "f" else None)
                 else:
-                    value = np.asarray(value)
-                    handle.create_dataset(f"{VIEW_GROUP}/{key}", data=value,
-                                          dtype=VIEW if value.dtype.kind == "f" else None)
+                    handle.create_dataset(path, data=value, dtype=np.float32 if key in SINGLE else None)
 
     atomic_h5(Path(directory) / name, fill)
+
+
+def views(arrays):
+    """The views' ``arrays`` (name -> array) as a batch of :func:`write_chunk`."""
+    return {f"{VIEW_GROUP}/{key}": value for key, value in arrays.items()}
 
 
 def write_index(directory, static, t_out, t, chunks, info):

@@ -167,13 +167,13 @@ class RunWriter:
         final = self.t_out is not None and len(self.t) == len(self.t_out)
         index = None if final else self._index(dict(success=True, message="running", stats={}, complete=False))
         # The thread writes each batch of arrays while this one computes the next, then the views' text.
-        views = self._view_batches(shown) if self.views else []
+        posed, moving = self._view_batches(shown) if self.views else ([], [])
         fragment = [partial(self._fragment, shown.t, name)] if self.views else []
-        makers = [lambda: {key: getattr(chunk, key) for key in LOADS}, *views, *fragment]
+        makers = [*posed, lambda: {key: getattr(chunk, key) for key in LOADS}, *moving, *fragment]
         handed = [Future() for _ in makers]
         made = [future.result for future in handed]
         at_hand = {key: getattr(chunk, key) for key in STORED if key not in LOADS}
-        self._write_behind(name, partial(self._write, name, [at_hand, made[0]], made[1:1 + len(views)],
+        self._write_behind(name, partial(self._write, name, [at_hand, *made[:len(made) - len(fragment)]],
                                          made[-1] if fragment else None, list(self.chunks), index))
         try:
             for future, make in zip(handed, makers):
@@ -207,12 +207,12 @@ class RunWriter:
             self._pool = ThreadPoolExecutor(1, thread_name_prefix="rodmol-writer")
         self._pending = (self._pool.submit(job), name)
 
-    def _write(self, name, batches, views, fragment, chunks, index):
+    def _write(self, name, batches, fragment, chunks, index):
         """Write a chunk file (see :func:`h5result.write_chunk`), its views (``fragment``: a
         function returning their XDMF text, or None without views) and the index that lists
         it (``index``: the arguments of :func:`h5result.write_index`, or None), in the writer's
         thread (h5py lets the solver run meanwhile)."""
-        h5result.write_chunk(self.directory, name, batches, views)
+        h5result.write_chunk(self.directory, name, batches)
         if fragment is not None:
             xdmf.write_fragment(self.directory / (name[:-3] + ".xmf"), fragment())
             fragments = [c[:-3] + ".xmf" for c in chunks]
@@ -314,30 +314,32 @@ class RunWriter:
         return self._fixed_views
 
     def _view_batches(self, shown):
-        """The views' arrays of the Result ``shown`` (the frames they show), in batches: functions
-        returning the rod's, the cables' and the markers' arrays."""
+        """The views' arrays of the Result ``shown`` (the frames they show), in batches of
+        :func:`h5result.write_chunk`: functions returning the rod's pose, the cables', the
+        markers' arrays, and those that need the loads (:data:`rodmol.result.LOADS`): the
+        rod's strains, velocities and loads."""
         fixed = self._static_views()
 
-        def rod():
-            rotations = shown.rotations
-            velocity = rotate(rotations, shown.velocity)
+        def pose():
             arrays = {key: fixed[key] for key in ("s", "radius", "rod_cells")}
-            arrays.update(positions=shown.positions, rotations=rotations, velocity_global=velocity)
-            arrays.update({attribute: getattr(shown, attribute) for attribute, _ in ROD_ARRAYS.values()})
-            return arrays
+            return h5result.views(dict(arrays, positions=shown.positions, rotations=shown.rotations))
 
         def cables():
             tension = np.asarray(shown.tensions, dtype=VIEW).reshape(len(shown.t), -1)
             points = cable_point_array(self.static["s"], shown.positions, shown.rotations, self.meta, VIEW)
             arrays = {key: fixed[key] for key in ("cable_s", "cable_index", "cable_cells", "cable_cell_index")}
-            return dict(arrays, cable_points=points, cable_point_tension=tension[:, fixed["cable_index"]],
-                        cable_cell_tension=tension[:, fixed["cable_cell_index"]])
+            return h5result.views(dict(arrays, cable_points=points, cable_point_tension=tension[:, fixed["cable_index"]],
+                                       cable_cell_tension=tension[:, fixed["cable_cell_index"]]))
 
         def markers():
             arrays = {key: fixed[key] for key in ("marker_cells", "marker_s", "marker_index")}
-            return dict(arrays, markers=shown.markers)
+            return h5result.views(dict(arrays, markers=shown.markers))
 
-        return [rod] + ([cables] if "cable_s" in fixed else []) + ([markers] if "marker_s" in fixed else [])
+        def motion():
+            arrays = {attribute: getattr(shown, attribute) for attribute, _ in ROD_ARRAYS.values()}
+            return h5result.views(dict(arrays, velocity_global=rotate(shown.rotations, shown.velocity)))
+
+        return [pose] + ([cables] if "cable_s" in fixed else []) + ([markers] if "marker_s" in fixed else []), [motion]
 
     def _index(self, info):
         """The arguments of :func:`h5result.write_index` now (copies: the run goes on)."""
