@@ -238,9 +238,11 @@ class SemiDiscrete:
         tension is read once)."""
         cables = self.model.cables
         out = np.empty((len(t), len(cables)))
-        varying = [c for c, cable in enumerate(cables) if cable.tension.constant is None]
+        varying = []
         for c, cable in enumerate(cables):
-            if c not in varying:
+            if cable.tension.constant is None:
+                varying.append(c)
+            else:
                 out[:, c] = cable.tension_at(0.0)
         if varying:
             for i, (ti, yi) in enumerate(zip(np.asarray(t, dtype=float), states)):
