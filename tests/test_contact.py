@@ -124,13 +124,16 @@ def test_equilibrium_on_the_floor_is_the_rest_of_the_dynamics():
     assert drift < 1e-7
 
 
+SLIP_SPEED = 1e-5  # m/s
+
+
 def tilted_plane_run(angle, friction=0.5, t_end=1.0):
     """The rod along x on a plane through the x axis tilted by ``angle`` about x
     (straight rod just touching); returns the lateral (downhill, in-plane)
     displacement of the tip over time."""
     normal = np.array([0.0, np.cos(angle), np.sin(angle)])
     downhill = np.array([0.0, -np.sin(angle), np.cos(angle)])
-    plane = rodmol.PlaneContact(-R * normal, normal, friction=friction, slip_speed=1e-5, **LAW)
+    plane = rodmol.PlaneContact(-R * normal, normal, friction=friction, slip_speed=SLIP_SPEED, **LAW)
     model = rodmol.Model(_rod(), 20, medium="air", loads=[plane])
     result = rodmol.simulate(model, t_end, initial="straight", output_dt=0.01)
     assert result.success, result.message
@@ -153,6 +156,13 @@ def test_tilted_plane_stick_and_slip(friction):
           f"(frictionless: {free_stick:.2e} m); slip (tan a = {np.tan(slip_angle):.2f}): "
           f"{slip[-1]:.2e} m, net-load deflection {net:.2e} m")
     assert abs(stick[-1]) < 0.02 * free_stick
+    # Stuck, the regularised law creeps at the speed where mu N v / sqrt(v^2 + v_s^2)
+    # meets the demand tan(a) N: v = v_s d / sqrt(1 - d^2), d = tan(a) / mu = 0.6.
+    demand = np.tan(stick_angle) / friction
+    creep = (stick[-1] - stick[50]) / 0.5  # over the last half second
+    expected = SLIP_SPEED * demand / np.sqrt(1.0 - demand**2)
+    print(f"creep {creep:.2e} m/s, regularised law {expected:.2e} m/s")
+    assert 0.8 * expected < creep < 1.25 * expected
     # Sliding from rest, the rod overshoots the net-load deflection (up to twice
     # it without viscosity) and sticks there: between the two.
     assert net < slip[-1] < 2.2 * net

@@ -50,11 +50,17 @@ def field_scales(model):
     L / T and angular velocities L / (T r_min), the angular velocity that
     moves the thinnest section's surface as fast. T is the period of the
     first bending mode of a uniform cantilever with the base section
-    (Euler-Bernoulli, without the fluid), the time scale of the motion."""
+    (Euler-Bernoulli, without the fluid), the time scale of the motion.
+    With contact friction the speed is at most the smallest ``slip_speed``:
+    the friction law changes over it, and a coarser velocity tolerance let
+    a rod stuck on a slope creep ten times too fast, and 50-100 times slower.
+    """
     rod = model.rod
     length = rod.length
     r_min = float(np.min(rod.radius_at(model.s_nodes)))
     speed = length * first_bending_frequency(model) / (2.0 * np.pi)  # L / T
+    slip = [load.slip_speed for load in model.loads if getattr(load, "friction", 0.0) > 0.0]
+    speed = min([speed, *slip])
     return {"u": length, "Q": 1.0, "q": 1.0, "k": 1.0 / length, "v": speed, "w": speed / r_min}
 
 
