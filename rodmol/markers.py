@@ -5,6 +5,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _checks
+from .discretise import centreline
 from .errors import ParameterError
 
 
@@ -46,16 +47,14 @@ def marker_offsets(markers, rod):
 
 def track(s_markers, offsets, s_nodes, positions, rotations):
     """Global marker positions (n_t, n_markers, 3) from nodal poses, for markers
-    at arc lengths ``s_markers`` [m] with local ``offsets`` (n_markers, 3) [m].
+    at arc lengths ``s_markers`` [m] with local offsets ``offsets`` (n_markers, 2),
+    (p_y, p_z) [m].
 
     Each marker is ``u + R p`` evaluated at the two nodes around it and
-    interpolated linearly in s.
+    interpolated linearly in s (:func:`rodmol.discretise.centreline.section_points`).
     """
-    out = np.empty(positions.shape[:1] + (len(s_markers), 3))
-    for i, s in enumerate(s_markers):
-        j = int(np.clip(np.searchsorted(s_nodes, s, side="right") - 1, 0, len(s_nodes) - 2))
-        f = (s - s_nodes[j]) / (s_nodes[j + 1] - s_nodes[j])
-        a = positions[:, j] + rotations[:, j] @ offsets[i]
-        b = positions[:, j + 1] + rotations[:, j + 1] @ offsets[i]
-        out[:, i] = (1.0 - f) * a + f * b
-    return out
+    pairs = [centreline.bracket(s_nodes, s) for s in s_markers]
+    nodes = np.array([[j, j + 1] for j, _ in pairs], dtype=np.int64).reshape(-1, 2)
+    weights = np.array([[1.0 - w, w] for _, w in pairs]).reshape(-1, 2)
+    at_nodes = np.repeat(np.asarray(offsets, dtype=float).reshape(-1, 1, 2), 2, axis=1)  # the same at both
+    return centreline.section_points(positions, rotations, nodes, weights, at_nodes)

@@ -231,11 +231,15 @@ def _loads(system, result):
     }
 
 
+def _layout(result):
+    """The state layout of a Result's ``states``."""
+    return StateLayout(result.meta["n_elements"])
+
+
 def _kinematics(result):
     """Strains and velocities at all nodes: the state's fields and the boundary rows."""
     y, rows = result.states, getattr(result, BOUNDARY)
-    layout = StateLayout(result.meta["n_elements"])
-    field = partial(layout.field, y)
+    field = partial(_layout(result).field, y)
     return dict(linear_strain=np.concatenate([field("q"), rows[:, None, 6:9]], axis=1),
                 curvature=np.concatenate([field("k"), rows[:, None, 9:12]], axis=1),
                 velocity=np.concatenate([rows[:, None, 0:3], field("v")], axis=1),
@@ -245,13 +249,13 @@ def _kinematics(result):
 def _pose(result):
     """Positions rebuilt from the strains, rotations, markers."""
     y, meta = result.states, result.meta
-    layout = StateLayout(meta["n_elements"])
+    layout = _layout(result)
     quat_all = layout.quaternions(y)
     positions = centreline.positions(layout.base_position(y), quat_all, layout.field(y, "q"),
                                      layout.field(y, "k"), meta["length"] / layout.n_elements)
     rots = rotations.matrices(quat_all)
     marks = meta.get("markers", [])
-    offsets = np.array([[0.0, *m["offset"]] for m in marks]).reshape(-1, 3)
+    offsets = np.array([m["offset"] for m in marks]).reshape(-1, 2)
     return dict(
         positions=positions, rotations=rots,
         markers=markers.track([m["s"] for m in marks], offsets, result.s, positions, rots),
@@ -260,7 +264,7 @@ def _pose(result):
 
 def _drift(result):
     """The positions integrated in time, and the quaternions' drift off the unit sphere."""
-    layout = StateLayout(result.meta["n_elements"])
+    layout = _layout(result)
     quat_all = layout.quaternions(result.states)
     return dict(integrated_positions=layout.integrated_positions(result.states),
                 quaternion_norm_error=np.max(np.abs(np.linalg.norm(quat_all, axis=-1) - 1.0), axis=-1))

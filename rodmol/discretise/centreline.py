@@ -50,3 +50,36 @@ def positions(u0, quat, q, k, ds):
     steps = chords(quat[..., :-1, :], q, k, ds)
     u0 = np.asarray(u0, dtype=float)[..., None, :]
     return np.concatenate([u0, u0 + np.cumsum(steps, axis=-2)], axis=-2)
+
+
+def bracket(s_nodes, s):
+    """(j, w): the nodes j, j + 1 of ``s_nodes`` around arc length ``s`` [m], and the weight
+    of node j + 1 for a linear interpolation in s."""
+    j = int(np.clip(np.searchsorted(s_nodes, s, side="right") - 1, 0, len(s_nodes) - 2))
+    return j, (s - s_nodes[j]) / (s_nodes[j + 1] - s_nodes[j])
+
+
+def section_points(positions, rotations, nodes, weights, offsets, dtype=float):
+    """Material points of the sections (n_t, n, 3) [m], global: ``u + R p`` with the local
+    offset p = (0, p_y, p_z) [m], at two nodes ``nodes`` (n, 2) interpolated with ``weights``
+    (n, 2), the offsets (p_y, p_z) at those nodes ``offsets`` (n, 2, 2); for the frames'
+    node positions (n_t, N+1, 3) and rotations (n_t, N+1, 3, 3). Markers and cables."""
+    out = np.empty((len(positions), len(nodes), 3), dtype=dtype)
+    if len(nodes):
+        _section_points(np.asarray(positions, dtype=float), np.asarray(rotations, dtype=float),
+                        np.asarray(nodes, dtype=np.int64), np.asarray(weights, dtype=float),
+                        np.asarray(offsets, dtype=float), out)
+    return out
+
+
+@jit
+def _section_points(positions, rotations, nodes, weights, offsets, out):
+    for f in range(positions.shape[0]):
+        for i in range(nodes.shape[0]):
+            for c in range(3):
+                total = 0.0
+                for e in range(2):
+                    n = nodes[i, e]
+                    total += weights[i, e] * (positions[f, n, c] + offsets[i, e, 0] * rotations[f, n, c, 1]
+                                              + offsets[i, e, 1] * rotations[f, n, c, 2])
+                out[f, i, c] = total

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from .physics import jit, quaternion_product, rotation, rotation_vector_quaternion
+from .physics import jit, quaternion_product, rotation, rotation_vector_quaternion, to_global
 
 
 def matrices(quat):
@@ -32,7 +32,7 @@ def rotate(matrices, vectors, out=None):
     vectors to the global frame. Strided arrays are read, and ``out`` written, in place."""
     matrices, vectors = np.asarray(matrices, dtype=float), np.asarray(vectors, dtype=float)
     out = np.empty(vectors.shape) if out is None else out
-    _rotate(matrices, vectors, out)
+    _rotate(matrices.reshape(matrices.shape[:-2] + (9,)), vectors, out)  # rows of R: a view
     return out
 
 
@@ -40,8 +40,7 @@ def rotate(matrices, vectors, out=None):
 def _rotate(m, v, out):
     for f in range(v.shape[0]):
         for n in range(v.shape[1]):
-            for i in range(3):
-                out[f, n, i] = m[f, n, i, 0] * v[f, n, 0] + m[f, n, i, 1] * v[f, n, 1] + m[f, n, i, 2] * v[f, n, 2]
+            out[f, n, 0], out[f, n, 1], out[f, n, 2] = to_global(m[f, n], (v[f, n, 0], v[f, n, 1], v[f, n, 2]))
 
 
 def rate(quat, omega):

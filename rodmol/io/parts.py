@@ -4,7 +4,7 @@ paths."""
 
 import numpy as np
 
-from ..discretise.physics import jit
+from ..discretise import centreline
 
 #: The drawn parts, one view or series each.
 PARTS = ("rod", "cables", "markers")
@@ -49,11 +49,10 @@ def cable_point_array(s_nodes, positions, rotations, meta, dtype=float):
     """The points of :func:`cable_points` of all cables in one array (n_t, n_points, 3) [m] of
     ``dtype``, global, cable after cable."""
     plan = _cable_plan(np.asarray(s_nodes, dtype=float), meta)
-    points = np.empty((len(positions), sum(len(p[0]) for p in plan), 3), dtype=dtype)
-    if plan:
-        _surface_points(np.asarray(positions, dtype=float), np.asarray(rotations, dtype=float),
-                        *(np.concatenate([p[i] for p in plan]) for i in (1, 2, 3)), points)
-    return points
+    if not plan:
+        return np.empty((len(positions), 0, 3), dtype=dtype)
+    return centreline.section_points(positions, rotations, *(np.concatenate([p[i] for p in plan]) for i in (1, 2, 3)),
+                                     dtype=dtype)
 
 
 def cable_arc_lengths(s_nodes, meta):
@@ -71,23 +70,9 @@ def _cable_plan(s_nodes, meta):
                                   (len(s_nodes), 2))
         anchor = min(float(cable["anchor"]), float(s_nodes[-1]))
         on_path = int(np.count_nonzero(s_nodes < anchor))  # the nodes below the anchor come first
-        j = min(int(np.searchsorted(s_nodes, anchor, side="right")) - 1, len(s_nodes) - 2)
-        w = (anchor - s_nodes[j]) / (s_nodes[j + 1] - s_nodes[j])
+        j, w = centreline.bracket(s_nodes, anchor)
         nodes = np.array([[i, i] for i in range(on_path)] + [[j, j + 1]], dtype=np.int64).reshape(-1, 2)
         weights = np.array([[1.0, 0.0]] * on_path + [[1.0 - w, w]]).reshape(-1, 2)
         plan.append((np.append(s_nodes[:on_path], anchor), nodes, weights, offsets[nodes]))
     return plan
 
-
-@jit
-def _surface_points(positions, rotations, nodes, weights, offsets, out):
-    # u + R p at two nodes, weighted: one pass over frames and points.
-    for f in range(positions.shape[0]):
-        for i in range(nodes.shape[0]):
-            for c in range(3):
-                total = 0.0
-                for e in range(2):
-                    n = nodes[i, e]
-                    total += weights[i, e] * (positions[f, n, c] + offsets[i, e, 0] * rotations[f, n, c, 1]
-                                              + offsets[i, e, 1] * rotations[f, n, c, 2])
-                out[f, i, c] = total

@@ -168,15 +168,15 @@ class RunWriter:
         index = None if final else self._index(dict(success=True, message="running", stats={}, complete=False))
         # The thread writes each batch of arrays while this one computes the next, then the views' text.
         posed, moving = self._view_batches(shown) if self.views else ([], [])
+        batches = [*posed, lambda: {key: getattr(chunk, key) for key in LOADS}, *moving]
         fragment = [partial(self._fragment, shown.t, name)] if self.views else []
-        makers = [*posed, lambda: {key: getattr(chunk, key) for key in LOADS}, *moving, *fragment]
-        handed = [Future() for _ in makers]
+        handed = [Future() for _ in batches + fragment]
         made = [future.result for future in handed]
         at_hand = {key: getattr(chunk, key) for key in STORED if key not in LOADS}
-        self._write_behind(name, partial(self._write, name, [at_hand, *made[:len(made) - len(fragment)]],
+        self._write_behind(name, partial(self._write, name, [at_hand, *made[:len(batches)]],
                                          made[-1] if fragment else None, list(self.chunks), index))
         try:
-            for future, make in zip(handed, makers):
+            for future, make in zip(handed, batches + fragment):
                 future.set_result(make())
         except BaseException as exc:  # an interrupt, say: the chunk is dropped
             for future in handed:
