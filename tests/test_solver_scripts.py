@@ -1,8 +1,12 @@
-"""The solver studies under solvers/ run end to end (tiny --smoke sizes) and
-write their CSV, Markdown and PNG outputs. Timings are not checked here.
-core_speed.py also checks out the pre-refactor commit into a temporary git
-worktree (skipped outside a git checkout that has it)."""
+"""The solver studies under solvers/ run end to end (tiny --smoke sizes),
+write their CSV, Markdown and PNG outputs, and each produces the figure it
+exists for within a loose physical bound: an observed order, an error against
+its reference, an agreement or a ratio measured in the same run. Wall times
+themselves are not checked. core_speed.py also checks out the pre-refactor
+commit into a temporary git worktree (skipped outside a git checkout that has it)."""
 
+import csv
+import math
 import os
 import shutil
 import subprocess
@@ -11,23 +15,147 @@ import sys
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def rows(path):
+    """The rows of one of the scripts' CSV tables (the '#' header lines skipped), values as floats where they parse."""
+    with open(path) as f:
+        table = list(csv.DictReader(line for line in f if not line.startswith("#")))
+    assert table, f"{path.name} holds no rows"
+    return [{key: _number(value) for key, value in row.items()} for row in table]
+
+
+def _number(text):
+    try:
+        return float(text)
+    except ValueError:
+        return {"True": True, "False": False}.get(text, text)
+
+
+def _scaling(out):
+    by_n = {}
+    for row in rows(out / "scaling.csv"):
+        by_n.setdefault(row["N"], []).append(row)
+    for n, runs in by_n.items():
+        steps = [row["steps"] for row in runs]
+        # the same problem at the same tolerance: the linear solvers change the steps, not their number's scale
+        assert max(steps) < 2.5 * min(steps), (n, steps)
+        assert all(row["h_min_s"] <= row["h_median_s"] <= row["h_max_s"] for row in runs)
+    long = rows(out / "scaling_long.csv")
+    assert all(row["success"] and row["max_quaternion_drift"] < 1e-3 for row in long)
+
+
+def _temporal(out):
+    sweep = sorted(rows(out / "temporal.csv"), key=lambda row: row["rtol"])
+    for row in sweep:  # the tip error follows the tolerance (relative to L, against rtol 1e-10)
+        assert row["tip_err_max"] < 10 * row["rtol"], row
+    assert sweep[0]["tip_err_max"] < sweep[-1]["tip_err_max"]
+    cvode, rk23 = rows(out / "temporal_rk23.csv")
+    assert cvode["tip_err_max"] < 1e-6 and rk23["tip_err_max"] < 1e-6
+
+
+def _work_precision(out):
+    table = rows(out / "work_precision.csv")
+    assert all(row["success"] for row in table)
+    for row in table:  # every backend and linear solver meets its tolerance against the reference
+        assert row["tip_err_max"] < 10 * row["rtol"], row
+
+
+def _convergence(out):
+    for row in rows(out / "convergence.csv"):
+        if not math.isnan(row["equilibrium_order"]):
+            nominal = 2.0 if row["scheme"] == "centred" else 1.0
+            assert abs(row["equilibrium_order"] - nominal) < 0.25, row
+
+
+def _release(out):
+    for row in rows(out / "release.csv"):
+        # released in water, the explicit solver is limited by the axial waves, the implicit one is not
+        assert row["cvode_speedup_over_rk23"] > 1, row
+
+
+def _profile_rhs(out):
+    calls = {row["operation"]: row["microseconds"] for row in rows(out / "profile_rhs_calls.csv")}
+    kernel = calls["right-hand side, bare kernel"]
+    assert kernel <= calls["right-hand side, compiled (SemiDiscrete call)"] * 1.5
+    # the Jacobian is a few dozen coloured kernel evaluations, not one per state variable
+    assert calls["Jacobian, compiled (34 kernel evaluations)"] < 200 * kernel
+
+
+def _continuum(out):
+    for row in rows(out / "continuum.csv"):
+        if not math.isnan(row["tip_order"]):
+            low = 1.6 if row["scheme"] == "centred" else 0.8
+            assert low < row["tip_order"] < low + 0.8, row
+
+
+def _schemes(out):
+    table = rows(out / "schemes.csv")
+    for test in {row["test"] for row in table}:
+        for scheme in ("centred", "upwind"):
+            errors = [row["tip_err_mm"] for row in sorted(table, key=lambda row: row["N"])
+                      if row["test"] == test and row["scheme"] == scheme]
+            assert errors[-1] < errors[0], (test, scheme, errors)  # refining reduces the error
+        finest = max(row["N"] for row in table if row["test"] == test)
+        by_scheme = {row["scheme"]: row["tip_err_mm"] for row in table if row["test"] == test and row["N"] == finest}
+        assert by_scheme["centred"] < by_scheme["upwind"]
+
+
+def _scheme_targets(out):
+    for row in rows(out / "scheme_targets.csv"):
+        assert 0 < row["tip_err_mm"] < 50, row  # finite errors of the right scale at the smoke sizes
+
+
+def _fetching_hold(out):
+    table = {row["scheme"]: row for row in rows(out / "fetching_hold.csv")}
+    for row in table.values():
+        assert row["success"] and row["gap_end_mm"] < row["gap_at_8s_mm"], row  # the held arm settles
+    assert table["centred"]["gap_end_mm"] < table["upwind"]["gap_end_mm"]
+
+
+def _long_output(out):
+    for row in rows(out / "long_output.csv"):
+        assert row["success"] and row["frames"] == round(100 * row["t_end_s"]) + 1, row
+        if row["format"] == "xdmf":
+            assert row["files"] == 6 and row["megabytes"] > 0
+
+
+def _stiff_cantilever(out):
+    for row in rows(out / "stiff_cantilever.csv"):
+        if row["success"] and row["t_reached"] > 0:  # the Euler-Bernoulli period within a few percent
+            assert abs(row["period_error_pct"]) < 5, row
+            if "galpha" in row["configuration"] and "rho_inf 1" in row["configuration"]:
+                assert row["swing_energy_kept_pct"] > 99.0, row  # undamped: no numerical damping
+
+
+def _core_speed(out):
+    table = {row["key"]: row for row in rows(out / "core_speed.csv")}
+    assert table["tip_max_diff_m"]["new_median"] < 1e-5  # the two versions compute the same motion
+    assert 0.5 < table["steps"]["ratio_new_old_median"] < 2
+
+
+def _view_open(out):
+    for row in rows(out / "view_open.csv"):
+        assert row["open_s"] > 0 and row["last_frame_s"] <= row["open_s"], row
+
+
 SCRIPTS = {
-    "scaling.py": ["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"],
-    "temporal.py": ["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv",
-                    "temporal_options.csv"],
-    "work_precision.py": ["work_precision.csv", "work_precision.md", "work_precision.png"],
-    "convergence.py": ["convergence.csv", "convergence.md", "convergence.png"],
-    "release.py": ["release.csv", "release.md"],
-    "profile_rhs.py": ["profile_rhs.csv", "profile_rhs_calls.csv", "profile_rhs_ladder.csv", "profile_rhs.md",
-                       "profile_rhs.png"],
-    "core_speed.py": ["core_speed.csv", "core_speed.md"],
-    "continuum.py": ["continuum.csv", "continuum.md", "continuum.png"],
-    "schemes.py": ["schemes.csv", "schemes.md", "schemes.png"],
-    "scheme_targets.py": ["scheme_targets.csv", "scheme_targets.md"],
-    "fetching_hold.py": ["fetching_hold.csv", "fetching_hold.md", "fetching_hold.png"],
-    "long_output.py": ["long_output.csv", "long_output.md"],
-    "stiff_cantilever.py": ["stiff_cantilever.csv", "stiff_cantilever.md"],
-    "view_open.py": ["view_open.csv", "view_open.md"],
+    "scaling.py": (["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"], _scaling),
+    "temporal.py": (["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv", "temporal_options.csv"],
+                    _temporal),
+    "work_precision.py": (["work_precision.csv", "work_precision.md", "work_precision.png"], _work_precision),
+    "convergence.py": (["convergence.csv", "convergence.md", "convergence.png"], _convergence),
+    "release.py": (["release.csv", "release.md"], _release),
+    "profile_rhs.py": (["profile_rhs.csv", "profile_rhs_calls.csv", "profile_rhs_ladder.csv", "profile_rhs.md",
+                        "profile_rhs.png"], _profile_rhs),
+    "core_speed.py": (["core_speed.csv", "core_speed.md"], _core_speed),
+    "continuum.py": (["continuum.csv", "continuum.md", "continuum.png"], _continuum),
+    "schemes.py": (["schemes.csv", "schemes.md", "schemes.png"], _schemes),
+    "scheme_targets.py": (["scheme_targets.csv", "scheme_targets.md"], _scheme_targets),
+    "fetching_hold.py": (["fetching_hold.csv", "fetching_hold.md", "fetching_hold.png"], _fetching_hold),
+    "long_output.py": (["long_output.csv", "long_output.md"], _long_output),
+    "stiff_cantilever.py": (["stiff_cantilever.csv", "stiff_cantilever.md"], _stiff_cantilever),
+    "view_open.py": (["view_open.csv", "view_open.md"], _view_open),
 }
 
 
@@ -42,10 +170,12 @@ def test_script_smoke_run(script, tmp_path):
     proc = subprocess.run([sys.executable, os.path.join(ROOT, "solvers", script), "--smoke",
                            "--out", str(tmp_path)], capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-4000:]
-    for name in SCRIPTS[script]:
+    files, check = SCRIPTS[script]
+    for name in files:
         path = tmp_path / name
         assert path.is_file() and path.stat().st_size > 0, name
-    markdown = next(name for name in SCRIPTS[script] if name.endswith(".md"))
+    markdown = next(name for name in files if name.endswith(".md"))
     with open(tmp_path / markdown) as f:
         text = f.read()
     assert "machine:" in text and "numba" in text  # the header names the machine and versions
+    check(tmp_path)
