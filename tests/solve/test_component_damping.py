@@ -4,7 +4,7 @@ the bending mode decays at the Kelvin-Voigt rate of the bending viscosity."""
 
 import numpy as np
 import pytest
-from test_dynamics import measure_free_vibration
+from vibration import measure_free_vibration
 
 import rodmol
 from rodmol.discretise.system import SemiDiscrete, grid_damping_ratio
