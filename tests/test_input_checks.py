@@ -129,3 +129,15 @@ def test_scenario_marker_off_the_body():
 def test_scenario_output_directory_with_nul():
     with pytest.raises(ScenarioError, match="without NUL characters"):
         parse_scenario(MINIMAL + '[output]\ndirectory = "a\\u0000b"\n')
+
+
+@pytest.mark.parametrize("options, match", [
+    (dict(cables=5), r"`cables` must be a sequence, each item a rodmol.Cable, got 5"),
+    (dict(cables=rodmol.Cable((0.004, 0.0), 0.2)), r"`cables` must be a sequence \(a single one: cables=\[...\]\)"),
+    (dict(markers=0.1), r"`markers` must be a sequence, each item a rodmol.Marker, got 0.1"),
+    (dict(loads=None), r"`loads` must be a sequence"),
+    (dict(drag="no"), r"`drag` must be True or False, got 'no'"),
+    (dict(drag_law=np.array([1.0, 2.0])), r"unknown `drag_law` array"),
+])
+def test_model_refuses_wrong_types(options, match):
+    refused(match, rodmol.Model, ROD, 6, **options)
