@@ -18,7 +18,9 @@ ROD = rodmol.Rod(0.3, (0.012, 0.005), MATERIAL)
 #: Each absurd input, as the Model arguments that give it and what the message names.
 ABSURD = {
     "gravity": (lambda x: dict(gravity=(0.0, -x, 0.0)), r"`gravity` = \(0.0, -[0-9.e+]+, 0.0\) m/s\^2"),
-    "medium": (lambda x: dict(medium_density=x), r"the medium's density `rho` = [0-9.e+]+ kg/m\^3"),
+    "buoyancy": (lambda x: dict(medium_density=x), r"the medium's density `rho` = [0-9.e+]+ kg/m\^3"),
+    "fluid": (lambda x: dict(medium=rodmol.Medium(x, 0.01, 2.5, 2.5, 1.5, 1.5)),  # its drag overflows
+              r"the medium's density `rho` = [0-9.e+]+ kg/m\^3"),
     "tension": (lambda x: dict(cables=[rodmol.Cable((0.004, 0.0), 0.3, x, name="pull")]),
                 r"the cables' tensions at t = 0 s \('pull'\)"),
     "force": (lambda x: dict(loads=[rodmol.PointForce(0.3, (0.0, x, 0.0), name="push")]), r"the loads \('push'\)"),
