@@ -61,6 +61,8 @@ def refuse_directories(paths, name=None):
     is a directory (renaming a finished file over it would fail only after the work);
     ``name``: the parameter that gave the path, if it was given whole."""
     for path in paths:
+        if not isinstance(path, (str, os.PathLike)):
+            raise ParameterError(f"`{name or 'path'}` must be a file name, got {path!r}")
         if os.path.isdir(path):
             given = f"`{name}` = " if name else ""
             raise ParameterError(f"{given}{str(path)!r} is a directory, where rodmol writes a file; "
