@@ -47,9 +47,10 @@ class Task:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)  # the outcome carries the message
                 result = spec.simulate()
-        except Exception as exc:  # noqa: BLE001 (no equilibrium, absurd values, a user function: this run failed, not the batch)
+            value = self.extract(result, spec) if self.extract is not None else None
+        # No equilibrium, absurd values, a user function that raised: this run failed, not the batch.
+        except Exception as exc:  # noqa: BLE001
             return failed_run(overrides, exc, time.perf_counter() - started)
-        value = self.extract(result, spec) if self.extract is not None else None
         return Outcome(dict(overrides), result.success, result.message, time.perf_counter() - started,
                        dict(result.stats), value, result if self.keep else None)
 

@@ -36,7 +36,8 @@ def test_absurd_inputs_are_refused_before_the_run_naming_them(which, exponent):
     def no_run(*args, **kwargs):
         raise AssertionError("the run started")
 
-    with pytest.MonkeyPatch.context() as patch, pytest.raises(rodmol.ParameterError, match=r"out of any meaningful range.*it comes from " + named + "$"):
+    message = r"out of any meaningful range.*it comes from " + named + "$"  # that input alone
+    with pytest.MonkeyPatch.context() as patch, pytest.raises(rodmol.ParameterError, match=message):
         patch.setattr(kernels, "prepare", no_run)
         rodmol.simulate(model, 0.1, initial="straight")
 
