@@ -89,6 +89,39 @@ def integer_at_least(name, value, minimum):
     return int(value)
 
 
+def flag(name, value):
+    """``value`` as a bool; only True and False (numpy's too) are accepted."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ParameterError(f"`{name}` must be True or False, got {short(value)}")
+    return bool(value)
+
+
+def choice(name, value, options):
+    """``value`` if it is one of the strings ``options``, else a ParameterError
+    naming it (an array or other unhashable value is refused, not compared)."""
+    if not (isinstance(value, str) and value in options):
+        raise ParameterError(f"unknown `{name}` {short(value)}{did_you_mean(value, options)}; "
+                             f"choose one of {', '.join(map(repr, options))}")
+    return value
+
+
+def items(name, value, kind, what):
+    """``value`` as a tuple of ``kind`` instances (a list, a tuple or another
+    iterable of them); ``what`` names one item in messages ("a rodmol.Cable")."""
+    if isinstance(value, kind):
+        raise ParameterError(f"`{name}` must be a sequence (a single one: {name}=[...]), got {short(value)}")
+    if isinstance(value, (str, bytes, dict)) or not hasattr(value, "__iter__"):
+        raise ParameterError(f"`{name}` must be a sequence, each item {what}, got {short(value)}")
+    try:
+        found = tuple(value)
+    except Exception:  # noqa: BLE001 (an iterable that fails to iterate is refused, named)
+        raise ParameterError(f"`{name}` must be a sequence, each item {what}, got {short(value)}") from None
+    for i, item in enumerate(found):
+        if not isinstance(item, kind):
+            raise ParameterError(f"`{name}[{i}]` must be {what}, got {short(item)}")
+    return found
+
+
 def did_you_mean(value, options):
     """``"; did you mean 'x'?"`` for a near miss among ``options``, else ``""``."""
     if not isinstance(value, str):

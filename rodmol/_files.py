@@ -5,6 +5,8 @@ import os
 import tempfile
 from pathlib import Path
 
+from .errors import ParameterError
+
 
 def _temporary_name(name):
     """(prefix, suffix) of the temporaries of a file called ``name``: hidden, ``.part``."""
@@ -37,6 +39,34 @@ def atomic_path(path):
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
+
+
+def output_directory(path, name="out"):
+    """Create the output directory ``path`` (and its parents) and return it as a Path; a
+    :class:`ParameterError` naming the parameter ``name`` says why it cannot be (a file
+    in its place, no permission, a NUL in the name), before anything is written."""
+    try:
+        path = Path(path)
+        path.mkdir(parents=True, exist_ok=True)
+    except (OSError, TypeError, ValueError) as exc:  # ValueError: a NUL in the path
+        reason = getattr(exc, "strerror", None) or str(exc)
+        if isinstance(exc, FileExistsError):
+            reason = "a file of that name is in the way (give a directory)"
+        raise ParameterError(f"cannot create the output directory `{name}` = {str(path)!r}: {reason}") from None
+    return path
+
+
+def refuse_directories(paths, name=None):
+    """Raise a :class:`ParameterError` if one of ``paths``, where files are to be written,
+    is a directory (renaming a finished file over it would fail only after the work);
+    ``name``: the parameter that gave the path, if it was given whole."""
+    for path in paths:
+        if not isinstance(path, (str, os.PathLike)):
+            raise ParameterError(f"`{name or 'path'}` must be a file name, got {path!r}")
+        if os.path.isdir(path):
+            given = f"`{name}` = " if name else ""
+            raise ParameterError(f"{given}{str(path)!r} is a directory, where rodmol writes a file; "
+                                 "remove it or choose another name")
 
 
 def write_atomically(path, write, buffering=-1):

@@ -189,7 +189,7 @@ class Cable:
         label = f"cable {self.name!r}"
         object.__setattr__(self, "offset", cable_routing.as_offset(self.offset, self.name))
         object.__setattr__(self, "anchor", _checks.positive(f"{label} anchor", self.anchor, " m"))
-        object.__setattr__(self, "outside_body", bool(self.outside_body))
+        object.__setattr__(self, "outside_body", _checks.flag(f"{label} outside_body", self.outside_body))
         object.__setattr__(self, "friction", _checks.non_negative(f"{label} friction", self.friction))
         object.__setattr__(self, "slip_speed", _checks.positive(f"{label} slip_speed", self.slip_speed, " m/s"))
         self.offset_at(np.linspace(0.0, self.anchor, 65))  # a failing offset function fails here

@@ -66,9 +66,9 @@ class GridLoad:
 
 
 def _frame(frame, name):
-    if frame not in FRAMES:
+    if not (isinstance(frame, str) and frame in FRAMES):
         raise ParameterError(f"{name}: `frame` must be 'global' (dead load) or 'local' "
-                             f"(follower load), got {frame!r}")
+                             f"(follower load), got {_checks.short(frame)}")
     return frame
 
 

@@ -91,30 +91,22 @@ class Model:
             raise ParameterError(f"`n_elements` must be <= {MAX_ELEMENTS}, got {self.n_elements}")
         self.gravity = _checks.vector3("gravity", gravity)
         self.medium = _medium(medium, medium_density)
-        self.cables = tuple(cables)
-        for i, c in enumerate(self.cables):
-            if not isinstance(c, Cable):
-                raise ParameterError(f"`cables[{i}]` must be a rodmol.Cable, got {c!r}")
+        self.cables = _checks.items("cables", cables, Cable, "a rodmol.Cable")
         self.base = BaseMotion() if base is None else base
         if not isinstance(self.base, BaseMotion):
             raise ParameterError(f"`base` must be a rodmol.BaseMotion or None, got {base!r}")
-        self.drag, self.added_mass = bool(drag), bool(added_mass)
-        self.viscosity, self.munk_moment = bool(viscosity), bool(munk_moment)
+        self.drag, self.added_mass = _checks.flag("drag", drag), _checks.flag("added_mass", added_mass)
+        self.viscosity = _checks.flag("viscosity", viscosity)
+        self.munk_moment = _checks.flag("munk_moment", munk_moment)
         self.drag_law, self.drag_coefficients = _drag_law(drag_law, drag_coefficients)
         self._check_cables()
-        self.loads = tuple(loads)
-        for i, load in enumerate(self.loads):
-            if not isinstance(load, load_types.LOAD_TYPES):
-                names = ", ".join(t.__name__ for t in load_types.LOAD_TYPES)
-                raise ParameterError(f"`loads[{i}]` must be one of rodmol's loads ({names}), got {load!r}")
+        names = ", ".join(t.__name__ for t in load_types.LOAD_TYPES)
+        self.loads = _checks.items("loads", loads, load_types.LOAD_TYPES, f"one of rodmol's loads ({names})")
         names = [c.name for c in self.cables]
         duplicate = next((n for n in names if names.count(n) > 1), None)
         if duplicate is not None:
             raise ParameterError(f"two cables are named {duplicate!r}: cable names must be unique")
-        self.markers = tuple(markers)
-        for i, mk in enumerate(self.markers):
-            if not isinstance(mk, Marker):
-                raise ParameterError(f"`markers[{i}]` must be a rodmol.Marker, got {mk!r}")
+        self.markers = _checks.items("markers", markers, Marker, "a rodmol.Marker")
         self.marker_offsets = marker_offsets(self.markers, rod)
         self._sample()
 
@@ -276,8 +268,7 @@ DRAG_LAWS = ("morison", "componentwise")
 
 def _drag_law(law, coefficients):
     """(law, coefficients (3,) [kg/m^2] or None), checked."""
-    if law not in DRAG_LAWS:
-        raise ParameterError(f"unknown `drag_law` {law!r}; choose one of {', '.join(map(repr, DRAG_LAWS))}")
+    _checks.choice("drag_law", law, DRAG_LAWS)
     if law == "morison":
         if coefficients is not None:
             raise ParameterError("`drag_coefficients` belong to drag_law='componentwise' (the Morison "

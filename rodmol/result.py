@@ -6,7 +6,7 @@ from functools import partial
 import numpy as np
 
 from . import markers
-from ._files import write_atomically
+from ._files import refuse_directories, write_atomically
 from .discretise import centreline, physics, rotations
 from .discretise.layout import StateLayout
 from .model import Q_STAR
@@ -123,6 +123,7 @@ class Result:
 
     def save(self, path):
         """Write the result to ``path`` (.npz); read it back with :func:`rodmol.load_result`."""
+        refuse_directories([path], "path")  # before the arrays are compressed
         info = dict(success=self.success, message=self.message, stats=self.stats, meta=self.meta,
                     units=ARRAYS)
         arrays = {k: getattr(self, k) for k in ARRAYS}

@@ -16,6 +16,7 @@ from .result import Result, from_states
 from .solve import kernels, options
 from .solve.backends import get_backend
 from .solve.equilibrium import equilibrium
+from .solve.scales import check_scales
 from .solve.watch import state_problem
 
 INITIAL = ("equilibrium", "straight")
@@ -146,6 +147,7 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
     with _stage(progress, "preparing the compiled kernels", timings, "prepare_s",
                 kernels.ready(run, backend_options)):
         system = SemiDiscrete(model, scheme)  # the one system of this run
+        check_scales(system, t0, atol)  # before the kernels' first run, which would fail on them
         kernels.prepare(system, t0, straight_state(model), run, rtol, atol, backend_options)
         getattr(sink, "prepare", lambda system: None)(system)
     with _stage(progress, f"solving the initial equilibrium at t = {t0:g} s", timings, "equilibrium_s",

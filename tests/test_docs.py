@@ -15,6 +15,8 @@ virtual display when there is none (``xvfb-run``), and a page that needs it is
 skipped where ParaView is not installed.
 """
 
+import builtins
+import importlib
 import os
 import re
 import shutil
@@ -78,3 +80,41 @@ def test_page_runs_as_written(page, tmp_path, monkeypatch):
                     pytest.skip("xvfb-run is not installed")
                 done = xserver.run(argv, env=env, timeout=600)
                 assert done.returncode == 0, f"{where}: `{command}` failed:\n{done.stdout}\n{done.stderr}"
+
+
+def _resolves(dotted):
+    """True if ``a.b.c`` is a module or an attribute reached from one."""
+    parts = dotted.split(".")
+    found = importlib.import_module(parts[0])
+    for i, part in enumerate(parts[1:], start=2):
+        if hasattr(found, part):
+            found = getattr(found, part)
+            continue
+        try:
+            found = importlib.import_module(".".join(parts[:i]))
+        except ImportError:
+            return False
+    return True
+
+
+def test_every_dotted_rodmol_name_in_the_docs_exists():
+    missing = [(page.name, name) for page in PAGES
+               for name in sorted(set(re.findall(r"(?<![\w./])rodmol(?:\.[A-Za-z_]\w*)+", page.read_text())))
+               if not _resolves(name)]
+    assert not missing
+
+
+def test_every_name_api_md_gives_unqualified_is_importable_from_rodmol():
+    """docs/api.md: "Everything below is importable from `rodmol`": its class names, and the
+    functions that open a list item or a table row, unless the page names their module."""
+    import rodmol
+
+    text = (ROOT / "docs" / "api.md").read_text()
+    assert "Everything below is importable from `rodmol`" in text
+    names = {m for m in re.findall(r"`([A-Z]\w*)", text) if any(c.islower() for c in m)}
+    names |= set(re.findall(r"^(?:- |\| )`([a-z_]\w*)\(", text, re.M))
+    qualified = {m[1]: m[0] for m in re.findall(r"`(rodmol(?:\.\w+)*)\.([A-Za-z_]\w*)", text)}
+    missing = [name for name in sorted(names) if not (
+        hasattr(rodmol, name) or hasattr(builtins, name)
+        or (name in qualified and hasattr(importlib.import_module(qualified[name]), name)))]
+    assert not missing, f"docs/api.md names these as importable from rodmol: {missing}"

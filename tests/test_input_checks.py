@@ -4,6 +4,8 @@ rules in Python and in scenario files."""
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scenario_texts import MINIMAL
 
 import rodmol
@@ -115,9 +117,28 @@ def test_scenario_max_wall_time_reaches_simulate():
     assert spec.solver["max_wall_time"] == 30.0
 
 
-def test_scenario_nested_too_deeply():
-    with pytest.raises(ScenarioError, match="nested too deeply"):
-        parse_scenario("x = " + "[" * 3000 + "]" * 3000)
+@pytest.mark.parametrize("text, line", [
+    ("x = " + "[" * 3000 + "]" * 3000, 1),
+    ('a = 1\n[t]\nb = "[[[[" # [[\nx = [\n' + "[\n" * 1500 + "{y = " + "[" * 1500 + "]" * 1501 + "}" + "]" * 1500,
+     1505),  # the deepest line, past a string and a comment holding brackets and 1500 lines of "["
+])
+def test_scenario_nested_too_deeply(text, line):
+    with pytest.raises(ScenarioError, match=rf"s.toml:{line}: not a scenario: arrays or inline tables nested too deeply"):
+        parse_scenario(text, source="s.toml")
+
+
+@given(before=st.integers(0, 4), after=st.integers(0, 4), output_dt=st.booleans(), huge=st.sampled_from(["t_end", "both"]))
+@settings(max_examples=20, deadline=None, derandomize=True)
+def test_scenario_too_many_frames_cites_the_line_of_t_end(before, after, output_dt, huge):
+    """The message opens with t_end: it cites t_end's line, not the output_dt beside it."""
+    others = ["rtol = 1e-4", 'initial = "straight"', 'backend = "cvode"', "max_wall_time = 100.0"]
+    solver = ["# a comment"] * before + ["t_end = 1e12  # s"] + others[:after]
+    if output_dt:
+        solver.insert(before + 1, "output_dt = 1e-3" if huge == "both" else "output_dt = 0.01")
+    text = MINIMAL.replace("t_end = 1.0\n", "\n".join(solver) + "\n")
+    line = text.splitlines().index("t_end = 1e12  # s") + 1
+    with pytest.raises(ScenarioError, match=rf"s.toml:{line}: \[solver\] t_end = 1000000000000.0 s with output_dt"):
+        parse_scenario(text, source="s.toml")
 
 
 def test_scenario_marker_off_the_body():
@@ -129,3 +150,15 @@ def test_scenario_marker_off_the_body():
 def test_scenario_output_directory_with_nul():
     with pytest.raises(ScenarioError, match="without NUL characters"):
         parse_scenario(MINIMAL + '[output]\ndirectory = "a\\u0000b"\n')
+
+
+@pytest.mark.parametrize("options, match", [
+    (dict(cables=5), r"`cables` must be a sequence, each item a rodmol.Cable, got 5"),
+    (dict(cables=rodmol.Cable((0.004, 0.0), 0.2)), r"`cables` must be a sequence \(a single one: cables=\[...\]\)"),
+    (dict(markers=0.1), r"`markers` must be a sequence, each item a rodmol.Marker, got 0.1"),
+    (dict(loads=None), r"`loads` must be a sequence"),
+    (dict(drag="no"), r"`drag` must be True or False, got 'no'"),
+    (dict(drag_law=np.array([1.0, 2.0])), r"unknown `drag_law` array"),
+])
+def test_model_refuses_wrong_types(options, match):
+    refused(match, rodmol.Model, ROD, 6, **options)

@@ -41,6 +41,15 @@ class Camera:
         return np.append(self.H, 1.0).reshape(3, 4)
 
     @property
+    def centre(self):
+        """The camera's projection centre [m], global: the point every ray passes through
+        (the null vector of :attr:`matrix`); None for a camera at infinity (affine)."""
+        null = np.linalg.svd(self.matrix)[2][-1]
+        if abs(null[3]) <= 1e-12 * np.max(np.abs(null[:3])):
+            return None
+        return null[:3] / null[3]
+
+    @property
     def rms(self):
         """Root-mean-square reprojection error [px] of the control points."""
         return float(np.sqrt(np.mean(self.errors**2))) if len(self.errors) else 0.0
@@ -131,6 +140,10 @@ def triangulate(cameras, uvs):
     if len(cameras) < 2 or len(tracks) != len(cameras):
         raise ParameterError(f"triangulation needs two or more cameras and one set of image points "
                              f"per camera, got {len(cameras)} cameras and {len(tracks)} sets")
+    for i, camera in enumerate(cameras):
+        if not isinstance(camera, Camera):
+            raise ParameterError(f"`cameras[{i}]` must be a rodmol.calibrate.dlt.Camera, got {camera!r}")
+    _check_baseline(cameras)
     as_tracks = all(isinstance(u, PixelTracks) for u in tracks)
     if as_tracks and any(len(u.t) != len(tracks[0].t) or not np.allclose(u.t, tracks[0].t) for u in tracks):
         raise ParameterError("the cameras' pixel tracks must share their sample times")
@@ -140,12 +153,29 @@ def triangulate(cameras, uvs):
     seen = np.all(np.isfinite(uv), axis=-1)  # (n_cam, ...)
     a, b = _equations(cameras, np.where(seen[..., None], uv, 0.0), seen)
     xyz = _solve(a, b, np.sum(seen, axis=0) >= 2)
-    depth = np.stack([np.where(seen[i], xyz @ c.H[8:11] + 1.0, 1.0) for i, c in enumerate(cameras)])
+    found = np.all(np.isfinite(xyz), axis=-1)
+    depth = np.stack([np.where(seen[i] & found, xyz @ c.H[8:11] + 1.0, 1.0) for i, c in enumerate(cameras)])
     a, b = a / np.repeat(depth, 2, axis=0)[..., None], b / np.repeat(depth, 2, axis=0)
     xyz = _solve(a, b, np.sum(seen, axis=0) >= 2)
     if as_tracks:
         return MarkerTracks(tracks[0].t, xyz, tracks[0].names)
     return xyz
+
+
+def _check_baseline(cameras):
+    """Refuse cameras that all sit at one centre: their rays through a marker coincide,
+    so no position follows from them, however many there are."""
+    centres = [c.centre for c in cameras]
+    if any(c is None for c in centres):
+        return  # a camera at infinity views along parallel rays: any other camera's rays cross them
+    spread = max(np.linalg.norm(c - centres[0]) for c in centres)
+    size = max(np.linalg.norm(c) for c in centres)
+    if spread <= 1e-9 * max(size, 1.0):
+        names = ", ".join(repr(c.name) for c in cameras)
+        raise ParameterError(f"the cameras are degenerate: {names} all have their centre at "
+                             f"{tuple(np.round(centres[0], 6).tolist())} m (one position), so their rays "
+                             "through a marker coincide and triangulation cannot find its depth; "
+                             "use cameras at two different positions")
 
 
 def reprojection_errors(cameras, uvs, xyz):
@@ -170,9 +200,12 @@ def _equations(cameras, uv, seen):
 
 
 def _solve(a, b, ok):
-    """Least-squares points from the stacked equations (normal equations per sample)."""
+    """Least-squares points from the stacked equations (normal equations per sample); NaN
+    where the rays do not cross at one point (a point on the line through the cameras)."""
     ata = np.einsum("k...i,k...j->...ij", a, a)
     atb = np.einsum("k...i,k...->...i", a, b)
+    ok = ok & np.all(np.isfinite(ata), axis=(-2, -1))
+    ok = ok & (np.linalg.cond(np.where(ok[..., None, None], ata, np.eye(3))) < 1e12)
     ata[~ok] = np.eye(3)  # unseen samples: any regular system, overwritten with NaN below
     xyz = np.linalg.solve(ata, atb[..., None])[..., 0]
     xyz[~ok] = np.nan

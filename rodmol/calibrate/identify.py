@@ -18,7 +18,7 @@ from scipy.optimize import least_squares
 from ..errors import ParameterError
 from .paper_errors import ErrorTable, as_tracks
 from .parallel import SERIAL, check_picklable, executor
-from .runs import MarkersAt, Task
+from .runs import MarkersAt, Task, failed_run
 from .variants import apply, as_spec, current, split_key
 
 #: Residual entry [-] (a fraction of L) for a sample after a run stopped early.
@@ -122,9 +122,10 @@ def identify(spec, measured, parameters, *, start=None, client=None, rel_step=1e
         return {name: float(v) for name, v in zip(names, x * scale)}
 
     def simulate(points, ex):
-        outcomes = ex.map(task, [overrides(x) for x in points])
+        outcomes = ex.map(task, [overrides(x) for x in points], failed=failed_run)
         for x, o in zip(points, outcomes):
-            cache[tuple(x)] = _residual(o.value, tracks.xyz, seen, length)
+            simulated = o.value if o.value is not None else np.full(tracks.xyz.shape, np.nan)  # a failed run
+            cache[tuple(x)] = _residual(simulated, tracks.xyz, seen, length)
         return [cache[tuple(x)] for x in points]
 
     with executor(client, n_workers) as ex:

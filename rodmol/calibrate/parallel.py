@@ -29,10 +29,16 @@ class Serial:
 
     workers = 1
 
-    def map(self, function, items, progress=None):
+    def map(self, function, items, progress=None, failed=None):
+        """``function(item)`` for each item, in order; see :meth:`Dask.map` for ``failed``."""
         out = []
         for i, item in enumerate(items):
-            out.append(function(item))
+            try:
+                out.append(function(item))
+            except Exception as exc:  # noqa: BLE001 (one item's failure, returned in its place)
+                if failed is None:
+                    raise
+                out.append(failed(item, exc))
             if progress:
                 progress(i + 1, len(items))
         return out
@@ -45,7 +51,12 @@ class Dask:
         self.client = client
         self.workers = max(1, len(client.scheduler_info().get("workers", {})))
 
-    def map(self, function, items, progress=None):
+    def map(self, function, items, progress=None, failed=None):
+        """``function(item)`` for each item, in the items' order. A worker that dies
+        (killed, out of memory) has its tasks rerun on the others by the scheduler
+        (up to its ``allowed-failures``); a task that still fails, by raising or by
+        killing every worker it ran on, gives ``failed(item, exception)`` in its
+        place if ``failed`` is given, else its exception is raised here."""
         from distributed import as_completed
 
         items = list(items)
@@ -53,7 +64,10 @@ class Dask:
         for done, _ in enumerate(as_completed(futures), start=1):
             if progress:
                 progress(done, len(items))
-        return self.client.gather(futures)
+        if failed is None:
+            return self.client.gather(futures)
+        return [future.result() if future.status == "finished" else failed(item, future.exception())
+                for item, future in zip(items, futures)]
 
 
 def cores():

@@ -9,7 +9,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ParameterError, RodmolError
 from .paper_errors import paper_errors
 from .variants import apply
 
@@ -43,19 +42,23 @@ class Task:
 
     def __call__(self, overrides):
         started = time.perf_counter()
-        spec = apply(self.spec, overrides)
         try:
+            spec = apply(self.spec, overrides)  # the batch checked the overrides; a run may still refuse
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)  # the outcome carries the message
                 result = spec.simulate()
-        except ParameterError:
-            raise
-        except RodmolError as exc:  # e.g. no initial equilibrium: this run failed, not the batch
-            return Outcome(dict(overrides), False, f"{type(exc).__name__}: {exc}",
-                           time.perf_counter() - started)
-        value = self.extract(result, spec) if self.extract is not None else None
+            value = self.extract(result, spec) if self.extract is not None else None
+        # No equilibrium, absurd values, a user function that raised: this run failed, not the batch.
+        except Exception as exc:  # noqa: BLE001
+            return failed_run(overrides, exc, time.perf_counter() - started)
         return Outcome(dict(overrides), result.success, result.message, time.perf_counter() - started,
                        dict(result.stats), value, result if self.keep else None)
+
+
+def failed_run(overrides, exc, wall=0.0):
+    """The :class:`Outcome` of a run that raised ``exc`` (or whose worker died every
+    time it ran it, ``distributed``'s KilledWorker): failed, with the exception as its message."""
+    return Outcome(dict(overrides), False, f"{type(exc).__name__}: {exc}", wall)
 
 
 @dataclass(frozen=True)
@@ -122,3 +125,8 @@ def run_indexed(task, item):
         if not task.keep:
             outcome.result = None  # read back from the file when needed
     return outcome
+
+
+def failed_item(item, exc):
+    """:func:`failed_run` for an ``item`` of :func:`run_indexed` (the executors' ``failed``)."""
+    return failed_run(item[1], exc)

@@ -9,7 +9,7 @@ from pathlib import Path
 from ..errors import ParameterError
 from .paper_errors import as_tracks
 from .parallel import SERIAL, check_picklable, executor
-from .runs import Summary, Task, run_indexed
+from .runs import Summary, Task, failed_item, run_indexed
 from .variants import apply, as_spec
 
 
@@ -105,7 +105,7 @@ def sweep(spec, overrides, *, client=None, out=None, measured=None, keep=None, p
     folder = None if out is None else str(Path(out).resolve())
     items = [(i, o, folder) for i, o in enumerate(overrides)]
     with executor(client, n_workers) as ex:
-        runs = ex.map(partial(run_indexed, task), items, progress)
+        runs = ex.map(partial(run_indexed, task), items, progress, failed=failed_item)
     result = Sweep(runs, out)
     if out is not None:
         result.write(out)

@@ -166,8 +166,10 @@ def _stream_writer(args, spec, out):
     if fmt != "xdmf":
         if args.resume:
             raise ParameterError("`--resume` needs the streamed output (--format xdmf)")
+        from .._files import refuse_directories
         from .stream import clear_outputs
 
+        refuse_directories([out / "result.npz"] if spec.output.npz else [])  # before the run
         clear_outputs(out)  # a result.h5 of an earlier run would be read instead of result.npz
         return None
     from .stream import RunWriter
@@ -285,6 +287,8 @@ def _result_in(directory):
         raise ParameterError(f"{exc}; run `rodmol run ... --out DIR` first") from None
     try:
         return load_result(path)
+    except ParameterError:  # names the file and what is wrong with it
+        raise
     except (OSError, KeyError, ValueError) as exc:
         raise ParameterError(f"cannot read {str(path)!r} (another rodmol version?): {exc}") from None
 

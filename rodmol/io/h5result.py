@@ -23,12 +23,14 @@ first access) and concatenates the chunks.
 """
 
 import json
+import os
 from pathlib import Path
 
 import numpy as np
 
 from .._files import atomic_path
 from ..discretise.layout import StateLayout
+from ..errors import ParameterError
 from ..result import ARRAYS, FORCES, STATIC, STORED, Result
 
 INDEX = "result.h5"
@@ -105,17 +107,46 @@ def write_index(directory, static, t_out, t, chunks, info):
     atomic_h5(Path(directory) / INDEX, fill)
 
 
+def damaged(path, exc):
+    """The :class:`ParameterError` for a result file ``path`` that cannot be read
+    (``exc`` is what the reader raised), to be raised ``from exc``."""
+    text = str(exc).strip() or type(exc).__name__
+    try:
+        with open(path, "rb") as handle:
+            start = handle.read(8)
+    except OSError:
+        start = b""
+    ours = start.startswith((b"PK\x03\x04", b"\x89HDF\r\n\x1a\n"))  # a zip (.npz) or an HDF5 file
+    if not os.path.exists(path):
+        what = "it is missing (the run's result.h5 lists it: a run directory copied in part?)"
+    elif "truncated" in text or (ours and "not a zip file" in text):  # a zip's directory is at its end
+        what = "it is truncated (it ends early: a copy or a write that did not finish?)"
+    elif not ours:
+        what = "it is not a file rodmol wrote (neither a .npz nor an HDF5 file)"
+    else:
+        what = "it is damaged or not a file rodmol wrote"
+    if len(text) > 200:
+        text = text[:200] + "..."
+    return ParameterError(f"cannot read the result file {str(path)!r}: {what} ({type(exc).__name__}: {text})")
+
+
 def read_index(path):
-    """The index at ``path``: dict with the static arrays, ``t_out``, ``t``, ``chunks`` (name -> frames), ``info``."""
+    """The index at ``path``: dict with the static arrays, ``t_out``, ``t``, ``chunks`` (name -> frames),
+    ``info``; a file that is not a readable index is a :func:`damaged` error naming it."""
     import h5py
 
-    with h5py.File(path, "r") as handle:
-        if handle.attrs.get("format") != FORMAT:
-            raise ValueError(f"{str(path)!r} is not a rodmol result index")
-        index = {key: handle[key][()] for key in (*STATIC, "t_out", "t")}
-        names = [c.decode() if isinstance(c, bytes) else str(c) for c in handle["chunks"][()]]
-        index["chunks"] = dict(zip(names, handle["chunk_frames"][()].tolist()))
-        index["info"] = json.loads(handle.attrs["info"])
+    try:
+        with h5py.File(path, "r") as handle:
+            if handle.attrs.get("format") != FORMAT:
+                raise ValueError(f"no attribute format = {FORMAT!r}: not a rodmol result index")
+            index = {key: handle[key][()] for key in (*STATIC, "t_out", "t")}
+            names = [c.decode() if isinstance(c, bytes) else str(c) for c in handle["chunks"][()]]
+            index["chunks"] = dict(zip(names, handle["chunk_frames"][()].tolist()))
+            index["info"] = json.loads(handle.attrs["info"])
+    except FileNotFoundError:
+        raise
+    except (OSError, KeyError, ValueError, TypeError) as exc:  # h5py reports damage as OSError
+        raise damaged(path, exc) from exc
     return index
 
 
@@ -125,8 +156,11 @@ def read_series(directory, chunks, name):
 
     parts = []
     for chunk in chunks:
-        with h5py.File(Path(directory) / chunk, "r") as handle:
-            parts.append(handle[name][()])
+        try:
+            with h5py.File(Path(directory) / chunk, "r") as handle:
+                parts.append(handle[name][()])
+        except (OSError, KeyError, ValueError) as exc:  # a missing chunk too: the index lists it
+            raise damaged(Path(directory) / chunk, exc) from exc
     return np.asarray(np.concatenate(parts), dtype=float) if parts else np.zeros((0,))
 
 
@@ -169,8 +203,11 @@ def _stored(folder, chunks):
 
     if not chunks:
         return STORED
-    with h5py.File(folder / chunks[0], "r") as handle:
-        return tuple(name for name in dict.fromkeys((*STORED, *ARRAYS)) if name in handle and name not in STATIC)
+    try:
+        with h5py.File(folder / chunks[0], "r") as handle:
+            return tuple(name for name in dict.fromkeys((*STORED, *ARRAYS)) if name in handle and name not in STATIC)
+    except OSError as exc:
+        raise damaged(folder / chunks[0], exc) from exc
 
 
 def _empty_shape(name, n_nodes, info):

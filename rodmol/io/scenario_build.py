@@ -136,7 +136,9 @@ def _solver(data, ctx, t_end_default, n_elements):
         try:
             run_options.output_count(t_end, options["output_dt"], StateLayout(n_elements).size)
         except ParameterError as exc:
-            ctx.add(path + (("output_dt",) if "output_dt" in table else ("t_end",)), str(exc))
+            # The message opens with t_end: its line, unless only output_dt was written here.
+            ctx.add(path + (("output_dt",) if "output_dt" in table and "t_end" not in table else ("t_end",)),
+                    str(exc))
     return options, t_end
 
 

@@ -28,7 +28,7 @@ from .scenario_build import build
 from .scenario_problems import Context, Problem, ScenarioError
 from .scenario_readers import RadiusProfile
 from .scenario_spec import OutputOptions, Override, RunSpec
-from .toml_lines import KeyLines
+from .toml_lines import KeyLines, deepest_line
 
 __all__ = ["OutputOptions", "Override", "Problem", "RadiusProfile", "RunSpec", "ScenarioError",
            "load_scenario", "parse_scenario"]
@@ -68,8 +68,8 @@ def parse_scenario(text, base_dir=".", source="<string>", overrides=None, defaul
         line = int(match.group(1)) if match else None
         raise ScenarioError(source, [Problem(source, line, "", f"not valid TOML: {exc}")]) from None
     except RecursionError:  # tomllib recurses once per level of nested arrays and tables
-        raise ScenarioError(source, [Problem(source, None, "", "not a scenario: arrays or inline "
-                                             "tables nested too deeply")]) from None
+        raise ScenarioError(source, [Problem(source, deepest_line(text), "", "not a scenario: arrays or "
+                                             "inline tables nested too deeply")]) from None
     ctx = Context(source, KeyLines(text), Path(base_dir))
     for dotted, value in (overrides or {}).items():
         ctx.override(dotted, value, data)

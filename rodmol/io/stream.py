@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._files import leftover_temporaries
+from .._files import leftover_temporaries, output_directory, refuse_directories
 from ..discretise.rotations import rotate
 from ..errors import ParameterError
 from ..result import STATIC
@@ -70,8 +70,7 @@ class RunWriter:
                  meta=None):
         if (every is not None and int(every) < 1) or int(chunk_frames) < 1:
             raise ParameterError(f"`every` and `chunk_frames` must be >= 1, got {every!r}, {chunk_frames!r}")
-        self.directory = Path(directory)
-        self.directory.mkdir(parents=True, exist_ok=True)
+        self.directory = output_directory(directory, "out")
         self.views, self.chunk_frames = bool(views), int(chunk_frames)
         self.every = None if every is None else int(every)
         self.extra_meta = dict(meta or {})
@@ -366,9 +365,13 @@ _RUN_FILES = (INDEX, *(f"{view}.xdmf" for view in xdmf.VIEWS))
 def clear_outputs(directory):
     """Remove the streamed outputs of an earlier run in ``directory``, so nothing stale is listed or read."""
     directory = Path(directory)
+    frames = directory / h5result.FRAMES
+    refuse_directories([directory / name for name in _RUN_FILES])
+    if frames.exists() and not frames.is_dir():
+        raise ParameterError(f"{str(frames)!r} is a file, where rodmol writes the folder of the frames; "
+                             "remove it or choose another output directory")
     for name in _RUN_FILES:
         (directory / name).unlink(missing_ok=True)
-    frames = directory / h5result.FRAMES
     if frames.is_dir():
         for file in frames.glob("chunk_*"):
             file.unlink()

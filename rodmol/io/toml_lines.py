@@ -25,7 +25,7 @@ class KeyLines:
         table, counts, depth, in_string = (), {}, 0, None
         for number, line in enumerate(text.splitlines(), start=1):
             if depth or in_string:
-                depth, in_string = _scan(line, depth, in_string)
+                depth, in_string, _ = _scan(line, depth, in_string)
                 continue
             if match := _ARRAY_HEADER.match(line):
                 name = _split_key(match.group(1))
@@ -35,7 +35,7 @@ class KeyLines:
                 table = _split_key(match.group(1))
             elif match := _ASSIGN.match(line):
                 self.lines.setdefault(table + _split_key(match.group(1)), number)
-                depth, in_string = _scan(match.group(2), 0, None)
+                depth, in_string, _ = _scan(match.group(2), 0, None)
                 continue
             else:
                 continue
@@ -51,14 +51,27 @@ class KeyLines:
         return None
 
 
+def deepest_line(text):
+    """The line where arrays and inline tables nest deepest (the first such), or None:
+    where to point when a parser gives up on the nesting."""
+    depth, in_string, deepest, where = 0, None, 0, None
+    for number, line in enumerate(text.splitlines(), start=1):
+        value = line if (depth or in_string) else (m.group(2) if (m := _ASSIGN.match(line)) else "")
+        depth, in_string, peak = _scan(value, depth, in_string)
+        if peak > deepest:
+            deepest, where = peak, number
+    return where
+
+
 def _scan(fragment, depth, in_string):
-    """Follow brackets and strings through a value fragment; return (depth, open string)."""
-    i = 0
+    """Follow brackets and strings through a value fragment; return (depth, open string,
+    deepest depth reached)."""
+    i, peak = 0, depth
     while i < len(fragment):
         if in_string:
             end = fragment.find(in_string, i)
             if end < 0:
-                return depth, in_string
+                return depth, in_string, peak
             i, in_string = end + 3, None
             continue
         c = fragment[i]
@@ -73,7 +86,8 @@ def _scan(fragment, depth, in_string):
                 i += 2 if (c == '"' and fragment[i] == "\\") else 1
         elif c in "[{":
             depth += 1
+            peak = max(peak, depth)
         elif c in "]}":
             depth = max(depth - 1, 0)
         i += 1
-    return depth, in_string
+    return depth, in_string, peak

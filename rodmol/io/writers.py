@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._files import write_atomically
+from .._files import output_directory, refuse_directories, write_atomically
 from ..discretise.rotations import rotate
 from ..errors import ParameterError
 from .parts import PARTS, ROD_ARRAYS, cable_points, view_step
@@ -264,15 +264,16 @@ def write_series(result, directory, every=None, format="xdmf"):
     ``every``: show every n-th output frame (and the last); by default all
     of them up to :data:`rodmol.io.parts.MAX_SHOWN` frames.
     """
+    if not (isinstance(format, str) and format in ("xdmf", "vtp")):
+        raise ParameterError(f"unknown `format` {format!r}; use 'xdmf' or 'vtp'")
+    directory = output_directory(directory, "directory")
     if format == "xdmf":
         from .stream import RunWriter
 
         return RunWriter(directory, every=every).write_result(result)
-    if format != "vtp":
-        raise ParameterError(f"unknown `format` {format!r}; use 'xdmf' or 'vtp'")
     from .stream import clear_outputs
 
-    Path(directory).mkdir(parents=True, exist_ok=True)
+    refuse_directories([directory / "result.npz", *(directory / f"{part}.pvd" for part in PARTS)])
     clear_outputs(directory)  # load_result would read a stale result.h5 first
     result.save(Path(directory) / "result.npz")
     with SeriesWriter.for_result(result, directory) as writer:

@@ -53,18 +53,9 @@ def _unit_interval(name, value):
     return value
 
 
-def _flag(name, value):
-    if not isinstance(value, (bool, np.bool_)):
-        raise ParameterError(f"`{name}` must be True or False, got {_checks.short(value)}")
-    return bool(value)
-
-
 def _choice(options):
     def check(name, value):
-        if value not in options:
-            raise ParameterError(f"unknown `{name}` {_checks.short(value)}{_checks.did_you_mean(value, options)}; "
-                                 f"valid: {', '.join(map(repr, options))}")
-        return value
+        return _checks.choice(name, value, options)
     return check
 
 
@@ -79,7 +70,7 @@ def _values():
         "jacobian": _choice(("auto", *JACOBIANS)),
         "dt": _auto_or(lambda name, value: _checks.positive(name, value, " s")),
         "rho_inf": _unit_interval,
-        "python_loop": _flag,
+        "python_loop": _checks.flag,
     }
 
 

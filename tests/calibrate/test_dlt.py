@@ -103,3 +103,30 @@ def test_occluded_samples_give_nan_only_where_fewer_than_two_cameras_see():
 def test_one_camera_is_not_enough():
     with pytest.raises(ParameterError, match="two or more cameras"):
         triangulate(CAMERAS[:1], [CAMERAS[0].project(CONTROL)])
+
+
+def test_camera_centre_is_where_it_was_put():
+    assert CAMERAS[0].centre == pytest.approx([0.22, 0.0, 1.2], abs=1e-12)
+    assert CAMERAS[1].centre == pytest.approx([0.22, 1.2, 0.0], abs=1e-12)
+
+
+def test_identical_cameras_are_degenerate():
+    pts = workspace_points(5)
+    twin = Camera(CAMERAS[0].H.copy(), name="twin")
+    with pytest.raises(ParameterError, match=r"cameras are degenerate: 'front', 'twin' all have their centre "
+                                             r"at \(0.22, 0.0, 1.2\) m"):
+        triangulate([CAMERAS[0], twin], [CAMERAS[0].project(pts)] * 2)
+    # The same centre, turned to look elsewhere: still one position, still refused.
+    turned = Camera.looking_at((0.22, 0.0, 1.2), (0.3, 0.1, 0.0), name="turned")
+    with pytest.raises(ParameterError, match="cameras are degenerate"):
+        triangulate([CAMERAS[0], turned], [CAMERAS[0].project(pts), turned.project(pts)])
+
+
+def test_a_point_on_the_cameras_baseline_gives_nan_not_an_error():
+    """The rays of both cameras through a point on the line joining their centres coincide."""
+    front, top = CAMERAS
+    on_baseline = 0.5 * (front.centre + top.centre)
+    pts = np.vstack([on_baseline, workspace_points(3)])
+    xyz = triangulate(CAMERAS, [front.project(pts), top.project(pts)])
+    assert np.all(np.isnan(xyz[0]))
+    assert np.max(np.abs(xyz[1:] - pts[1:])) < 1e-10

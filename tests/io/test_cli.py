@@ -1,10 +1,12 @@
 """The command line end to end, in subprocesses: every shipped example, errors, Ctrl-C."""
 
 import os
+import re
 import signal
 import subprocess
 import sys
 import time
+import tomllib
 from pathlib import Path
 
 import pytest
@@ -82,6 +84,15 @@ def test_run_each_example_coarse(scenario, tmp_path):
     assert assert_valid_views(out) == pytest.approx(list(result.t))
     assert str(out / "rod.xdmf") in run.stdout and "Jacobian evaluations" in run.stdout
     assert "x real time" in run.stdout and "tip" in run.stdout
+    promised = set(re.findall(r"[\w.-]+\.(?:xdmf|h5|pvd|vtp|npz)\b", "\n".join(
+        line.partition("#")[2] for line in scenario.read_text().splitlines())))
+    assert all((out / name).is_file() for name in promised), (promised, sorted(p.name for p in out.iterdir()))
+
+
+def test_examples_keep_the_views_frame_cap():
+    """``every`` lifts the cap of 6000 frames shown; the examples leave it to the user."""
+    for scenario in SCENARIOS:
+        assert "every" not in tomllib.loads(scenario.read_text()).get("output", {}), scenario.name
 
 
 @pytest.mark.subprocess

@@ -77,12 +77,20 @@ def test_lock_is_exclusive_and_released(tmp_path):
     assert not (tmp_path / LOCK_NAME).exists()
 
 
-def test_result_npz_being_a_directory(tmp_path, capsys):
-    (tmp_path / "result.npz").mkdir()
-    code, err = run_cli(capsys, "--out", tmp_path, "--format", "vtp")
-    assert code == cli.EXIT_OUTPUT
-    assert "cannot write" in err and "result.npz" in err
-    assert assert_valid_series(tmp_path) == pytest.approx([0.0, 0.02, 0.04, 0.05])  # written all the same
+@pytest.mark.parametrize("fmt, name", [("vtp", "result.npz"), ("xdmf", "result.h5"), ("xdmf", "rod.xdmf"),
+                                       ("vtp", "result.h5")])
+def test_a_directory_where_the_result_file_goes_is_refused_before_the_run(tmp_path, capsys, fmt, name):
+    (tmp_path / name).mkdir()
+    code, err = run_cli(capsys, "--out", tmp_path, "--format", fmt)
+    assert code == cli.EXIT_USAGE
+    assert f"{str(tmp_path / name)!r} is a directory" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == [name]  # nothing run, nothing written
+
+
+def test_out_being_a_file(tmp_path, capsys):
+    (tmp_path / "file").write_text("not a directory")
+    code, err = run_cli(capsys, "--out", tmp_path / "file")
+    assert code == cli.EXIT_USAGE and "cannot create the output directory" in err
 
 
 def test_vtk_being_a_file(tmp_path, capsys):
