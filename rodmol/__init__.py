@@ -27,6 +27,7 @@ from .calibrate import (
     triangulate,
     worsened_models,
 )
+from .control import Simulator
 from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
 from .discretise.system import SemiDiscrete, StateView
@@ -58,7 +59,7 @@ __all__ = [
     "BACKENDS", "Base", "BaseMotion", "Cable", "CapsuleContact", "DistributedForce",
     "DistributedMoment", "PlaneContact", "PointForce", "PointMoment", "SphereContact", "EquilibriumError", "IntegrationError", "MEDIA",
     "Marker", "Material", "Medium", "Model", "ParameterError", "Result", "Rod", "RodmolError",
-    "SCHEMES", "ScenarioError", "SemiDiscrete", "StateLayout", "StateView", "UserFunctionError",
+    "SCHEMES", "ScenarioError", "SemiDiscrete", "Simulator", "StateLayout", "StateView", "UserFunctionError",
     "default_atol", "energy",
     "equilibrium", "load_result", "load_scenario", "marker_errors", "oscillation_period", "paper_arm",
     "read_tension_csv", "scenarios", "simulate", "straight_state", "write_series",
