@@ -244,9 +244,12 @@ class Simulator:
             self._stored = len(self._times)
 
     def close(self):
-        """Finish the streamed output (all frames and the final index written); returns :attr:`result`."""
-        if self._sink is None or self._closed:
-            return self.result if self._sink is None else self._sink.result()
+        """Finish the streamed output (all frames and the final index written) and return its
+        Result; without ``out``, nothing to do (None)."""
+        if self._sink is None:
+            return None
+        if self._closed:
+            return self._sink.result()
         self._stream(force=True)
         self._closed = True
         return self._sink.end(True, f"stepped to t = {self.t:.6g} s", self.stats)
