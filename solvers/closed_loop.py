@@ -118,7 +118,7 @@ def main(argv=None):
     for row in rows:
         print(row, flush=True)
     facts = (f"Tip of the Simulator against the table replay: largest distance {gap:.2g} m; "
-             f"against the per-period calls {gap_old:.2g} m . The Simulator's integrator: "
+             f"against the per-period calls {gap_old:.2g} m. The Simulator's integrator: "
              f"{stats['steps']} steps, {stats['restarts']} restarts (one per tension change), "
              f"{stats['rhs_evals']} right-hand sides; the replay: {replay.stats['steps']} steps, "
              f"{replay.stats['rhs_evals']} right-hand sides. Tension range "

@@ -25,7 +25,10 @@ HELD_LOADS = (PointForce, PointMoment)
 
 
 class Held(TimeInput):
-    """A value [its input's unit] set between steps; ``value(t)`` ignores t."""
+    """A value [its input's unit] set between steps; ``value(t)`` ignores t. A held
+    tension is read by ``SemiDiscrete.read_held``, not at every right-hand side."""
+
+    held = True
 
     def __init__(self, current, width):
         self.current, self.width = current, width

@@ -182,6 +182,7 @@ class Simulator:
     def _hold(self, row):
         for held, value in zip(self._held, row):
             held.current = value
+        self._system.read_held(self.t)
 
     # ----------------------------------------------------------------- rollouts
 

@@ -207,7 +207,11 @@ class SemiDiscrete:
             len(active), m.n_elements)
         self._weights = self._path_weights.copy()  # times the friction factors, refreshed
         self.tension_values = np.array([constant[i] or 0.0 for i in active])
-        self._timed = [(j, m.cables[i]) for j, i in enumerate(active) if constant[i] is None]
+        timed = [(j, m.cables[i]) for j, i in enumerate(active) if constant[i] is None]
+        # Inputs held over a step (rodmol.control.Simulator) are read by read_held, not per call.
+        self._held = [(j, cable) for j, cable in timed if getattr(getattr(cable.tension, "signal", None), "held", False)]
+        self._timed = [entry for entry in timed if entry not in self._held]
+        self.read_held(0.0)
 
     def _setup_loads(self):
         entries = self.model.grid_loads
@@ -240,6 +244,13 @@ class SemiDiscrete:
         if self._friction:
             self._weights[:] = self._path_weights * self.friction_factors(y)[self._active]
         self._grid_loads.fill(t, self.entry_values)
+
+    def read_held(self, t):
+        """Read the held tensions (time inputs with ``held = True``: a stepping simulator's
+        zero-order hold) at t into the kernel's arguments; the right-hand side then treats
+        them as constants until the next call."""
+        for j, cable in self._held:
+            self.tension_values[j] = cable.tension_at(t)
 
     def tensions(self, t, y=None):
         """Tensions of all cables at (t, y) where they leave the base, shape (n_cables,) [N]."""
