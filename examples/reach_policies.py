@@ -12,14 +12,11 @@ with an absolute path, see docs/paraview.md). Needs gymnasium
 
 import argparse
 import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))  # run from a checkout
-
-from rodmol.arm import CABLE_OFFSETS  # noqa: E402
-from rodmol.control.envs import ReachEnv  # noqa: E402  (registers rodmol/Reach-v0)
+from rodmol.arm import CABLE_OFFSETS
+from rodmol.control.envs import ReachEnv  # needs gymnasium
 
 GAIN = 8.0  # N per m of tip error
 

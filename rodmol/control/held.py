@@ -158,6 +158,9 @@ class HeldInputs:
             i = int(key)
         elif isinstance(key, str) and names.count(key) == 1:
             i = names.index(key)
+        elif isinstance(key, str) and key in names:
+            raise ParameterError(f"`{what}s`: {names.count(key)} loads are named {key!r}: give the "
+                                 "index, or distinct names")
         else:
             raise ParameterError(f"`{what}s`: unknown {'load' if what == 'load' else 'cable'} "
                                  f"{_checks.short(key)}{_checks.did_you_mean(key, names)}; valid: "

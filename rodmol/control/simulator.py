@@ -104,7 +104,7 @@ class Simulator:
         if self._sink is not None:
             # The writer derives each chunk's arrays from the record so far (only ever appended to).
             record = self._inputs.recorded(self._times, self._rows)
-            self._sink.begin(SemiDiscrete(record, self._scheme), np.array([args.t0]))
+            self._sink.begin(SemiDiscrete(record, self._scheme), None)  # no planned end
 
     # ----------------------------------------------------------------- stepping
 
@@ -132,7 +132,7 @@ class Simulator:
         model = self._inputs.model
         for kind, i, value in zip(self._inputs.kinds, self._inputs.targets, self._row):
             pool = model.loads if kind == "load" else model.cables
-            out[f"{kind}s"][pool[i].name] = value
+            out[f"{kind}s"][pool[i].name] = value.copy() if kind == "load" else value
         return out
 
     def step(self, dt, tensions=None, *, displacements=None, loads=None):
