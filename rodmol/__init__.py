@@ -10,7 +10,8 @@ layout, the compiled physics and the semi-discrete scheme, its Jacobian),
 ``solve/`` (static equilibrium and the time-integration backends) and
 ``io/`` (scenario files, ParaView series, pictures, command line) and
 ``calibrate/`` (measured data, stereo reconstruction, the paper's error
-study, identification, sweeps, linearisation).
+study, identification, sweeps, linearisation) and ``control/`` (the stepping
+simulator; the gymnasium environments in ``rodmol.control.envs``).
 """
 
 from . import scenarios

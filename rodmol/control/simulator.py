@@ -20,7 +20,7 @@ from ..solve.stepping import Stepper
 from .held import HeldInputs
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Snapshot:
     """A saved state of a :class:`Simulator` (:meth:`Simulator.copy`), for :meth:`Simulator.reset`.
 

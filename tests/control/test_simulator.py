@@ -1,5 +1,7 @@
 """The stepping simulator: equal to simulate on the same held inputs, rollouts, failures, checks."""
 
+import contextlib
+
 import numpy as np
 import pytest
 
@@ -48,23 +50,26 @@ def test_stepping_equals_simulate_on_the_same_tension_table(stepped):
     np.testing.assert_allclose(stepped.state.markers, result.markers[-1], rtol=0, atol=1e-15)
 
 
-def test_copy_and_reset_continue_bitwise(stepped):
-    saved = stepped.copy()
+@pytest.mark.parametrize("linsolver", ["band", "gmres"])
+def test_copy_and_reset_continue_bitwise(linsolver):
+    sim = Simulator(rodmol.paper_arm(N), linsolver=linsolver)
+    for k in range(3):
+        sim.step(DT, {"cable 11": 0.3 * k})
+    saved = sim.copy()
 
     def rollout():
         states = []
         for k in range(6):
-            tensions = controller(stepped.state) if k != 3 else None  # k = 3: inputs unchanged
-            stepped.step(DT, tensions)
-            states.append(stepped.y)
+            tensions = controller(sim.state) if k != 3 else None  # k = 3: inputs unchanged
+            sim.step(DT, tensions)
+            states.append(sim.y)
         return np.array(states)
 
     first = rollout()
-    n_frames = len(stepped.result.t)
-    stepped.reset(saved)
-    assert stepped.t == saved.t and len(stepped.result.t) == n_frames - 6
+    sim.step(DT, {"cable 3": 2.0})  # elsewhere
+    sim.reset(saved)
+    assert sim.t == saved.t and len(sim.result.t) == 4
     np.testing.assert_array_equal(rollout(), first)
-    stepped.reset(saved)  # leave the fixture where it was
 
 
 def test_held_inputs_are_not_read_during_steps():
@@ -168,3 +173,28 @@ def test_streamed_frames_are_the_stepped_ones(tmp_path):
     np.testing.assert_array_equal(stored.states, in_memory.states)
     np.testing.assert_array_equal(stored.tensions[:, 10], [0.0, 0.0, 0.5, 1.0, 1.5, 2.0])
     assert (tmp_path / "run" / "rod.xdmf").is_file()
+
+
+def test_gmres_steps_as_the_band_solver_and_stages_are_announced():
+    class Recorder:
+        def __init__(self):
+            self.stages = []
+
+        def __call__(self, t, t_end):
+            pass
+
+        @contextlib.contextmanager
+        def stage(self, text):
+            self.stages.append(text)
+            yield
+
+    progress = Recorder()
+    tips = []
+    for options in ({"linsolver": "gmres", "progress": progress}, {"linsolver": "band"}):
+        sim = Simulator(rodmol.paper_arm(N), **options)
+        for k in range(10):
+            sim.step(DT, {"cable 11": 0.3 * k})
+        assert sim.stats["linear_solver"] == options["linsolver"]
+        tips.append(sim.state.tip)
+    assert np.max(np.abs(tips[0] - tips[1])) < 1e-5
+    assert any("initial equilibrium" in text for text in progress.stages)
