@@ -209,8 +209,9 @@ class SemiDiscrete:
         self.tension_values = np.array([constant[i] or 0.0 for i in active])
         timed = [(j, m.cables[i]) for j, i in enumerate(active) if constant[i] is None]
         # Inputs held over a step (rodmol.control.Simulator) are read by read_held, not per call.
-        self._held = [(j, cable) for j, cable in timed if getattr(getattr(cable.tension, "signal", None), "held", False)]
-        self._timed = [entry for entry in timed if entry not in self._held]
+        held = [getattr(getattr(cable.tension, "signal", None), "held", False) for _, cable in timed]
+        self._held = [entry for entry, h in zip(timed, held) if h]
+        self._timed = [entry for entry, h in zip(timed, held) if not h]
         self.read_held(0.0)
 
     def _setup_loads(self):
