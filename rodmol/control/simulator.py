@@ -70,14 +70,19 @@ class Simulator:
         as :func:`rodmol.simulate` does; call :meth:`close` (or use the
         simulator in a ``with`` block) to finish the files. A streamed
         simulator cannot be :meth:`reset` to an earlier time.
+    backend : "cvode"
+        The only backend (an integrator kept alive between steps).
     **backend_options
         CVODE's options (``linsolver``, ``jacobian``, ``max_order``,
         ``max_step``, ``max_nonlin_iters``), checked as by simulate.
     """
 
     def __init__(self, model, initial="equilibrium", *, scheme=DEFAULT_SCHEME, rtol=None, atol=None,
-                 t0=None, progress=None, max_wall_time=None, out=None, **backend_options):
-        args = check_run(model, initial=initial, t0=t0, scheme=scheme, backend="cvode", rtol=rtol,
+                 t0=None, progress=None, max_wall_time=None, out=None, backend="cvode", **backend_options):
+        if backend != "cvode":
+            raise ParameterError(f"`backend` {_checks.short(backend)}: the Simulator keeps CVODE alive "
+                                 "between steps and has no other backend")
+        args = check_run(model, initial=initial, t0=t0, scheme=scheme, backend=backend, rtol=rtol,
                          atol=atol, progress=progress, max_wall_time=max_wall_time,
                          backend_options=backend_options)
         self._inputs = HeldInputs.of(model)

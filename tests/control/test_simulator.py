@@ -137,6 +137,8 @@ def test_construction_checks_as_simulate():
         Simulator(model, linsovler="band")
     with pytest.raises(rodmol.ParameterError, match="unknown `initial`"):
         Simulator(model, initial="equilibirum")
+    with pytest.raises(rodmol.ParameterError, match="no other backend"):
+        Simulator(model, backend="galpha")
     with pytest.raises(rodmol.ParameterError, match="feedback tension"):
         Simulator(rodmol.paper_arm(N, tensions={1: lambda t, state: 1.0}))
 
