@@ -10,7 +10,8 @@ layout, the compiled physics and the semi-discrete scheme, its Jacobian),
 ``solve/`` (static equilibrium and the time-integration backends) and
 ``io/`` (scenario files, ParaView series, pictures, command line) and
 ``calibrate/`` (measured data, stereo reconstruction, the paper's error
-study, identification, sweeps, linearisation).
+study, identification, sweeps, linearisation) and ``control/`` (the stepping
+simulator; the gymnasium environments in ``rodmol.control.envs``).
 """
 
 from . import scenarios
@@ -27,6 +28,7 @@ from .calibrate import (
     triangulate,
     worsened_models,
 )
+from .control import Simulator
 from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
 from .discretise.system import SemiDiscrete, StateView
@@ -58,7 +60,7 @@ __all__ = [
     "BACKENDS", "Base", "BaseMotion", "Cable", "CapsuleContact", "DistributedForce",
     "DistributedMoment", "PlaneContact", "PointForce", "PointMoment", "SphereContact", "EquilibriumError", "IntegrationError", "MEDIA",
     "Marker", "Material", "Medium", "Model", "ParameterError", "Result", "Rod", "RodmolError",
-    "SCHEMES", "ScenarioError", "SemiDiscrete", "StateLayout", "StateView", "UserFunctionError",
+    "SCHEMES", "ScenarioError", "SemiDiscrete", "Simulator", "StateLayout", "StateView", "UserFunctionError",
     "default_atol", "energy",
     "equilibrium", "load_result", "load_scenario", "marker_errors", "oscillation_period", "paper_arm",
     "read_tension_csv", "scenarios", "simulate", "straight_state", "write_series",

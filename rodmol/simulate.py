@@ -3,6 +3,7 @@
 import time
 import warnings
 from contextlib import contextmanager, nullcontext
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -110,49 +111,27 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
     if resume:
         plan, first, initial = sink.resume_point()
         t0, output_times = float(plan[first]), plan[first:]
-    if isinstance(initial, Result):
-        t0 = float(initial.t[-1]) if t0 is None else t0
-        initial = _last_state(initial, model)
-    t0 = 0.0 if t0 is None else _checks.non_negative("t0", t0, " s")
+    run_args = check_run(model, initial=initial, t0=t0, scheme=scheme, backend=backend, rtol=rtol,
+                         atol=atol, progress=progress, max_wall_time=max_wall_time,
+                         backend_options=backend_options)
+    t0, run, backend_options = run_args.t0, run_args.run, run_args.backend_options
+    rtol, atol, max_wall_time = run_args.rtol, run_args.atol, run_args.max_wall_time
     t_end = _checks.positive("t_end", t_end, " s")
     if t_end <= t0:
         raise ParameterError(f"`t_end` must be after the start t0 = {t0!r} s, got {t_end!r} s")
     output_dt = _checks.positive("output_dt", output_dt, " s")
-    scheme = get_scheme(scheme)
-    rtol = options.rtol(scheme.default_rtol if rtol is None else rtol)
-    progress = options.progress(progress)
+    t_out = options.output_times(t0, t_end, output_dt, output_times, StateLayout(model.n_elements).size)
+    if plan is not None:
+        if t_end != plan[-1]:
+            raise ParameterError(f"`t_end` = {t_end!r} s: the run being resumed ends at {float(plan[-1])!r} s")
+        t_out = plan
+    progress = run_args.progress
     owned = progress is True
     if owned:
         from ._progress import Progress
 
         progress = Progress()
-    max_wall_time = options.max_wall_time(max_wall_time)
-    run = get_backend(backend)
-    backend_options = options.backend_options(backend, run, backend_options)
-    size = StateLayout(model.n_elements).size
-    t_out = options.output_times(t0, t_end, output_dt, output_times, size)
-    if plan is not None:
-        if t_end != plan[-1]:
-            raise ParameterError(f"`t_end` = {t_end!r} s: the run being resumed ends at {float(plan[-1])!r} s")
-        t_out = plan
-    if isinstance(initial, str) and initial not in INITIAL:
-        raise ParameterError(f"unknown `initial` {_checks.short(initial)}"
-                             f"{_checks.did_you_mean(initial, INITIAL)}; use 'equilibrium', "
-                             "'straight' or a state")
-    if atol is not None:
-        atol = _state_sized("atol", atol, size, positive=True, layout=StateLayout(model.n_elements))
-    if atol is None:
-        atol = default_atol(model, rtol)
-    timings = {}
-    with _stage(progress, "preparing the compiled kernels", timings, "prepare_s",
-                kernels.ready(run, backend_options)):
-        system = SemiDiscrete(model, scheme)  # the one system of this run
-        check_scales(system, t0, atol)  # before the kernels' first run, which would fail on them
-        kernels.prepare(system, t0, straight_state(model), run, rtol, atol, backend_options)
-        getattr(sink, "prepare", lambda system: None)(system)
-    with _stage(progress, f"solving the initial equilibrium at t = {t0:g} s", timings, "equilibrium_s",
-                not (isinstance(initial, str) and initial == "equilibrium")):
-        y0 = _initial_state(system, initial, t0)
+    system, y0, timings = prepare_run(model, run_args, progress, sink)
 
     try:
         if sink is not None:
@@ -169,6 +148,73 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
     if not raw.success:
         warnings.warn(raw.message, RuntimeWarning, stacklevel=2)
     return result
+
+
+@dataclass(frozen=True)
+class RunArguments:
+    """The checked arguments a run of :func:`simulate` shares with the stepping
+    simulator (:class:`rodmol.control.Simulator`); see :func:`check_run`."""
+
+    initial: object  # "equilibrium", "straight" or a checked state vector
+    t0: float
+    scheme: object
+    rtol: float
+    atol: np.ndarray
+    progress: object  # None, True or a callable
+    max_wall_time: float | None
+    backend: str
+    run: object
+    backend_options: dict
+
+
+def check_run(model, *, initial, t0, scheme, backend, rtol, atol, progress, max_wall_time,
+              backend_options):
+    """Check the arguments every run takes (see :func:`simulate`), before any work;
+    an ``initial`` Result gives its last state and, unless ``t0`` is given, its last time."""
+    if not isinstance(model, Model):
+        raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
+    if isinstance(initial, Result):
+        t0 = float(initial.t[-1]) if t0 is None else t0
+        initial = _last_state(initial, model)
+    t0 = 0.0 if t0 is None else _checks.non_negative("t0", t0, " s")
+    scheme = get_scheme(scheme)
+    rtol = options.rtol(scheme.default_rtol if rtol is None else rtol)
+    progress = options.progress(progress)
+    max_wall_time = options.max_wall_time(max_wall_time)
+    run = get_backend(backend)
+    backend_options = options.backend_options(backend, run, backend_options)
+    layout = StateLayout(model.n_elements)
+    if isinstance(initial, str):
+        if initial not in INITIAL:
+            raise ParameterError(f"unknown `initial` {_checks.short(initial)}"
+                                 f"{_checks.did_you_mean(initial, INITIAL)}; use 'equilibrium', "
+                                 "'straight' or a state")
+    else:
+        initial = _state_sized("initial", initial, layout.size, layout=layout)
+    if atol is not None:
+        atol = _state_sized("atol", atol, layout.size, positive=True, layout=layout)
+    if atol is None:
+        atol = default_atol(model, rtol)
+    return RunArguments(initial, t0, scheme, rtol, atol, progress, max_wall_time, backend, run,
+                        backend_options)
+
+
+def prepare_run(model, args, progress, sink=None):
+    """The system of ``model``, its compiled kernels made ready, and the initial state, each
+    stage announced through ``progress``: returns (system, y0, timings [s])."""
+    timings = {}
+    with _stage(progress, "preparing the compiled kernels", timings, "prepare_s",
+                kernels.ready(args.run, args.backend_options)):
+        system = SemiDiscrete(model, args.scheme)  # the one system of this run
+        check_scales(system, args.t0, args.atol)  # before the kernels' first run, which would fail on them
+        kernels.prepare(system, args.t0, straight_state(model), args.run, args.rtol, args.atol,
+                        args.backend_options)
+        getattr(sink, "prepare", lambda system: None)(system)
+    initial = args.initial
+    with _stage(progress, f"solving the initial equilibrium at t = {args.t0:g} s", timings, "equilibrium_s",
+                not (isinstance(initial, str) and initial == "equilibrium")):
+        y0 = _initial_state(system, initial, args.t0)
+    return system, y0, timings
 
 
 @contextmanager

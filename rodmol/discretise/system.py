@@ -12,6 +12,7 @@ interface (``size``, ``__call__``, ``layout``, ``pattern``, ``bandwidths``,
 
 import numpy as np
 
+from ..markers import track
 from . import centreline, external, rotations, stencil
 from .layout import StateLayout, merge
 from .physics import compile_signatures
@@ -87,11 +88,14 @@ class StateView:
 
     Attributes are computed on access: ``t`` [s], ``positions`` (N+1, 3) [m]
     global (rebuilt from the strains, as ``Result.positions``), ``tip`` (3,)
-    [m], ``rotations`` (N+1, 3, 3), ``q``, ``k``, ``v``, ``w`` (N, 3) local.
+    [m], ``rotations`` (N+1, 3, 3), ``q``, ``k``, ``v``, ``w`` (N, 3) local;
+    from :meth:`SemiDiscrete.state_view` also ``cable_lengths`` (n_cables,) [m]
+    and ``markers`` (n_markers, 3) [m] global, as ``Result.markers``.
     """
 
-    def __init__(self, layout, t, y, ds, routing=None):
+    def __init__(self, layout, t, y, ds, routing=None, markers=None):
         self.t, self._layout, self._y, self._ds, self._routing = t, layout, y, ds, routing
+        self._markers = markers  # the model, whose markers are tracked
 
     def cable_length(self, name):
         """Path length [m] of the cable called ``name`` from the base to its anchor."""
@@ -116,6 +120,10 @@ class StateView:
                                         self._layout.quaternions(self._y), self.q, self.k, self._ds)
         if name == "tip":
             return self.positions[-1]
+        if name == "markers" and self._markers is not None:
+            m = self._markers
+            return track([mk.s for mk in m.markers], m.marker_offsets[:, 1:], m.s_nodes,
+                         self.positions[None], self.rotations[None])[0]
         raise AttributeError(name)
 
 
@@ -199,7 +207,12 @@ class SemiDiscrete:
             len(active), m.n_elements)
         self._weights = self._path_weights.copy()  # times the friction factors, refreshed
         self.tension_values = np.array([constant[i] or 0.0 for i in active])
-        self._timed = [(j, m.cables[i]) for j, i in enumerate(active) if constant[i] is None]
+        timed = [(j, m.cables[i]) for j, i in enumerate(active) if constant[i] is None]
+        # Inputs held over a step (rodmol.control.Simulator) are read by read_held, not per call.
+        held = [getattr(getattr(cable.tension, "signal", None), "held", False) for _, cable in timed]
+        self._held = [entry for entry, h in zip(timed, held) if h]
+        self._timed = [entry for entry, h in zip(timed, held) if not h]
+        self.read_held(0.0)
 
     def _setup_loads(self):
         entries = self.model.grid_loads
@@ -233,6 +246,13 @@ class SemiDiscrete:
             self._weights[:] = self._path_weights * self.friction_factors(y)[self._active]
         self._grid_loads.fill(t, self.entry_values)
 
+    def read_held(self, t):
+        """Read the held tensions (time inputs with ``held = True``: a stepping simulator's
+        zero-order hold) at t into the kernel's arguments; the right-hand side then treats
+        them as constants until the next call."""
+        for j, cable in self._held:
+            self.tension_values[j] = cable.tension_at(t)
+
     def tensions(self, t, y=None):
         """Tensions of all cables at (t, y) where they leave the base, shape (n_cables,) [N]."""
         state = self.state_view(t, y) if self.global_coupling and y is not None else None
@@ -258,7 +278,7 @@ class SemiDiscrete:
 
     def state_view(self, t, y):
         """A :class:`StateView` of ``y`` at t, with the cables' path lengths."""
-        return StateView(self.layout, t, y, self.model.ds, self.routing)
+        return StateView(self.layout, t, y, self.model.ds, self.routing, self.model)
 
     def friction_factors(self, y):
         """Tension along each cable over its tension at the base, (n_cables, N),

@@ -95,15 +95,17 @@ class RunWriter:
         _load_once()
 
     def begin(self, system, t_out):
-        """Start (or, resuming, continue) a run of ``system`` with output times ``t_out``."""
+        """Start (or, resuming, continue) a run of ``system`` with output times ``t_out``
+        (None: a run without a planned end, as a stepping simulator's; the views then show
+        every ``every``-th frame, default all)."""
         from ..result import run_meta, static_arrays
 
         self.system = system
-        if self.t_out is None:
+        if self.t_out is None and t_out is not None:
             self.t_out = np.asarray(t_out, dtype=float)
         if self.static is None:
             self.static, self.meta = static_arrays(system), dict(run_meta(system), **self.extra_meta)
-        self._plan_views(len(self.t_out))
+        self._plan_views(0 if self.t_out is None else len(self.t_out))
 
     def frames(self, t, y):
         """Store the states ``y`` (n, size) at output times ``t`` (n,) as one chunk."""

@@ -62,46 +62,10 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, l
     (blow-ups, degenerate elements, stalls, the wall-time budget
     ``max_wall_time`` [s]), which also reports ``progress`` between outputs.
     """
-    from sksundae.cvode import CVODE, CVODEPrecond
+    from sksundae.cvode import CVODE
 
-    if linsolver == "auto":
-        # GMRES's Jacobian-vector products are differences of the full right-hand
-        # side, so they carry the global coupling of feedback tensions that any
-        # banded Jacobian leaves out (20x fewer steps on a P controller, N = 12).
-        big = system.layout.n_blocks >= GMRES_MIN_ELEMENTS
-        linsolver = "gmres" if (big or system.global_coupling) and _block_solvable(system) else "band"
-    if linsolver not in LINEAR_SOLVERS:
-        raise ParameterError(f"unknown `linsolver` {linsolver!r}; valid: {['auto', *LINEAR_SOLVERS]}")
-    if jacobian == "auto":
-        jacobian = "compiled" if linsolver in ("sparse", "gmres") else "sundials"
-    if jacobian not in JACOBIANS:
-        raise ParameterError(f"unknown `jacobian` {jacobian!r}; valid: {['auto', *JACOBIANS]}")
-    if linsolver == "gmres" and jacobian != "compiled":
-        raise ParameterError("linsolver='gmres' is preconditioned with the compiled Jacobian; "
-                             "use jacobian='auto' or 'compiled'")
-    if max_order == "auto":
-        max_order = 2 if system.lightly_damped else 5
-    options = dict(method="BDF", rtol=rtol, atol=atol, linsolver=linsolver,
-                   max_num_steps=1_000_000, max_step=max_step, max_order=int(max_order),
-                   max_nonlin_iters=int(max_nonlin_iters))
-    scale = np.broadcast_to(atol, (system.size,)) / rtol
-    precond = None
-    if linsolver == "gmres":
-        precond = system.preconditioner(scale)
-        # Left preconditioning, SUNDIALS' default Krylov dimension (5): the
-        # fastest of {left, right} x {1, 5} on the bending test.
-        options["precond"] = CVODEPrecond(precond.setup, precond.solve, "left")
-        options["krylov_dim"] = 5
-    elif linsolver in ("band", "lapackband"):
-        options["lband"], options["uband"] = system.bandwidths()
-    if jacobian == "compiled" and linsolver != "gmres":
-        matrix = "band" if linsolver in ("band", "lapackband") else linsolver
-        jac = system.jacobian(scale, matrix)
-        options["jacfn"] = jac
-        if matrix == "sparse":
-            options["sparsity"] = jac.sparsity
-    elif linsolver == "sparse":
-        options["sparsity"] = sparse.csc_matrix(system.pattern())
+    options, linsolver, precond = solver_options(system, rtol, atol, linsolver, max_step, jacobian,
+                                                 max_order, max_nonlin_iters)
 
     out = Outputs(t_out, y0, progress)
     watch = Watch(system, t_out, max_wall_time, progress)
@@ -172,6 +136,55 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, l
             if slow and not out.done:
                 return stop(slow)
     return run_steps(steps, stop, out, stats)
+
+
+def solver_options(system, rtol, atol, linsolver="auto", max_step=0.0, jacobian="auto", max_order="auto",
+                   max_nonlin_iters=3):
+    """scikit-sundae's ``CVODE`` options for ``system`` (see :func:`cvode` for the
+    arguments): returns (options, the linear solver chosen, the block preconditioner
+    or None). Shared with the stepping integrator (:mod:`rodmol.solve.stepping`)."""
+    from sksundae.cvode import CVODEPrecond
+
+    if linsolver == "auto":
+        # GMRES's Jacobian-vector products are differences of the full right-hand
+        # side, so they carry the global coupling of feedback tensions that any
+        # banded Jacobian leaves out (20x fewer steps on a P controller, N = 12).
+        big = system.layout.n_blocks >= GMRES_MIN_ELEMENTS
+        linsolver = "gmres" if (big or system.global_coupling) and _block_solvable(system) else "band"
+    if linsolver not in LINEAR_SOLVERS:
+        raise ParameterError(f"unknown `linsolver` {linsolver!r}; valid: {['auto', *LINEAR_SOLVERS]}")
+    if jacobian == "auto":
+        jacobian = "compiled" if linsolver in ("sparse", "gmres") else "sundials"
+    if jacobian not in JACOBIANS:
+        raise ParameterError(f"unknown `jacobian` {jacobian!r}; valid: {['auto', *JACOBIANS]}")
+    if linsolver == "gmres" and jacobian != "compiled":
+        raise ParameterError("linsolver='gmres' is preconditioned with the compiled Jacobian; "
+                             "use jacobian='auto' or 'compiled'")
+    if max_order == "auto":
+        max_order = 2 if system.lightly_damped else 5
+    options = dict(method="BDF", rtol=rtol, atol=atol, linsolver=linsolver,
+                   max_num_steps=1_000_000, max_step=max_step, max_order=int(max_order),
+                   max_nonlin_iters=int(max_nonlin_iters))
+    scale = np.broadcast_to(atol, (system.size,)) / rtol
+    precond = None
+    if linsolver == "gmres":
+        precond = system.preconditioner(scale)
+        # Left preconditioning, SUNDIALS' default Krylov dimension (5): the
+        # fastest of {left, right} x {1, 5} on the bending test.
+        options["precond"] = CVODEPrecond(precond.setup, precond.solve, "left")
+        options["krylov_dim"] = 5
+    elif linsolver in ("band", "lapackband"):
+        options["lband"], options["uband"] = system.bandwidths()
+    if jacobian == "compiled" and linsolver != "gmres":
+        matrix = "band" if linsolver in ("band", "lapackband") else linsolver
+        jac = system.jacobian(scale, matrix)
+        options["jacfn"] = jac
+        if matrix == "sparse":
+            options["sparsity"] = jac.sparsity
+    elif linsolver == "sparse":
+        options["sparsity"] = sparse.csc_matrix(system.pattern())
+
+    return options, linsolver, precond
 
 
 @contextlib.contextmanager

@@ -6,10 +6,10 @@ import signal
 import subprocess
 import sys
 import time
-import tomllib
 from pathlib import Path
 
 import pytest
+import tomllib
 from views import assert_valid_views
 
 import rodmol
