@@ -10,7 +10,8 @@ layout, the compiled physics and the semi-discrete scheme, its Jacobian),
 ``solve/`` (static equilibrium and the time-integration backends) and
 ``io/`` (scenario files, ParaView series, pictures, command line) and
 ``calibrate/`` (measured data, stereo reconstruction, the paper's error
-study, identification, sweeps, linearisation).
+study, identification, sweeps, linearisation) and ``control/`` (inverse
+statics).
 """
 
 from . import scenarios
@@ -27,6 +28,7 @@ from .calibrate import (
     triangulate,
     worsened_models,
 )
+from .control import StaticFit, inverse_statics, inverse_statics_path
 from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
 from .discretise.system import SemiDiscrete, StateView
@@ -65,4 +67,6 @@ __all__ = [
     # rodmol.calibrate: from experiment to model
     "calibrate_dlt", "identify", "linearize", "paper_errors", "sweep", "triangulate",
     "worsened_models",
+    # rodmol.control: questions a controller asks
+    "StaticFit", "inverse_statics", "inverse_statics_path",
 ]

@@ -1,11 +1,9 @@
 """Linearisation for control design: dy/dt ~ A dy + B dT about a state."""
 
-from dataclasses import replace
-
 import numpy as np
 
 from ..discretise.schemes import DEFAULT_SCHEME
-from ..discretise.system import SemiDiscrete
+from ..discretise.system import SemiDiscrete, tensions_by_hand
 from ..errors import ParameterError
 from ..model import Model
 
@@ -47,12 +45,7 @@ def linearize(model, state, t=0.0, scheme=DEFAULT_SCHEME):
     if y.shape != (layout_size,) or not np.all(np.isfinite(y)):
         raise ParameterError(f"`state` must be {layout_size} finite numbers (the state size), got shape {y.shape}")
     tensions = model.tensions(t, probe.state_view(t, y) if model.feedback else None)
-    # The same model with every cable active and its tension set by hand: a
-    # constant nonzero tension keeps each cable in the kernel.
-    # Everything else of each cable (routing, friction) stays as it is.
-    held = model.replace(cables=[replace(c, tension=1.0, displacement=None, compliance=None,
-                                         base_to_actuator=0.0, rest_length=None) for c in model.cables])
-    system = SemiDiscrete(held, scheme)
+    system = SemiDiscrete(tensions_by_hand(model), scheme)
 
     def rates(x, cable_tensions):
         return system.rest_rates(t, x, np.empty(system.size), tensions=cable_tensions)
