@@ -28,6 +28,7 @@ SCRIPTS = {
     "long_output.py": ["long_output.csv", "long_output.md"],
     "stiff_cantilever.py": ["stiff_cantilever.csv", "stiff_cantilever.md"],
     "view_open.py": ["view_open.csv", "view_open.md"],
+    "inverse_statics.py": ["inverse_statics.csv", "inverse_statics.md"],
 }
 
 
