@@ -20,6 +20,7 @@ from .arm import paper_arm
 from .base_motion import Base, BaseMotion
 from .cables import Cable, read_tension_csv
 from .calibrate import (
+    LinearModel,
     calibrate_dlt,
     identify,
     linearize,
@@ -65,7 +66,7 @@ __all__ = [
     "equilibrium", "load_result", "load_scenario", "marker_errors", "oscillation_period", "paper_arm",
     "read_tension_csv", "scenarios", "simulate", "straight_state", "write_series",
     # rodmol.calibrate: from experiment to model
-    "calibrate_dlt", "identify", "linearize", "paper_errors", "sweep", "triangulate",
+    "LinearModel", "calibrate_dlt", "identify", "linearize", "paper_errors", "sweep", "triangulate",
     "worsened_models",
     # rodmol.control: questions a controller asks
     "StaticFit", "inverse_statics", "inverse_statics_path",
