@@ -29,6 +29,7 @@ SCRIPTS = {
     "stiff_cantilever.py": ["stiff_cantilever.csv", "stiff_cantilever.md"],
     "view_open.py": ["view_open.csv", "view_open.md"],
     "inverse_statics.py": ["inverse_statics.csv", "inverse_statics.md"],
+    "linear_mpc.py": ["linear_mpc.csv", "linear_mpc.md"],
 }
 
 

@@ -49,6 +49,8 @@ class LinearModel:
         self.inputs, self.outputs = tuple(inputs), tuple(outputs)
         self.state, self.t, self.dt, self.projection = state, t, dt, projection
         self._named = dict(named_outputs or {})  # name -> (C rows over the whole state, names)
+        self._modes = None  # (eigenvalues, right, left eigenvectors) of A
+        self._owner = self  # the model whose A this one shares (and its modes)
 
     def __iter__(self):
         return iter((self.A, self.B))
@@ -63,7 +65,20 @@ class LinearModel:
                       state=self.state, t=self.t, dt=self.dt, projection=self.projection,
                       named_outputs=self._named)
         fields.update(changes)
-        return LinearModel(**fields)
+        model = LinearModel(**fields)
+        if "A" not in changes:
+            model._owner = self._owner
+        return model
+
+    def modes(self):
+        """Eigenvalues [1/s] and right and left eigenvectors of A (columns,
+        rows), computed once (a dense eigendecomposition: the cost of
+        :meth:`reduced`) and shared with the models this one makes."""
+        owner = self._owner
+        if owner._modes is None:
+            lam, right = scipy.linalg.eig(owner.A)
+            owner._modes = lam, right, np.linalg.inv(right)
+        return owner._modes
 
     def output(self, output="tip"):
         """The same model with output ``output``: ``"tip"``, the tip position
@@ -110,8 +125,7 @@ class LinearModel:
             raise ParameterError("`reduced` needs an output: give `output` (e.g. 'tip')")
         if order is not None:
             order = _checks.integer_at_least("order", order, 1)
-        lam, right = scipy.linalg.eig(model.A)
-        left = np.linalg.inv(right)
+        lam, right, left = model.modes()
         gain_in = np.linalg.norm(left @ model.B, axis=1)
         gain_out = np.linalg.norm(model.C @ right, axis=0)
         coupled = (gain_in > DECOUPLED * gain_in.max()) & (gain_out > DECOUPLED * gain_out.max())

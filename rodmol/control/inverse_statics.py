@@ -385,14 +385,14 @@ class _Problem:
                 displacements[names[i]] = float(cable.tension.position_for(view.cable_length(names[i]),
                                                                            tensions[j]))
         reachable = residual <= tol
-        how = f"in {iterations} steps ({self.equilibria} equilibria)"
+        how = f"in {iterations} step{'' if iterations == 1 else 's'} ({self.equilibria} equilibria)"
         if reachable:
             message = f"target met to {residual:.3g} m {how}"
         else:
             upper = [f"{names[i]} ({self.high[j]:.4g} N)" for j, i in enumerate(self.index)
                      if active.get(names[i]) == "upper"]
-            message = (f"target not reached within the bounds (a local minimum: another `start` may "
-                       f"do better): residual {residual:.3g} m > tol {tol:.3g} m "
+            why = "" if upper else " (a local minimum: another `start` may do better)"
+            message = (f"target not reached within the bounds{why}: residual {residual:.3g} m > tol {tol:.3g} m "
                        f"{how}; at an upper bound: {', '.join(upper) or 'none'}; at the lower bound: "
                        f"{', '.join(n for n, side in active.items() if side == 'lower') or 'none'}")
         return StaticFit(dict(zip(names, all_tensions.tolist())), displacements, y, y[self._tip].copy(),
