@@ -1,4 +1,5 @@
-"""Inverse statics: the cable tensions whose static equilibrium puts the tip at a target.
+"""Inverse statics: the cable tensions whose static equilibrium puts the tip (its
+tangent, markers) at a target.
 
 A bounded Levenberg-Marquardt loop over the tensions of the actuated cables.
 Each iterate is a static equilibrium (:mod:`rodmol.solve.equilibrium`) warm-
@@ -18,20 +19,18 @@ import numpy as np
 from scipy.optimize import lsq_linear
 
 from .. import _checks
-from ..discretise import rotations
+from ..discretise.layout import StateLayout
 from ..discretise.schemes import DEFAULT_SCHEME
 from ..discretise.system import SemiDiscrete, tensions_by_hand
 from ..errors import EquilibriumError, ParameterError
 from ..model import Model
 from ..solve.equilibrium import _rest_state, tension_sensitivity
+from ._targets import Targets, check_aims
 
 #: Default reach tolerance [m] on the weighted tip residual.
 REACH_TOLERANCE = 1e-4
 #: The loop stops once the residual is this fraction of the reach tolerance.
 _PRECISION = 1e-3
-#: Step [-] of the central differences of the tip direction in its quaternion
-#: (a closed-form 3 x 4 derivative, differenced for brevity: no equilibrium solve).
-_QUATERNION_STEP = 1e-7
 
 
 @dataclass(frozen=True)
@@ -52,12 +51,15 @@ class StaticFit:
     tip : (3,) array
         Its tip position [m], global frame.
     residual : float
-        The weighted residual [m]: sqrt(|tip - target|^2 + (w |d - d_target|)^2),
-        d the tip's tangent (global), w the ``direction_weight``.
-    tip_error : float
+        The weighted residual [m]: sqrt(|tip - target|^2 + (w_d |d - d_target|)^2
+        + w_m^2 sum |marker - target|^2), d the tip's tangent (global), w_d the
+        ``direction_weight``, w_m the ``marker_weight`` (each term if aimed at).
+    tip_error : float or None
         |tip - target| [m].
     direction_error : float or None
         Angle [rad] between the tip's tangent and the target direction.
+    marker_errors : dict
+        Marker name -> |marker - target| [m], for the markers aimed at.
     reachable : bool
         ``residual <= tol``.
     active : dict
@@ -72,8 +74,9 @@ class StaticFit:
     state: np.ndarray = field(repr=False)
     tip: np.ndarray
     residual: float
-    tip_error: float
+    tip_error: float | None
     direction_error: float | None
+    marker_errors: dict
     reachable: bool
     active: dict
     message: str
@@ -93,9 +96,9 @@ class StaticFit:
         return model.replace(cables=cables)
 
 
-def inverse_statics(model, tip, *, direction=None, bounds=(0.0, np.inf), cables=None, t=0.0,
-                    tol=REACH_TOLERANCE, direction_weight=None, start=None, scheme=DEFAULT_SCHEME,
-                    max_iter=50):
+def inverse_statics(model, tip=None, *, direction=None, markers=None, bounds=(0.0, np.inf), cables=None,
+                    t=0.0, tol=REACH_TOLERANCE, direction_weight=None, marker_weight=1.0, start=None,
+                    scheme=DEFAULT_SCHEME, max_iter=50):
     """The cable tensions, within bounds, whose static equilibrium puts the tip at ``tip``.
 
     Parameters
@@ -103,11 +106,14 @@ def inverse_statics(model, tip, *, direction=None, bounds=(0.0, np.inf), cables=
     model : Model
         Its loads (gravity, buoyancy, external loads, contact at ``t``) act;
         the cables not in ``cables`` keep their tensions.
-    tip : (3,) array
+    tip : (3,) array, optional
         Target tip position [m], global frame.
     direction : (3,) array, optional
         Target direction of the tip's tangent (its local x axis), global
         frame; normalised here.
+    markers : dict, optional
+        Marker name (one of ``model.markers``) -> target position [m],
+        global frame. At least one of ``tip``, ``direction``, ``markers``.
     bounds : (low, high)
         Tension bounds [N], each a number or one per actuated cable (in the
         order of ``cables``); 0 <= low < high (``high`` may be ``inf``).
@@ -121,7 +127,9 @@ def inverse_statics(model, tip, *, direction=None, bounds=(0.0, np.inf), cables=
     tol : float
         Reach tolerance [m] on the weighted residual (default 0.1 mm).
     direction_weight : float, optional
-        Length w [m] weighting the direction error (default: the rod's length).
+        Length w_d [m] weighting the direction error (default: the rod's length).
+    marker_weight : float
+        Weight w_m [-] of the markers' errors against the tip's.
     start : (n_actuated,) array, optional
         Initial tensions [N]; default the model's tensions at ``t`` (clipped
         to the bounds).
@@ -147,13 +155,13 @@ def inverse_statics(model, tip, *, direction=None, bounds=(0.0, np.inf), cables=
     EquilibriumError
         No equilibrium under the initial tensions.
     """
-    tip = _checks.vector3("tip", tip)
-    if direction is not None:
-        _checks.vector3("direction", direction)
+    _check_model(model)
+    tip, direction, names, positions = check_aims(model, tip, direction, markers)
     tol = _checks.positive("tol", tol, " m")
     max_iter = _checks.integer_at_least("max_iter", max_iter, 1)
-    problem = _Problem(model, cables, bounds, t, scheme, direction_weight)
-    return problem.fit(problem.target(tip, direction), problem.start(start), tol, max_iter)
+    problem = _Problem(model, cables, bounds, t, scheme, (tip is not None, direction is not None, names),
+                       direction_weight, marker_weight)
+    return problem.fit(problem.targets.aim(tip, direction, positions), problem.start(start), tol, max_iter)
 
 
 def inverse_statics_path(model, tips, *, directions=None, **options):
@@ -181,14 +189,17 @@ def inverse_statics_path(model, tips, *, directions=None, **options):
         if len(directions) != len(tips):
             raise ParameterError(f"`directions` must have one row per target ({len(tips)}), got {len(directions)}")
     unknown = set(options) - {"bounds", "cables", "t", "tol", "direction_weight", "start", "scheme", "max_iter"}
+    _check_model(model)
     if unknown:
         raise ParameterError(f"unknown options {sorted(unknown)} for inverse_statics_path")
     tol = _checks.positive("tol", options.get("tol", REACH_TOLERANCE), " m")
     max_iter = _checks.integer_at_least("max_iter", options.get("max_iter", 50), 1)
+    aims = [check_aims(model, p, None if directions is None else d, None)
+            for p, d in zip(tips, directions if directions is not None else tips)]
     problem = _Problem(model, options.get("cables"), options.get("bounds", (0.0, np.inf)), options.get("t", 0.0),
-                       options.get("scheme", DEFAULT_SCHEME), options.get("direction_weight"))
-    targets = [problem.target(p, None if directions is None else d)
-               for p, d in zip(tips, directions if directions is not None else tips)]
+                       options.get("scheme", DEFAULT_SCHEME), (True, directions is not None, []),
+                       options.get("direction_weight"), 1.0)
+    targets = [problem.targets.aim(tip, direction, None) for tip, direction, _, _ in aims]
     tensions = problem.start(options.get("start"))
     fits = []
     for target in targets:
@@ -207,18 +218,23 @@ def _targets(name, value):
     return arr
 
 
-class _Problem:
-    """The tip of the equilibrium as a function of the actuated tensions."""
+def _check_model(model):
+    if not isinstance(model, Model):
+        raise ParameterError(f"`model` must be a rodmol.Model, got {_checks.short(model)}")
 
-    def __init__(self, model, cables, bounds, t, scheme, direction_weight):
-        if not isinstance(model, Model):
-            raise ParameterError(f"`model` must be a rodmol.Model, got {_checks.short(model)}")
+
+class _Problem:
+    """The aimed-at outputs of the equilibrium as functions of the actuated tensions."""
+
+    def __init__(self, model, cables, bounds, t, scheme, aims, direction_weight, marker_weight):
         self.model, self.t = model, _checks.finite("t", t)
         self.names = [c.name for c in model.cables]
         self.index = self._actuated(cables)
         self.low, self.high = self._bounds(bounds)
-        self.weight = (model.rod.length if direction_weight is None
-                       else _checks.positive("direction_weight", direction_weight, " m"))
+        weight = (model.rod.length if direction_weight is None
+                  else _checks.positive("direction_weight", direction_weight, " m"))
+        self.targets = Targets(model, StateLayout(model.n_elements), *aims, weight,
+                               _checks.positive("marker_weight", marker_weight))
         held = np.setdiff1d(np.arange(len(model.cables)), self.index)
         for i in held:
             if model.cables[i].tension.feedback:
@@ -227,8 +243,7 @@ class _Problem:
         self.tensions = np.zeros(len(model.cables))
         self.tensions[held] = [model.cables[i].tension_at(self.t) for i in held]
         self.system = SemiDiscrete(tensions_by_hand(model), scheme)
-        layout = self.system.layout
-        self._tip, self._quat = layout.tip_slice("u"), layout.tip_slice("Q")
+        self._tip = self.system.layout.tip_slice("u")
         self.warm, self.equilibria = None, 0
 
     def _actuated(self, cables):
@@ -270,16 +285,6 @@ class _Problem:
                                  "(to hold a cable's tension fixed, leave it out of `cables`)")
         return low, high
 
-    def target(self, tip, direction):
-        tip = _checks.vector3("tip", tip)
-        if direction is None:
-            return tip
-        direction = _checks.vector3("direction", direction)
-        size = np.linalg.norm(direction)
-        if size == 0.0:
-            raise ParameterError("`direction` must be a nonzero vector, got (0, 0, 0)")
-        return np.concatenate([tip, self.weight * direction / size])
-
     def start(self, start):
         if start is None:
             values = np.array([self.model.cables[i].tension_at(self.t) for i in self.index])
@@ -302,33 +307,17 @@ class _Problem:
         self.warm = y
         return y
 
-    def outputs(self, y, n_out):
-        tip = y[self._tip]
-        if n_out == 3:
-            return tip
-        return np.concatenate([tip, self.weight * rotations.matrices(y[self._quat])[:, 0]])
-
-    def jacobian(self, y, actuated, n_out):
+    def jacobian(self, y, actuated):
         """d outputs / d actuated tensions [m/N], exact up to the equilibrium's tolerance."""
         d_y = tension_sensitivity(self.system, y, self.all_tensions(actuated), self.t)[:, self.index]
-        rows = [d_y[self._tip]]
-        if n_out == 6:
-            quat = y[self._quat]
-            d_dir = np.empty((3, 4))
-            for j in range(4):
-                h = np.zeros(4)
-                h[j] = _QUATERNION_STEP
-                d_dir[:, j] = (rotations.matrices(quat + h)[:, 0] - rotations.matrices(quat - h)[:, 0]) / (2 * h[j])
-            rows.append(self.weight * d_dir @ d_y[self._quat])
-        return np.vstack(rows)
+        return self.targets.rows(y) @ d_y[self.targets.entries]
 
     def fit(self, target, tensions, tol, max_iter):
         """Levenberg-Marquardt with bounds from ``tensions``."""
-        n_out = target.size
         self.equilibria = 0
         y = self.rest(tensions)
-        r = self.outputs(y, n_out) - target
-        jac = self.jacobian(y, tensions, n_out)
+        r = self.targets.values(y) - target
+        jac = self.jacobian(y, tensions)
         mu = 1e-6 * max(np.max(np.sum(jac**2, axis=0)), 1e-30)
         accepted = 0
         for _ in range(max_iter):
@@ -349,11 +338,11 @@ class _Problem:
             except EquilibriumError:  # e.g. buckling under the trial tensions: a shorter step
                 ratio = -np.inf
             else:
-                r_new = self.outputs(y_new, n_out) - target
+                r_new = self.targets.values(y_new) - target
                 ratio = (cost - r_new @ r_new) / predicted
             if ratio > 1e-4:
                 tensions, y, r = trial, y_new, r_new
-                jac = self.jacobian(y, tensions, n_out)
+                jac = self.jacobian(y, tensions)
                 accepted += 1
             else:
                 self.warm = y  # the next trial starts from the accepted state
@@ -362,12 +351,7 @@ class _Problem:
 
     def _report(self, target, tensions, y, r, tol, iterations):
         residual = float(np.linalg.norm(r))
-        tip_error = float(np.linalg.norm(r[:3]))
-        angle = None
-        if target.size == 6:
-            tangent = rotations.matrices(y[self._quat])[:, 0]
-            aim = target[3:] / self.weight
-            angle = float(np.arctan2(np.linalg.norm(np.cross(tangent, aim)), tangent @ aim))
+        tip_error, angle, marker_errors = self.targets.errors(y, target)
         all_tensions = self.all_tensions(tensions)
         names = self.names
         scale = 1e-9 * max(1.0, float(np.max(self.high[np.isfinite(self.high)], initial=1.0)))
@@ -396,4 +380,5 @@ class _Problem:
                        f"{how}; at an upper bound: {', '.join(upper) or 'none'}; at the lower bound: "
                        f"{', '.join(n for n, side in active.items() if side == 'lower') or 'none'}")
         return StaticFit(dict(zip(names, all_tensions.tolist())), displacements, y, y[self._tip].copy(),
-                         residual, tip_error, angle, reachable, active, message, iterations, self.equilibria)
+                         residual, tip_error, angle, marker_errors, reachable, active, message, iterations,
+                         self.equilibria)

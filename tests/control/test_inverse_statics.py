@@ -55,6 +55,20 @@ def test_position_and_direction_recover_four_tensions(arm, pulled):
     assert np.allclose(rest_pose(fit.apply(arm))[0], tip, atol=1e-7)
 
 
+def test_markers_alone_recover_the_tensions(arm):
+    """Three markers on the surface (no tip target) fix four cables; their errors
+    are reported by name."""
+    loaded = rodmol.paper_arm(N, tensions=PULLED)
+    run = rodmol.simulate(loaded, 1e-4, initial="equilibrium", output_dt=1e-4)  # a Result's markers, as measured
+    aims = dict(zip(("L1", "L2", "L3"), run.markers[0, :3]))
+    fit = inverse_statics(arm, markers=aims, cables=["cable 11", "cable 12", "cable 3", "cable 7"],
+                          bounds=(0.0, 5.0))
+    assert fit.reachable and fit.tip_error is None and set(fit.marker_errors) == {"L1", "L2", "L3"}
+    assert max(fit.marker_errors.values()) < 1e-7
+    for number, tension in {**PULLED, 7: 0.0}.items():
+        assert fit.tensions[f"cable {number}"] == pytest.approx(tension, abs=1e-5)
+
+
 def test_all_cables_meet_the_tip(arm, pulled):
     """Twelve cables for three coordinates: many solutions, the tip met by one."""
     fit = inverse_statics(arm, pulled[0], bounds=(0.0, 5.0))
@@ -126,6 +140,9 @@ def test_a_path_reuses_the_previous_solution(arm):
     (dict(tip=(0.1, 0.2, 0.0), cables=["cable 13"]), "`cables`"),
     (dict(tip=(0.1, 0.2, 0.0), direction=(0.0, 0.0, 0.0)), "`direction`"),
     (dict(tip=(0.1, 0.2, 0.0), tol=0.0), "`tol`"),
+    (dict(markers={"L4": (0.1, 0.2, 0.0)}), "`markers`"),
+    (dict(markers={"L2": (0.1, 0.2)}), "markers"),
+    (dict(), "give a target"),
 ])
 def test_bad_input_is_named_before_any_equilibrium(arm, monkeypatch, kwargs, named):
     def no_work(*args, **kwargs):
