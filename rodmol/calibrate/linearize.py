@@ -106,8 +106,7 @@ def _tip_rows(system, t, y):
     u(L), which differs from it by the time discretisation's drift), by central
     differences of that geometric function over the entries it reads."""
     layout = system.layout
-    index = np.arange(layout.size)
-    entries = np.concatenate([layout.field(index, f).ravel() for f in ("Q", "q", "k")])
+    entries = np.concatenate([_field_rows(layout, f).ravel() for f in ("Q", "q", "k")])
     h = _STRAIN_STEP * np.maximum(np.abs(y[entries]), system.atol_scale()[entries])
     rows = np.zeros((3, layout.size))
     for i, step in zip(entries, h):
@@ -124,22 +123,21 @@ def _tendons(model, system, t, y, a, b):
     motors = [(j, c) for j, c in enumerate(model.cables) if c.actuated]
     if not motors:
         return []
-    layout = system.layout
-    q, k = layout.field(y, "q"), layout.field(y, "k")
-    lengths = system.routing.lengths(q, k)
-    strains = np.hstack([q, k]).ravel()  # the path lengths read only q and k
-    typical = np.tile([1.0, 1.0, 1.0] + [1.0 / model.rod.length] * 3, model.n_elements)  # q ~ 1, k ~ 1/L
+    layout, n = system.layout, model.n_elements
+    strains = np.hstack([layout.field(y, "q"), layout.field(y, "k")])  # the path lengths read only q and k
+    lengths = system.routing.lengths(strains[:, :3], strains[:, 3:])
+    typical = np.tile([1.0] * 3 + [1.0 / model.rod.length] * 3, (n, 1))  # q ~ 1, k ~ 1/L
     h = _STRAIN_STEP * np.maximum(np.abs(strains), typical)
-    shifted = np.tile(strains, (2 * strains.size, 1))
-    shifted[np.arange(strains.size), np.arange(strains.size)] += h
-    shifted[strains.size + np.arange(strains.size), np.arange(strains.size)] -= h
-    shifted = shifted.reshape(-1, model.n_elements, 6)
-    moved = system.routing.lengths(shifted[..., :3], shifted[..., 3:])
-    d_length = (moved[:strains.size] - moved[strains.size:]) / (2 * h[:, None])  # (6N, n_cables)
-    rows = np.zeros((model.n_elements, 6), dtype=int)
-    rows[:, :3] = _field_rows(layout, "q")
-    rows[:, 3:] = _field_rows(layout, "k")
-    rows = rows.ravel()
+    d_length = np.empty((n, 6, len(model.cables)))
+    both = np.empty((2, n, 6))
+    for element, c in np.ndindex(n, 6):
+        both[:] = strains
+        both[0, element, c] += h[element, c]
+        both[1, element, c] -= h[element, c]
+        moved = system.routing.lengths(both[..., :3], both[..., 3:])
+        d_length[element, c] = (moved[0] - moved[1]) / (2 * h[element, c])
+    d_length = d_length.reshape(6 * n, -1)
+    rows = np.hstack([_field_rows(layout, "q"), _field_rows(layout, "k")]).ravel()
     out = []
     for j, cable in motors:
         stiffness, gain = cable.tension.slopes(t, lengths[j])
