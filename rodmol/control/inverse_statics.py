@@ -24,7 +24,7 @@ from ..discretise.schemes import DEFAULT_SCHEME
 from ..discretise.system import SemiDiscrete, tensions_by_hand
 from ..errors import EquilibriumError, ParameterError
 from ..model import Model
-from ..solve.equilibrium import _rest_state, tension_sensitivity
+from ..solve.equilibrium import rest_state, tension_sensitivity
 from ._targets import Targets, check_aims
 
 #: Default reach tolerance [m] on the weighted tip residual.
@@ -303,7 +303,7 @@ class _Problem:
     def rest(self, actuated):
         """The equilibrium under the actuated tensions, warm-started from the last one."""
         self.equilibria += 1
-        y = _rest_state(self.system, self.t, 1e-10, 40, self.all_tensions(actuated), start=self.warm)
+        y = rest_state(self.system, self.all_tensions(actuated), self.t, start=self.warm)
         self.warm = y
         return y
 

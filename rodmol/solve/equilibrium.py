@@ -269,6 +269,16 @@ def tension_sensitivity(system, y, tensions, t=0.0):
     return out.T
 
 
+def rest_state(system, tensions, t=0.0, *, start=None, tol=1e-10, max_iter=40):
+    """The rest state of ``system`` under cable ``tensions`` [N] (the other
+    loads at t), as :func:`equilibrium` finds it but without its checks:
+    Newton's method from ``start`` (a nearby rest state) first, the load
+    continuation from the straight rod if that fails. For loops that solve
+    many nearby equilibria (the inverse statics); raises
+    :class:`EquilibriumError` if none is found."""
+    return _rest_state(system, t, tol, max_iter, tensions, start)
+
+
 def _rest_state(system, t, tol, max_iter, tensions=None, start=None):
     """The rest state under the loads at t (cable ``tensions`` [N] if given).
     ``start``, a nearby rest state (the closed loop's last iterate), is tried

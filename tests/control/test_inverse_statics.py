@@ -148,7 +148,7 @@ def test_bad_input_is_named_before_any_equilibrium(arm, monkeypatch, kwargs, nam
     def no_work(*args, **kwargs):
         raise AssertionError("an equilibrium was solved")
 
-    monkeypatch.setattr(sys.modules["rodmol.control.inverse_statics"], "_rest_state", no_work)
+    monkeypatch.setattr(sys.modules["rodmol.control.inverse_statics"], "rest_state", no_work)
     with pytest.raises(rodmol.ParameterError, match=named):
         inverse_statics(arm, **kwargs)
 
