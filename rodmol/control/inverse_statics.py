@@ -99,7 +99,8 @@ class StaticFit:
 def inverse_statics(model, tip=None, *, direction=None, markers=None, bounds=(0.0, np.inf), cables=None,
                     t=0.0, tol=REACH_TOLERANCE, direction_weight=None, marker_weight=1.0, start=None,
                     scheme=DEFAULT_SCHEME, max_iter=50):
-    """The cable tensions, within bounds, whose static equilibrium puts the tip at ``tip``.
+    """The cable tensions, within bounds, whose static equilibrium puts the tip at
+    ``tip`` (its tangent along ``direction``, markers at ``markers``).
 
     Parameters
     ----------
