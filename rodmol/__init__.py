@@ -11,7 +11,7 @@ layout, the compiled physics and the semi-discrete scheme, its Jacobian),
 ``io/`` (scenario files, ParaView series, pictures, command line) and
 ``calibrate/`` (measured data, stereo reconstruction, the paper's error
 study, identification, sweeps, linearisation) and ``control/`` (the stepping
-simulator; the gymnasium environments in ``rodmol.control.envs``).
+simulator, inverse statics; the gymnasium environments in ``rodmol.control.envs``).
 """
 
 from . import scenarios
@@ -20,6 +20,7 @@ from .arm import paper_arm
 from .base_motion import Base, BaseMotion
 from .cables import Cable, read_tension_csv
 from .calibrate import (
+    LinearModel,
     calibrate_dlt,
     identify,
     linearize,
@@ -28,7 +29,7 @@ from .calibrate import (
     triangulate,
     worsened_models,
 )
-from .control import Simulator
+from .control import Simulator, StaticFit, inverse_statics, inverse_statics_path
 from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
 from .discretise.system import SemiDiscrete, StateView
@@ -65,6 +66,8 @@ __all__ = [
     "equilibrium", "load_result", "load_scenario", "marker_errors", "oscillation_period", "paper_arm",
     "read_tension_csv", "scenarios", "simulate", "straight_state", "write_series",
     # rodmol.calibrate: from experiment to model
-    "calibrate_dlt", "identify", "linearize", "paper_errors", "sweep", "triangulate",
+    "LinearModel", "calibrate_dlt", "identify", "linearize", "paper_errors", "sweep", "triangulate",
     "worsened_models",
+    # rodmol.control: questions a controller asks
+    "StaticFit", "inverse_statics", "inverse_statics_path",
 ]

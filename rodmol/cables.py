@@ -124,6 +124,20 @@ class ActuatorTension(Tension):
         free = self.free_length(t)
         return max(0.0, (length + self.base_to_actuator - free) / (free * self.compliance))
 
+    def position_for(self, length, tension):
+        """Actuator position z [m] that holds ``tension`` [N] > 0 over a path of
+        ``length`` [m] (the inverse of :meth:`from_length`); at 0 N, the position
+        that leaves the tendon just taut."""
+        return (length + self.base_to_actuator) / (1.0 + self.compliance * tension) - self.rest_length
+
+    def slopes(self, t, length):
+        """(dT / d path length, dT / dz) [N/m] at path ``length`` [m] and time t:
+        the tendon's stiffness and the actuator's gain (both 0 when slack)."""
+        free = self.free_length(t)
+        if self.from_length(t, length) == 0.0:
+            return 0.0, 0.0
+        return 1.0 / (free * self.compliance), -(length + self.base_to_actuator) / (free**2 * self.compliance)
+
     def __call__(self, t, state=None):
         length = self.straight_length if state is None else state.cable_length(self.name)
         return self.from_length(t, length)

@@ -145,6 +145,20 @@ def _closed_loop(out):
     assert table["Simulator"]["ratio_to_replay"] < table["per-period simulate"]["ratio_to_replay"]
 
 
+def _inverse_statics(out):
+    for row in rows(out / "inverse_statics.csv"):
+        assert row["reachable"] and row["residual_m"] < 1e-4, row  # reachable targets met to 0.1 mm
+        if row["case"].startswith("path"):
+            assert row["ratio_to_forward"] < 5, row  # a path target costs a few forward equilibria at most
+
+
+def _linear_mpc(out):
+    for row in rows(out / "linear_mpc.csv"):
+        errors = [row[f"error_{k}_pct"] for k in (4, 8, 16, 32) if f"error_{k}_pct" in row]
+        assert errors == sorted(errors, reverse=True), row  # more modes kept, closer to the full model
+        assert errors[-1] < 5, row
+
+
 SCRIPTS = {
     "scaling.py": (["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"], _scaling),
     "temporal.py": (["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv", "temporal_options.csv"],
@@ -163,6 +177,8 @@ SCRIPTS = {
     "stiff_cantilever.py": (["stiff_cantilever.csv", "stiff_cantilever.md"], _stiff_cantilever),
     "view_open.py": (["view_open.csv", "view_open.md"], _view_open),
     "closed_loop.py": (["closed_loop.csv", "closed_loop.md"], _closed_loop),
+    "inverse_statics.py": (["inverse_statics.csv", "inverse_statics.md"], _inverse_statics),
+    "linear_mpc.py": (["linear_mpc.csv", "linear_mpc.md"], _linear_mpc),
 }
 
 

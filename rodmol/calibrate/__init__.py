@@ -6,11 +6,13 @@ Runs go to a dask.distributed cluster (a LocalCluster by default, see
 :mod:`~rodmol.calibrate.parallel`). Modules: :mod:`~.measured` (CSV tables),
 :mod:`~.dlt` (cameras, triangulation), :mod:`~.variants` (dotted overrides),
 :mod:`~.paper_errors`, :mod:`~.study`, :mod:`~.identify`, :mod:`~.sweep`,
-:mod:`~.linearize`, :mod:`~.synthetic` (the project's synthetic experiment).
+:mod:`~.linearize` and :mod:`~.linear_model` (reduced and sampled forms for
+model-predictive control), :mod:`~.synthetic` (the project's synthetic experiment).
 """
 
 from .dlt import Camera, calibrate_dlt, reprojection_errors, triangulate
 from .identify import Fit, identify
+from .linear_model import LinearModel
 from .linearize import linearize
 from .measured import (
     MarkerTracks,
@@ -31,7 +33,7 @@ from .sweep import Sweep, grid, sweep
 from .variants import apply, spec_of
 
 __all__ = [
-    "VARIANTS", "Camera", "ErrorTable", "Fit", "MarkerTracks", "PixelTracks", "Study", "Sweep",
+    "VARIANTS", "Camera", "ErrorTable", "Fit", "LinearModel", "MarkerTracks", "PixelTracks", "Study", "Sweep",
     "TensionLog", "apply", "calibrate_dlt", "grid", "identify", "linearize", "paper_errors",
     "plot_errors", "read_control_points", "read_marker_tracks", "read_pixel_tracks",
     "read_tension_log", "reprojection_errors", "spec_of", "sweep", "triangulate",

@@ -1,13 +1,25 @@
-"""Linearisation for control design: dy/dt ~ A dy + B dT about a state."""
+"""Linearisation for control design: dy/dt ~ A dy + B du about a state.
 
-from dataclasses import replace
+The inputs u are the cable tensions, the actuator positions of
+displacement-controlled cables and the components of point loads; the
+result is a :class:`~rodmol.calibrate.linear_model.LinearModel`, which also
+gives the output of the tip, a reduced form and the zero-order-hold
+discretisation for model-predictive control.
+"""
 
 import numpy as np
 
+from ..discretise import stencil
 from ..discretise.schemes import DEFAULT_SCHEME
-from ..discretise.system import SemiDiscrete
+from ..discretise.system import SemiDiscrete, tensions_by_hand
 from ..errors import ParameterError
+from ..loads import PointForce, PointMoment
 from ..model import Model
+from .linear_model import LinearModel
+
+#: Step [-] of the central differences of the cables' path lengths in the
+#: strains (a smooth geometric function: its truncation error is about 1e-14).
+_STRAIN_STEP = 1e-7
 
 
 def linearize(model, state, t=0.0, scheme=DEFAULT_SCHEME):
@@ -25,15 +37,27 @@ def linearize(model, state, t=0.0, scheme=DEFAULT_SCHEME):
 
     Returns
     -------
-    A : (size, size) d f / d y, from the system's compiled Jacobian, with the
-        cable tensions held at their values at (state, t) (open loop: a
-        feedback law's or an actuator's own dependence on the state is not in
-        A). With friction, whose factors along each cable depend on the
-        sliding of its whole path, A comes from central differences instead.
-    B : (size, n_cables) d f / d T [per N], one column per cable in the
-        model's order. The right-hand side is affine in the tensions (the
-        cable loads are T times a function of the state), so B is exact up
-        to rounding, slack cables included.
+    LinearModel
+        ``A`` (size, size) d f / d y with every input held: the tension of a
+        tension-driven cable (open loop: a feedback law's own dependence on
+        the state is not in A), the actuator position of a displacement-
+        controlled cable (so the tendon's stiffness, its tension's dependence
+        on the path length, is in A). With friction, whose factors along each
+        cable depend on the sliding of its whole path, A comes from central
+        differences instead of the compiled Jacobian.
+        ``B`` (size, n_inputs), one column per input, named in ``inputs``:
+
+        - ``"<cable> tension [N]"``, every cable in the model's order: d f / d T,
+          a tension added to the cable's own (slack cables included). The
+          right-hand side is affine in the tensions, so these are exact up
+          to rounding.
+        - ``"<cable> displacement [m]"``, each displacement-controlled cable:
+          d f / d z of its actuator position (0 where the tendon is slack).
+        - ``"<load> x|y|z [N]"`` (``[N m]`` for a moment), three per point
+          force or moment, the components in the load's own frame (global for
+          ``frame="global"``, the section's for ``"local"``): exact as well.
+
+        It unpacks as before: ``A, B = linearize(...)``.
     """
     if not isinstance(model, Model):
         raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
@@ -47,12 +71,7 @@ def linearize(model, state, t=0.0, scheme=DEFAULT_SCHEME):
     if y.shape != (layout_size,) or not np.all(np.isfinite(y)):
         raise ParameterError(f"`state` must be {layout_size} finite numbers (the state size), got shape {y.shape}")
     tensions = model.tensions(t, probe.state_view(t, y) if model.feedback else None)
-    # The same model with every cable active and its tension set by hand: a
-    # constant nonzero tension keeps each cable in the kernel.
-    # Everything else of each cable (routing, friction) stays as it is.
-    held = model.replace(cables=[replace(c, tension=1.0, displacement=None, compliance=None,
-                                         base_to_actuator=0.0, rest_length=None) for c in model.cables])
-    system = SemiDiscrete(held, scheme)
+    system = SemiDiscrete(tensions_by_hand(model), scheme)
 
     def rates(x, cable_tensions):
         return system.rest_rates(t, x, np.empty(system.size), tensions=cable_tensions)
@@ -67,4 +86,91 @@ def linearize(model, state, t=0.0, scheme=DEFAULT_SCHEME):
     b = np.empty((system.size, len(model.cables)))
     for j, unit in enumerate(np.eye(len(model.cables))):
         b[:, j] = 0.5 * (rates(y, tensions + unit) - rates(y, tensions - unit))
-    return a, b
+    names = [f"{c.name} tension [N]" for c in model.cables]
+    columns = [b]
+    motors = _tendons(model, system, t, y, a, b)
+    if motors:
+        names += [name for name, _ in motors]
+        columns.append(np.column_stack([column for _, column in motors]))
+    loads = _point_loads(model, system, t, y, tensions)
+    if loads:
+        names += [name for name, _ in loads]
+        columns.append(np.column_stack([column for _, column in loads]))
+    tip = (_tip_rows(system, t, y), ("tip x [m]", "tip y [m]", "tip z [m]"))
+    return LinearModel(a, np.hstack(columns), inputs=tuple(names), state=y, t=t, named_outputs={"tip": tip})
+
+
+def _tip_rows(system, t, y):
+    """d tip / d y (3, size): the tip rebuilt from the orientations and strains
+    as ``Result.tip`` and ``StateView.tip`` give it (not the integrated position
+    u(L), which differs from it by the time discretisation's drift), by central
+    differences of that geometric function over the entries it reads."""
+    layout = system.layout
+    entries = np.concatenate([_field_rows(layout, f).ravel() for f in ("Q", "q", "k")])
+    h = _STRAIN_STEP * np.maximum(np.abs(y[entries]), system.atol_scale()[entries])
+    rows = np.zeros((3, layout.size))
+    for i, step in zip(entries, h):
+        up, down = y.copy(), y.copy()
+        up[i] += step
+        down[i] -= step
+        rows[:, i] = (system.state_view(t, up).tip - system.state_view(t, down).tip) / (2 * step)
+    return rows
+
+
+def _tendons(model, system, t, y, a, b):
+    """The displacement-controlled cables: their tendon law's dependence on the
+    path length is added to ``a`` in place; returns their (name, d f / d z) columns."""
+    motors = [(j, c) for j, c in enumerate(model.cables) if c.actuated]
+    if not motors:
+        return []
+    layout, n = system.layout, model.n_elements
+    strains = np.hstack([layout.field(y, "q"), layout.field(y, "k")])  # the path lengths read only q and k
+    lengths = system.routing.lengths(strains[:, :3], strains[:, 3:])
+    typical = np.tile([1.0] * 3 + [1.0 / model.rod.length] * 3, (n, 1))  # q ~ 1, k ~ 1/L
+    h = _STRAIN_STEP * np.maximum(np.abs(strains), typical)
+    d_length = np.empty((n, 6, len(model.cables)))
+    both = np.empty((2, n, 6))
+    for element, c in np.ndindex(n, 6):
+        both[:] = strains
+        both[0, element, c] += h[element, c]
+        both[1, element, c] -= h[element, c]
+        moved = system.routing.lengths(both[..., :3], both[..., 3:])
+        d_length[element, c] = (moved[0] - moved[1]) / (2 * h[element, c])
+    d_length = d_length.reshape(6 * n, -1)
+    rows = np.hstack([_field_rows(layout, "q"), _field_rows(layout, "k")]).ravel()
+    out = []
+    for j, cable in motors:
+        stiffness, gain = cable.tension.slopes(t, lengths[j])
+        a[:, rows] += np.outer(b[:, j], stiffness * d_length[:, j])
+        out.append((f"{cable.name} displacement [m]", b[:, j] * gain))
+    return out
+
+
+def _field_rows(layout, name):
+    """(N, width) indices of field ``name`` in the state vector."""
+    return layout.field(np.arange(layout.size), name)
+
+
+def _point_loads(model, system, t, y, tensions):
+    """(name, d f / d component) of the point forces and moments: the kernel's
+    load values moved by one unit, central (the right-hand side is affine in them)."""
+    radius = model.rod.radius_at(model.s_nodes)
+    out, start = [], 0
+    system.update_inputs(t, y, tensions)
+    values = system.entry_values
+    held = values.copy()
+    rates = np.empty((2, system.size))
+    for load in model.loads:
+        count = len(load.on_grid(model.s_nodes, radius).kind)
+        rows = slice(start, start + count)
+        start += count
+        if not isinstance(load, (PointForce, PointMoment)):
+            continue
+        unit = "N" if isinstance(load, PointForce) else "N m"
+        for c, axis in enumerate("xyz"):
+            for side, sign in enumerate((1.0, -1.0)):
+                values[rows, c] = held[rows, c] + sign
+                stencil.rhs(y, rates[side], *system.kernel_arguments())
+                values[rows, c] = held[rows, c]
+            out.append((f"{load.name} {axis} [{unit}]", 0.5 * (rates[0] - rates[1])))
+    return out

@@ -1,10 +1,13 @@
-"""Closing the loop: a model stepped by a controller (:class:`Simulator`).
+"""Closing the loop: the questions a controller asks of the model.
 
-The top floor with analysis and calibration: it drives :mod:`rodmol.solve`,
-builds Results and streams into :mod:`rodmol.io`. The learning environment
-(``rodmol.control.envs``, needs ``gymnasium``) is imported on demand.
+The top floor with analysis and calibration: a model stepped by a controller
+(:class:`Simulator`, which drives :mod:`rodmol.solve`, builds Results and
+streams into :mod:`rodmol.io`) and inverse statics (:func:`inverse_statics`:
+the tensions whose equilibrium puts the tip on a target). The learning
+environment (``rodmol.control.envs``, needs ``gymnasium``) is imported on demand.
 """
 
+from .inverse_statics import StaticFit, inverse_statics, inverse_statics_path
 from .simulator import Simulator, Snapshot
 
-__all__ = ["Simulator", "Snapshot"]
+__all__ = ["Simulator", "Snapshot", "StaticFit", "inverse_statics", "inverse_statics_path"]

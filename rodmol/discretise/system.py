@@ -10,6 +10,8 @@ interface (``size``, ``__call__``, ``layout``, ``pattern``, ``bandwidths``,
 ``jacobian``, ``preconditioner``, ``global_coupling``).
 """
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..markers import track
@@ -42,6 +44,17 @@ def straight_state(model):
     return StateLayout(model.n_elements).straight(
         model.s_nodes, np.asarray(base.position, dtype=float), np.asarray(base.rotation, dtype=float),
         rotations.from_matrix(base.rotation))
+
+
+def tensions_by_hand(model):
+    """The same model with every cable in the kernel and its tension given by
+    hand (``tensions=`` to :meth:`SemiDiscrete.rest_rates`): a constant
+    nonzero tension keeps each cable in the kernel, and displacement control
+    and feedback laws are dropped. The routing and friction of each cable
+    stay as they are. The linearisation and the inverse statics differentiate
+    with respect to the tensions of this model."""
+    return model.replace(cables=[replace(c, tension=1.0, displacement=None, compliance=None,
+                                         base_to_actuator=0.0, rest_length=None) for c in model.cables])
 
 
 def field_scales(model):

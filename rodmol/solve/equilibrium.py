@@ -143,52 +143,157 @@ def _closed_loop(system, t, tol, max_iter, max_rounds=30):
                            "(the law and the arm have no common rest state, or it is unstable)")
 
 
+class RestEquations:
+    """The rest equations R(z; T) = 0 of ``system`` at time t, in the static
+    unknowns z (the u, Q, q, k blocks of the state).
+
+    The force and torque rows are divided by the load scale of the tensions
+    the equations are built with, so R is dimensionless and its scale does
+    not move with T (the implicit-function theorem then needs no correction).
+
+    Parameters
+    ----------
+    system : SemiDiscrete
+    t : float
+        Time [s] at which the loads are read.
+    tensions : (n_cables,) array [N] or None
+        The cable tensions (None: the model's inputs at t).
+    """
+
+    def __init__(self, system, t, tensions=None):
+        model = system.model
+        self.system, self.t, self.tensions = system, t, tensions
+        self.layout = system.layout
+        self.static = BlockLayout(model.n_elements, dict(STATIC_FIELDS))
+        self.bands = self.static.bandwidths(static_dependencies(system.depends))
+        base = model.base
+        self._quat0 = rotations.from_matrix(base.rotation)
+        self._u0 = np.asarray(base.position, dtype=float)
+        self._y = straight_state(model)
+        self._rates = np.empty(self.layout.size)
+        # Views and slices made once: the residual runs thousands of times per solve.
+        self._sl, self._state_sl = self.static.slices(), self.layout.slices()
+        self._y_blocks, self._rate_blocks = self.layout.blocks(self._y), self.layout.blocks(self._rates)
+        self.scale = model.load_scale(t, tensions)
+        self.unloaded = self.scale == 0.0 and not model.loads
+        self._force_scale = (self.scale or 1.0) / model.rod.length  # contact alone: forces of about 1 N
+
+    def tolerance(self, tol):
+        """``tol`` raised to the round-off floor of the difference quotients:
+        differencing stresses of size EA * strain over ds loses digits as N grows."""
+        model = self.system.model
+        return max(tol, 10 * np.finfo(float).eps * np.max(model.kl) / (model.ds * self._force_scale))
+
+    def unknowns(self, y):
+        """The static unknowns z of a state vector ``y``."""
+        return np.hstack([self.layout.field(y, f) for f in STATIC_FIELDS]).ravel()
+
+    def residual(self, z, lam=1.0, tensions=None):
+        """R(z) with the loads scaled by ``lam``, under ``tensions`` [N] (default: the equations' own)."""
+        sl, state_sl, model = self._sl, self._state_sl, self.system.model
+        ds = model.ds
+        zb = self.static.blocks(z)
+        for f in STATIC_FIELDS:
+            self._y_blocks[:, state_sl[f]] = zb[:, sl[f]]
+        tensions = self.tensions if tensions is None else tensions
+        self.system.rest_rates(self.t, self._y, self._rates, lam, tensions)
+        u, quat, q, k = (zb[:, sl[f]] for f in STATIC_FIELDS)
+        u_prev = np.vstack([self._u0, u[:-1]])
+        q_prev = np.vstack([self._quat0, quat[:-1]])
+        out = np.empty_like(zb)
+        out[:, sl["u"]] = (u - u_prev - centreline.chords(q_prev, q, k, ds)) / ds
+        out[:, sl["Q"]] = quat - rotations.multiply(q_prev, rotations.from_rotation_vector(ds * k))
+        out[:, sl["q"]] = self._rate_blocks[:, state_sl["v"]] * model.mass / self._force_scale
+        out[:, sl["k"]] = self._rate_blocks[:, state_sl["w"]] * model.inertia / (self.scale or 1.0)
+        return out.ravel()
+
+    def state(self, z):
+        """The state vector at rest of the static unknowns z: unit quaternions, and
+        the positions rebuilt from the strains as ``Result.positions`` does."""
+        zb = self.static.blocks(z)
+        sl = self.static.slices()
+        n = self.system.model.n_elements
+        quat = zb[:, sl["Q"]] / np.linalg.norm(zb[:, sl["Q"]], axis=1, keepdims=True)
+        q, k = zb[:, sl["q"]], zb[:, sl["k"]]
+        u = centreline.positions(self._u0, np.vstack([self._quat0, quat]), q, k, self.system.model.ds)[1:]
+        zeros = np.zeros((n, 3))
+        return self.layout.pack(self._u0, self._quat0, u, quat, q, k, zeros, zeros)
+
+    def jacobian(self, z):
+        """dR/dz at full load, in ``solve_banded`` storage with :attr:`bands`."""
+        fun = self.residual
+        return _banded_jacobian(fun, z, fun(z), self.bands)
+
+
+def tension_sensitivity(system, y, tensions, t=0.0):
+    """d y / d T of the rest state ``y`` under cable ``tensions``, exactly.
+
+    By the implicit-function theorem, R(z(T); T) = 0 gives dR/dz dz/dT =
+    -dR/dT: one banded solve with the equilibrium's Jacobian, columns for
+    every cable. The right-hand side is affine in the tensions, so dR/dT is
+    a difference of residuals without truncation error.
+
+    Parameters
+    ----------
+    system : SemiDiscrete
+        A system whose kernel sees every cable (a cable slack by its constant
+        input is left out of the kernel; see
+        :func:`rodmol.discretise.system.tensions_by_hand`).
+    y : (size,) array
+        A rest state under ``tensions`` (``rodmol.equilibrium``).
+    tensions : (n_cables,) array [N]
+    t : float
+        Time [s] at which the other loads are read.
+
+    Returns
+    -------
+    (size, n_cables) array
+        d y / d T_j [per N], in the state layout (positions in m per N,
+        global frame; strains per N, local frame); zero in the base and
+        velocity rows.
+    """
+    tensions = np.asarray(tensions, dtype=float)
+    equations = RestEquations(system, t, tensions)
+    z = equations.unknowns(y)
+    r0 = equations.residual(z)
+    d_r = np.empty((z.size, tensions.size))
+    for j in range(tensions.size):
+        shifted = tensions.copy()
+        shifted[j] += 1.0
+        d_r[:, j] = equations.residual(z, tensions=shifted) - r0
+    d_z = solve_banded(equations.bands, equations.jacobian(z), -d_r)
+    out = np.zeros((tensions.size, system.size))
+    blocks = equations.static.blocks(d_z.T)  # (n_cables, N, 13)
+    for f, sl in equations.static.slices().items():
+        system.layout.field(out, f)[:] = blocks[..., sl]
+    return out.T
+
+
+def rest_state(system, tensions, t=0.0, *, start=None, tol=1e-10, max_iter=40):
+    """The rest state of ``system`` under cable ``tensions`` [N] (the other
+    loads at t), as :func:`equilibrium` finds it but without its checks:
+    Newton's method from ``start`` (a nearby rest state) first, the load
+    continuation from the straight rod if that fails. For loops that solve
+    many nearby equilibria (the inverse statics); raises
+    :class:`EquilibriumError` if none is found."""
+    return _rest_state(system, t, tol, max_iter, tensions, start)
+
+
 def _rest_state(system, t, tol, max_iter, tensions=None, start=None):
     """The rest state under the loads at t (cable ``tensions`` [N] if given).
     ``start``, a nearby rest state (the closed loop's last iterate), is tried
     first at the full loads; the continuation from the straight rod is the
     fallback."""
-    model = system.model
-    layout, n, ds = system.layout, model.n_elements, model.ds
-    static = BlockLayout(n, dict(STATIC_FIELDS))
-    sl = static.slices()
-    base = model.base
-    quat0 = rotations.from_matrix(base.rotation)
-    u0 = np.asarray(base.position, dtype=float)
-    y = straight_state(model)
-    z = np.hstack([layout.field(y, f) for f in STATIC_FIELDS]).ravel()
-    scale = model.load_scale(t, tensions)
-    if scale == 0.0 and not model.loads:
+    equations = RestEquations(system, t, tensions)
+    y = straight_state(system.model)
+    if equations.unloaded:
         return y
-
-    scale = scale or 1.0  # contact alone: forces of the order of 1 N
-    f_scale = scale / model.rod.length
-    # Differencing stresses of size EA * strain over ds loses digits as N grows:
-    # never ask for less than ten times that round-off floor.
-    tol = max(tol, 10 * np.finfo(float).eps * np.max(model.kl) / (ds * f_scale))
-    mass, inertia = model.mass, model.inertia
-    rates = np.empty(layout.size)
-
-    def residual(z, lam):
-        zb = static.blocks(z)
-        for f in STATIC_FIELDS:
-            layout.field(y, f)[:] = zb[:, sl[f]]
-        system.rest_rates(t, y, rates, lam, tensions)
-        u, quat, q, k = (zb[:, sl[f]] for f in STATIC_FIELDS)
-        u_prev = np.vstack([u0, u[:-1]])
-        q_prev = np.vstack([quat0, quat[:-1]])
-        out = np.empty_like(zb)
-        out[:, sl["u"]] = (u - u_prev - centreline.chords(q_prev, q, k, ds)) / ds
-        out[:, sl["Q"]] = quat - rotations.multiply(q_prev, rotations.from_rotation_vector(ds * k))
-        out[:, sl["q"]] = layout.field(rates, "v") * mass / f_scale
-        out[:, sl["k"]] = layout.field(rates, "w") * inertia / scale
-        return out.ravel()
-
-    bands = static.bandwidths(static_dependencies(system.depends))
+    z = equations.unknowns(y)
+    tol = equations.tolerance(tol)
+    residual, bands = equations.residual, equations.bands
     lam, step = 0.0, 1.0
     if start is not None:
-        z_warm = _newton(lambda x: residual(x, 1.0),
-                         np.hstack([layout.field(start, f) for f in STATIC_FIELDS]).ravel(), tol, max_iter, bands)
+        z_warm = _newton(residual, equations.unknowns(start), tol, max_iter, bands)
         if z_warm is not None:
             z, lam = z_warm, 1.0
     while lam < 1.0:
@@ -202,12 +307,7 @@ def _rest_state(system, t, tol, max_iter, tensions=None, start=None):
                 raise EquilibriumError(
                     f"no static equilibrium found beyond {lam:.4g} of the loads at t = {t} s "
                     "(the rod may buckle under these loads)")
-    zb = static.blocks(z)
-    quat = zb[:, sl["Q"]] / np.linalg.norm(zb[:, sl["Q"]], axis=1, keepdims=True)
-    q, k = zb[:, sl["q"]], zb[:, sl["k"]]
-    u = centreline.positions(u0, np.vstack([quat0, quat]), q, k, ds)[1:]
-    zeros = np.zeros((n, 3))
-    return layout.pack(u0, quat0, u, quat, q, k, zeros, zeros)
+    return equations.state(z)
 
 
 def _newton(fun, z, tol, max_iter, bands):
@@ -243,13 +343,14 @@ def _banded_jacobian(fun, z, f0, bands):
     size = z.size
     ab = np.zeros((width, size))
     h = 1.5e-8 * np.maximum(np.abs(z), 1.0)
+    offsets = np.arange(-up, lo + 1)[:, None]
     for group in range(min(width, size)):
         cols = np.arange(group, size, width)
         zp = z.copy()
         zp[cols] += h[cols]
         df = fun(zp) - f0
-        for d in range(-up, lo + 1):
-            rows = cols + d
-            ok = (rows >= 0) & (rows < size)
-            ab[up + d, cols[ok]] = df[rows[ok]] / h[cols[ok]]
+        rows = cols[None, :] + offsets  # one row per diagonal of the band
+        ok = (rows >= 0) & (rows < size)
+        diagonal, column = np.nonzero(ok)
+        ab[diagonal, cols[column]] = df[rows[ok]] / h[cols[column]]
     return ab

@@ -1,0 +1,385 @@
+"""Inverse statics: the cable tensions whose static equilibrium puts the tip (its
+tangent, markers) at a target.
+
+A bounded Levenberg-Marquardt loop over the tensions of the actuated cables.
+Each iterate is a static equilibrium (:mod:`rodmol.solve.equilibrium`) warm-
+started from the last one; the sensitivities of the tip to the tensions are
+exact, from the equilibrium's Jacobian by the implicit-function theorem
+(:func:`~rodmol.solve.equilibrium.tension_sensitivity`), not from differences
+of whole solves; each step is a bounded linear least-squares problem
+(``scipy.optimize.lsq_linear``) with the cables' bounds. Displacement-
+controlled cables are solved for their tension too, and the actuator
+position that holds it follows exactly from the path length
+(:meth:`rodmol.cables.ActuatorTension.position_for`).
+"""
+
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+from scipy.optimize import lsq_linear
+
+from .. import _checks
+from ..discretise.layout import StateLayout
+from ..discretise.schemes import DEFAULT_SCHEME
+from ..discretise.system import SemiDiscrete, tensions_by_hand
+from ..errors import EquilibriumError, ParameterError
+from ..model import Model
+from ..solve.equilibrium import rest_state, tension_sensitivity
+from ._targets import Targets, check_aims
+
+#: Default reach tolerance [m] on the weighted tip residual.
+REACH_TOLERANCE = 1e-4
+#: The loop stops once the residual is this fraction of the reach tolerance.
+_PRECISION = 1e-3
+
+
+@dataclass(frozen=True)
+class StaticFit:
+    """What :func:`inverse_statics` found.
+
+    Attributes
+    ----------
+    tensions : dict
+        Cable name -> tension [N] where it leaves the base, every cable of
+        the model (the cables not actuated keep their own).
+    displacements : dict
+        Cable name -> actuator position z [m] holding the found tension, for
+        the actuated displacement-controlled cables (at 0 N: the position
+        that leaves the tendon just taut).
+    state : (size,) array
+        The static equilibrium under ``tensions``.
+    tip : (3,) array
+        Its tip position [m], global frame.
+    residual : float
+        The weighted residual [m]: sqrt(|tip - target|^2 + (w_d |d - d_target|)^2
+        + w_m^2 sum |marker - target|^2), d the tip's tangent (global), w_d the
+        ``direction_weight``, w_m the ``marker_weight`` (each term if aimed at).
+    tip_error : float or None
+        |tip - target| [m].
+    direction_error : float or None
+        Angle [rad] between the tip's tangent and the target direction.
+    marker_errors : dict
+        Marker name -> |marker - target| [m], for the markers aimed at.
+    reachable : bool
+        ``residual <= tol``.
+    active : dict
+        Cable name -> ``"lower"`` or ``"upper"`` for the actuated cables at a bound.
+    message : str
+    iterations, equilibria : int
+        Accepted steps, and static equilibria solved (trial steps included).
+    """
+
+    tensions: dict
+    displacements: dict
+    state: np.ndarray = field(repr=False)
+    tip: np.ndarray
+    residual: float
+    tip_error: float | None
+    direction_error: float | None
+    marker_errors: dict
+    reachable: bool
+    active: dict
+    message: str
+    iterations: int
+    equilibria: int
+
+    def apply(self, model):
+        """``model`` with the found inputs: each actuated cable pulls with its
+        found tension, or its actuator sits at its found displacement."""
+        cables = []
+        for c in model.cables:
+            if c.name in self.displacements:
+                c = replace(c, tension=None, displacement=self.displacements[c.name])
+            elif c.name in self.tensions and c.tension.constant != self.tensions[c.name]:
+                c = replace(c, tension=float(self.tensions[c.name]))
+            cables.append(c)
+        return model.replace(cables=cables)
+
+
+def inverse_statics(model, tip=None, *, direction=None, markers=None, bounds=(0.0, np.inf), cables=None,
+                    t=0.0, tol=REACH_TOLERANCE, direction_weight=None, marker_weight=1.0, start=None,
+                    scheme=DEFAULT_SCHEME, max_iter=50):
+    """The cable tensions, within bounds, whose static equilibrium puts the tip at
+    ``tip`` (its tangent along ``direction``, markers at ``markers``).
+
+    Parameters
+    ----------
+    model : Model
+        Its loads (gravity, buoyancy, external loads, contact at ``t``) act;
+        the cables not in ``cables`` keep their tensions.
+    tip : (3,) array, optional
+        Target tip position [m], global frame.
+    direction : (3,) array, optional
+        Target direction of the tip's tangent (its local x axis), global
+        frame; normalised here.
+    markers : dict, optional
+        Marker name (one of ``model.markers``) -> target position [m],
+        global frame. At least one of ``tip``, ``direction``, ``markers``.
+    bounds : (low, high)
+        Tension bounds [N], each a number or one per actuated cable (in the
+        order of ``cables``); 0 <= low < high (``high`` may be ``inf``).
+        Displacement-controlled cables are bounded by their tension too.
+    cables : sequence of str, optional
+        Names of the actuated cables; default all. The others must not be
+        feedback or displacement-controlled (their tension must not read
+        the state).
+    t : float
+        Time [s] at which the other loads are read.
+    tol : float
+        Reach tolerance [m] on the weighted residual (default 0.1 mm).
+    direction_weight : float, optional
+        Length w_d [m] weighting the direction error (default: the rod's length).
+    marker_weight : float
+        Weight w_m [-] of the markers' errors against the tip's.
+    start : (n_actuated,) array, optional
+        Initial tensions [N]; default the model's tensions at ``t`` (clipped
+        to the bounds).
+    scheme : str
+        The spatial scheme (``rodmol.SCHEMES``).
+    max_iter : int
+        Most trial steps.
+
+    Returns
+    -------
+    StaticFit
+        ``reachable`` False (and the bounds that are active) if no tensions
+        within the bounds meet the target to ``tol``: the fit is then the
+        closest equilibrium the loop found: a local minimum of the residual
+        (the loop is local: another ``start`` may reach a target this one
+        does not, and with more cables than targets the tensions are one
+        solution of many, the one the damped steps reach from ``start``).
+
+    Raises
+    ------
+    ParameterError
+        Bad input, before any work.
+    EquilibriumError
+        No equilibrium under the initial tensions.
+    """
+    _check_model(model)
+    tip, direction, names, positions = check_aims(model, tip, direction, markers)
+    tol = _checks.positive("tol", tol, " m")
+    max_iter = _checks.integer_at_least("max_iter", max_iter, 1)
+    problem = _Problem(model, cables, bounds, t, scheme, (tip is not None, direction is not None, names),
+                       direction_weight, marker_weight)
+    return problem.fit(problem.targets.aim(tip, direction, positions), problem.start(start), tol, max_iter)
+
+
+def inverse_statics_path(model, tips, *, directions=None, **options):
+    """:func:`inverse_statics` along a sequence of targets, each warm-started
+    from the solution of the one before (its tensions and its equilibrium).
+
+    Parameters
+    ----------
+    model : Model
+    tips : (n, 3) array
+        Target tip positions [m], global frame.
+    directions : (n, 3) array, optional
+        Target tip tangents, global frame.
+    **options
+        As for :func:`inverse_statics` (``bounds``, ``cables``, ``tol``, ...);
+        ``start`` applies to the first target.
+
+    Returns
+    -------
+    list of StaticFit
+    """
+    tips = _targets("tips", tips)
+    if directions is not None:
+        directions = _targets("directions", directions)
+        if len(directions) != len(tips):
+            raise ParameterError(f"`directions` must have one row per target ({len(tips)}), got {len(directions)}")
+    unknown = set(options) - {"bounds", "cables", "t", "tol", "direction_weight", "start", "scheme", "max_iter"}
+    _check_model(model)
+    if unknown:
+        raise ParameterError(f"unknown options {sorted(unknown)} for inverse_statics_path")
+    tol = _checks.positive("tol", options.get("tol", REACH_TOLERANCE), " m")
+    max_iter = _checks.integer_at_least("max_iter", options.get("max_iter", 50), 1)
+    aims = [check_aims(model, p, None if directions is None else d, None)
+            for p, d in zip(tips, directions if directions is not None else tips)]
+    problem = _Problem(model, options.get("cables"), options.get("bounds", (0.0, np.inf)), options.get("t", 0.0),
+                       options.get("scheme", DEFAULT_SCHEME), (True, directions is not None, []),
+                       options.get("direction_weight"), 1.0)
+    targets = [problem.targets.aim(tip, direction, None) for tip, direction, _, _ in aims]
+    tensions = problem.start(options.get("start"))
+    fits = []
+    for target in targets:
+        fit = problem.fit(target, tensions, tol, max_iter)
+        tensions = np.array([fit.tensions[problem.names[i]] for i in problem.index])
+        fits.append(fit)
+    return fits
+
+
+def _targets(name, value):
+    arr = _checks.floats(value)
+    if arr is None or arr.ndim != 2 or arr.shape[1] != 3 or len(arr) == 0:
+        raise ParameterError(f"`{name}` must be an (n, 3) array of positions [m], got {_checks.short(value)}")
+    if not np.all(np.isfinite(arr)):
+        raise ParameterError(f"`{name}` must be finite, got {_checks.short(value)}")
+    return arr
+
+
+def _check_model(model):
+    if not isinstance(model, Model):
+        raise ParameterError(f"`model` must be a rodmol.Model, got {_checks.short(model)}")
+
+
+class _Problem:
+    """The aimed-at outputs of the equilibrium as functions of the actuated tensions."""
+
+    def __init__(self, model, cables, bounds, t, scheme, aims, direction_weight, marker_weight):
+        self.model, self.t = model, _checks.finite("t", t)
+        self.names = [c.name for c in model.cables]
+        self.index = self._actuated(cables)
+        self.low, self.high = self._bounds(bounds)
+        weight = (model.rod.length if direction_weight is None
+                  else _checks.positive("direction_weight", direction_weight, " m"))
+        self.targets = Targets(model, StateLayout(model.n_elements), *aims, weight,
+                               _checks.positive("marker_weight", marker_weight))
+        held = np.setdiff1d(np.arange(len(model.cables)), self.index)
+        for i in held:
+            if model.cables[i].tension.feedback:
+                raise ParameterError(f"cable {self.names[i]!r} reads the state (feedback or displacement "
+                                     "control): list it in `cables` to solve for it")
+        self.tensions = np.zeros(len(model.cables))
+        self.tensions[held] = [model.cables[i].tension_at(self.t) for i in held]
+        self.system = SemiDiscrete(tensions_by_hand(model), scheme)
+        self._tip = self.system.layout.tip_slice("u")
+        self.warm, self.equilibria = None, 0
+
+    def _actuated(self, cables):
+        if cables is None:
+            if not self.names:
+                raise ParameterError("the model has no cables to actuate")
+            return np.arange(len(self.names))
+        if isinstance(cables, str):
+            cables = [cables]
+        names = list(cables)
+        if not names or len(set(names)) != len(names):
+            raise ParameterError(f"`cables` must name distinct cables of the model, got {_checks.short(cables)}")
+        for name in names:
+            if name not in self.names:
+                raise ParameterError(f"`cables`: no cable named {name!r} in the model"
+                                     + _checks.did_you_mean(name, self.names))
+        return np.array([self.names.index(n) for n in names])
+
+    def _bounds(self, bounds):
+        n = len(self.index)
+        try:
+            low, high = bounds
+        except (TypeError, ValueError):
+            raise ParameterError(f"`bounds` must be (low, high) tensions [N], got {_checks.short(bounds)}") from None
+        out = []
+        for name, value in (("low", low), ("high", high)):
+            arr = _checks.floats(value)
+            if arr is None or arr.ndim > 1 or (arr.ndim == 1 and arr.shape != (n,)):
+                raise ParameterError(f"`bounds` {name} must be a number or {n} numbers (one per actuated "
+                                     f"cable), got {_checks.short(value)}")
+            if np.any(np.isnan(arr)):
+                raise ParameterError(f"`bounds` {name} must not be NaN, got {_checks.short(value)}")
+            out.append(np.broadcast_to(arr, (n,)).astype(float))
+        low, high = out
+        if np.any(~np.isfinite(low)) or np.any(low < 0.0):
+            raise ParameterError(f"`bounds` low must be finite and >= 0 N (cables only pull), got {_checks.short(bounds)}")
+        if np.any(low >= high):
+            raise ParameterError(f"`bounds` low must be < high for every cable, got {_checks.short(bounds)} "
+                                 "(to hold a cable's tension fixed, leave it out of `cables`)")
+        return low, high
+
+    def start(self, start):
+        if start is None:
+            values = np.array([self.model.cables[i].tension_at(self.t) for i in self.index])
+        else:
+            values = _checks.floats(start)
+            if values is None or values.shape != (len(self.index),) or not np.all(np.isfinite(values)):
+                raise ParameterError(f"`start` must be {len(self.index)} finite tensions [N] (one per actuated "
+                                     f"cable), got {_checks.short(start)}")
+        return np.clip(values, self.low, self.high)
+
+    def all_tensions(self, actuated):
+        out = self.tensions.copy()
+        out[self.index] = actuated
+        return out
+
+    def rest(self, actuated):
+        """The equilibrium under the actuated tensions, warm-started from the last one."""
+        self.equilibria += 1
+        y = rest_state(self.system, self.all_tensions(actuated), self.t, start=self.warm)
+        self.warm = y
+        return y
+
+    def jacobian(self, y, actuated):
+        """d outputs / d actuated tensions [m/N], exact up to the equilibrium's tolerance."""
+        d_y = tension_sensitivity(self.system, y, self.all_tensions(actuated), self.t)[:, self.index]
+        return self.targets.rows(y) @ d_y[self.targets.entries]
+
+    def fit(self, target, tensions, tol, max_iter):
+        """Levenberg-Marquardt with bounds from ``tensions``."""
+        self.equilibria = 0
+        y = self.rest(tensions)
+        r = self.targets.values(y) - target
+        jac = self.jacobian(y, tensions)
+        mu = 1e-6 * max(np.max(np.sum(jac**2, axis=0)), 1e-30)
+        accepted = 0
+        for _ in range(max_iter):
+            cost = r @ r
+            if np.sqrt(cost) <= _PRECISION * tol:
+                break
+            n = len(tensions)
+            system = np.vstack([jac, np.sqrt(mu) * np.eye(n)])
+            step = lsq_linear(system, np.concatenate([-r, np.zeros(n)]),
+                              bounds=(self.low - tensions, self.high - tensions), method="bvls").x
+            linear = r + jac @ step
+            predicted = cost - linear @ linear
+            if predicted <= 1e-12 * cost or np.max(np.abs(step)) <= 1e-12 * (1.0 + np.max(tensions)):
+                break  # a bounded minimum: no step within the bounds reduces the residual
+            trial = np.clip(tensions + step, self.low, self.high)
+            try:
+                y_new = self.rest(trial)
+            except EquilibriumError:  # e.g. buckling under the trial tensions: a shorter step
+                ratio = -np.inf
+            else:
+                r_new = self.targets.values(y_new) - target
+                ratio = (cost - r_new @ r_new) / predicted
+            if ratio > 1e-4:
+                tensions, y, r = trial, y_new, r_new
+                jac = self.jacobian(y, tensions)
+                accepted += 1
+            else:
+                self.warm = y  # the next trial starts from the accepted state
+            mu = mu / 3.0 if ratio > 0.75 else mu * 4.0 if ratio < 0.25 else mu
+        return self._report(target, tensions, y, r, tol, accepted)
+
+    def _report(self, target, tensions, y, r, tol, iterations):
+        residual = float(np.linalg.norm(r))
+        tip_error, angle, marker_errors = self.targets.errors(y, target)
+        all_tensions = self.all_tensions(tensions)
+        names = self.names
+        scale = 1e-9 * max(1.0, float(np.max(self.high[np.isfinite(self.high)], initial=1.0)))
+        active = {}
+        for j, i in enumerate(self.index):
+            if tensions[j] <= self.low[j] + scale:
+                active[names[i]] = "lower"
+            elif tensions[j] >= self.high[j] - scale:
+                active[names[i]] = "upper"
+        displacements = {}
+        view = self.system.state_view(self.t, y)
+        for j, i in enumerate(self.index):
+            cable = self.model.cables[i]
+            if cable.actuated:
+                displacements[names[i]] = float(cable.tension.position_for(view.cable_length(names[i]),
+                                                                           tensions[j]))
+        reachable = residual <= tol
+        how = f"in {iterations} step{'' if iterations == 1 else 's'} ({self.equilibria} equilibria)"
+        if reachable:
+            message = f"target met to {residual:.3g} m {how}"
+        else:
+            upper = [f"{names[i]} ({self.high[j]:.4g} N)" for j, i in enumerate(self.index)
+                     if active.get(names[i]) == "upper"]
+            why = "" if upper else " (a local minimum: another `start` may do better)"
+            message = (f"target not reached within the bounds{why}: residual {residual:.3g} m > tol {tol:.3g} m "
+                       f"{how}; at an upper bound: {', '.join(upper) or 'none'}; at the lower bound: "
+                       f"{', '.join(n for n, side in active.items() if side == 'lower') or 'none'}")
+        return StaticFit(dict(zip(names, all_tensions.tolist())), displacements, y, y[self._tip].copy(),
+                         residual, tip_error, angle, marker_errors, reachable, active, message, iterations,
+                         self.equilibria)
