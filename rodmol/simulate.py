@@ -6,7 +6,7 @@ from contextlib import contextmanager, nullcontext
 
 import numpy as np
 
-from . import _checks
+from . import _checks, _settings
 from .discretise.layout import StateLayout
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
 from .discretise.system import SemiDiscrete, field_scales, straight_state
@@ -19,6 +19,10 @@ from .solve.equilibrium import equilibrium
 from .solve.watch import state_problem
 
 INITIAL = ("equilibrium", "straight")
+#: Values of ``resume``: "force" continues even with settings other than the run's.
+RESUME = (False, True, "force")
+#: Defaults of the settings ``simulate`` leaves as None (a resumed run takes the run's).
+OUTPUT_DT, DEFAULT_BACKEND = 0.01, "cvode"
 
 
 def default_atol(model, rtol):
@@ -30,9 +34,9 @@ def default_atol(model, rtol):
     return rtol * StateLayout(model.n_elements).scales(field_scales(model))
 
 
-def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, backend="cvode",
-             rtol=None, atol=None, output_dt=0.01, output_times=None, t0=None, progress=None,
-             max_wall_time=None, out=None, resume=False, **backend_options):
+def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None, atol=None,
+             output_dt=None, output_times=None, t0=None, progress=None, max_wall_time=None, out=None,
+             resume=False, overwrite=False, **backend_options):
     """Integrate the model from t = 0 to ``t_end``.
 
     Parameters
@@ -105,10 +109,19 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
     """
     if not isinstance(model, Model):
         raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
-    sink, first, plan = _sink(out, resume), 0, None
+    if resume not in RESUME:
+        raise ParameterError(f"`resume` must be False, True or 'force', got {_checks.short(resume)}")
+    sink, first, plan, recorded = _sink(out, resume, overwrite), 0, None, None
+    asked_plan = (t0, output_dt, output_times)
     if resume:
-        plan, first, initial = sink.resume_point()
+        plan, first, kept = sink.resume_point()
+        recorded = getattr(sink, "settings", None) or {}
+        _settings.check_grid(recorded, model.n_elements, _where(sink))
         t0, output_times = float(plan[first]), plan[first:]
+        scheme, backend = scheme or recorded.get("scheme"), backend or recorded.get("backend")
+        rtol = recorded.get("rtol") if rtol is None else rtol
+        atol = recorded.get("atol") if atol is None else atol
+        backend_options = backend_options or recorded.get("backend_options") or {}
     if isinstance(initial, Result):
         t0 = float(initial.t[-1]) if t0 is None else t0
         initial = _last_state(initial, model)
@@ -116,8 +129,8 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
     t_end = _checks.positive("t_end", t_end, " s")
     if t_end <= t0:
         raise ParameterError(f"`t_end` must be after the start t0 = {t0!r} s, got {t_end!r} s")
-    output_dt = _checks.positive("output_dt", output_dt, " s")
-    scheme = get_scheme(scheme)
+    output_dt = _checks.positive("output_dt", OUTPUT_DT if output_dt is None else output_dt, " s")
+    scheme = get_scheme(scheme or DEFAULT_SCHEME)
     rtol = options.rtol(scheme.default_rtol if rtol is None else rtol)
     progress = options.progress(progress)
     owned = progress is True
@@ -126,6 +139,7 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
 
         progress = Progress()
     max_wall_time = options.max_wall_time(max_wall_time)
+    backend = backend or DEFAULT_BACKEND
     run = get_backend(backend)
     backend_options = options.backend_options(backend, run, backend_options)
     size = StateLayout(model.n_elements).size
@@ -133,6 +147,7 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
     if plan is not None:
         if t_end != plan[-1]:
             raise ParameterError(f"`t_end` = {t_end!r} s: the run being resumed ends at {float(plan[-1])!r} s")
+        _check_plan(plan, asked_plan, t_end, size, sink)
         t_out = plan
     if isinstance(initial, str) and initial not in INITIAL:
         raise ParameterError(f"unknown `initial` {_checks.short(initial)}"
@@ -140,6 +155,18 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
                              "'straight' or a state")
     if atol is not None:
         atol = _state_sized("atol", atol, size, positive=True, layout=StateLayout(model.n_elements))
+    if initial is not None and not isinstance(initial, str):
+        initial = _state_sized("initial", initial, size, layout=StateLayout(model.n_elements))
+    settings = _settings.record(model, scheme=scheme.name, backend=backend, rtol=rtol, atol=atol,
+                                backend_options=backend_options,
+                                initial=(recorded.get("initial") or "unknown") if resume and initial is None
+                                else INITIAL[0] if initial is None else initial)
+    forced = _settings.check(recorded, settings, resume == "force", _where(sink)) if recorded else []
+    if resume:
+        initial = kept
+    elif initial is None:
+        initial = INITIAL[0]
+    getattr(sink, "record_settings", lambda settings, forced: None)(settings, forced)
     if atol is None:
         atol = default_atol(model, rtol)
     timings = {}
@@ -179,18 +206,45 @@ def _stage(progress, text, timings, key, silent=False):
     timings[key] = time.perf_counter() - start
 
 
-def _sink(out, resume):
+def _sink(out, resume, overwrite):
     if out is None:
         if resume:
             raise ParameterError("`resume=True` needs `out`, the directory of the run to resume")
         return None
+    if resume and overwrite:
+        raise ParameterError("give either `resume` or `overwrite=True`, not both")
     if all(hasattr(out, name) for name in ("begin", "frames", "end", "chunk_frames")):
         if resume and not hasattr(out, "resume_point"):
             raise ParameterError("`resume=True`: this sink cannot resume (no resume_point)")
         return out
     from .io.stream import RunWriter
 
-    return RunWriter(out, resume=resume)
+    return RunWriter(out, resume=bool(resume), overwrite=bool(overwrite))
+
+
+def _where(sink):
+    """The run being resumed, for messages: its directory (quoted), or the sink."""
+    return repr(str(getattr(sink, "directory", sink)))
+
+
+def _check_plan(plan, asked, t_end, size, sink):
+    """Refuse a resumed call whose ``asked`` (t0, output_dt, output_times) give other output
+    times than the run's ``plan``: the frames kept are on it."""
+    t0, output_dt, output_times = asked
+    if t0 is None and output_dt is None and output_times is None:
+        return
+    start = float(plan[0]) if t0 is None else _checks.non_negative("t0", t0, " s")
+    dt = _checks.positive("output_dt", OUTPUT_DT if output_dt is None else output_dt, " s")
+    wanted = options.output_times(start, t_end, dt, output_times, size) if start < t_end else np.array([start])
+    if not np.array_equal(wanted, plan):
+        where = _where(sink)
+
+        def show(times):
+            return f"{len(times)} from {float(times[0])!r} to {float(times[-1])!r} s"
+
+        raise ParameterError(f"cannot resume the run in {where}: its output times are {show(plan)}, this call "
+                             f"asks for {show(wanted)} (leave out `t0`, `output_dt` and `output_times` to "
+                             "continue on the run's)")
 
 
 def _streamed(run, system, y0, t_out, sink, first, backend, timings, **options):

@@ -51,7 +51,7 @@ def _version():
 
 
 def _parser():
-    parser = argparse.ArgumentParser(prog="rodmol", description="Soft cable-driven arms as Cosserat rods.")
+    parser = _Parser(prog="rodmol", description="Soft cable-driven arms as Cosserat rods.")
     parser.add_argument("--version", action="version", version=f"rodmol {_version()}")
     commands = parser.add_subparsers(required=True, metavar="COMMAND")
 
@@ -83,6 +83,15 @@ def _parser():
     return parser
 
 
+class _Parser(argparse.ArgumentParser):
+    """A parser that takes no abbreviated options (argparse would take ``--n-element`` for
+    ``--n-elements``); the subcommands' parsers are of the same class (``add_subparsers``
+    makes them with the class of their parent)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, allow_abbrev=False, **kwargs)
+
+
 # --------------------------------------------------------------------------- run
 
 def _run(args):
@@ -94,7 +103,13 @@ def _run(args):
 
 
 def _run_locked(args, spec, out):
+    from .run_files import refuse_replacing
+
     say = (lambda *a, **k: None) if args.quiet else print
+    if args.resume and args.overwrite:
+        raise ParameterError("give either `--resume` or `--overwrite`, not both")
+    if not args.resume:
+        refuse_replacing(out, args.overwrite, "`--resume`", "`--overwrite`")
     model = spec.model
     writer = _stream_writer(args, spec, out)
     say(f"rodmol: {spec.name}: N = {model.n_elements} elements, t_end = {spec.t_end:g} s, "
@@ -166,9 +181,9 @@ def _stream_writer(args, spec, out):
     if fmt != "xdmf":
         if args.resume:
             raise ParameterError("`--resume` needs the streamed output (--format xdmf)")
-        from .stream import clear_outputs
+        from .run_files import clear
 
-        clear_outputs(out)  # a result.h5 of an earlier run would be read instead of result.npz
+        clear(out)  # a result.h5 of an earlier run would be read instead of result.npz
         return None
     from .stream import RunWriter
 

@@ -25,6 +25,9 @@ def add_run_options(parser):
                         "the restart points of --resume (default: [output] chunk_frames, else 2000)")
     parser.add_argument("--resume", action="store_true", help="continue the unfinished run in the output "
                         "directory from its last complete chunk (xdmf format)")
+    parser.add_argument("--overwrite", action="store_true", help="replace the run in the output directory "
+                        "(finished or not): all of its files, pictures included, are removed first; "
+                        "without it an earlier run there is kept and the command refused")
     parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
 
 

@@ -132,10 +132,15 @@ def read_series(directory, chunks, name):
 
 def last_state(directory, chunks):
     """(time [s], state) of the last frame of the last chunk: the restart point."""
+    return frame_state(directory, list(chunks)[-1], -1)
+
+
+def frame_state(directory, chunk, row):
+    """(time [s], state) of frame ``row`` of the chunk file ``chunk``."""
     import h5py
 
-    with h5py.File(Path(directory) / list(chunks)[-1], "r") as handle:
-        return float(handle["t"][-1]), handle["states"][-1]
+    with h5py.File(Path(directory) / chunk, "r") as handle:
+        return float(handle["t"][row]), handle["states"][row]
 
 
 def read_result(path):
