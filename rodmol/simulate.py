@@ -46,15 +46,15 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         End time [s], absolute (> ``t0``).
     initial : "equilibrium", "straight", Result or array
         Initial state: the static equilibrium under the loads at ``t0`` (the
-        paper's choice), the undeformed straight rod at rest, an earlier
-        :class:`Result` (the run continues from its last state, at its last
-        time unless ``t0`` is given), or a state vector (``Result.states``).
+        paper's choice, the default), the undeformed straight rod at rest, an
+        earlier :class:`Result` (the run continues from its last state, at its
+        last time unless ``t0`` is given), or a state vector (``Result.states``).
     scheme : str
         The spatial scheme, a name from ``rodmol.SCHEMES``: ``"centred"``
-        (second order in ds, default) or ``"upwind"`` (the paper's, first
+        (second order in ds, the default) or ``"upwind"`` (the paper's, first
         order); see ``docs/model.md``.
     backend : str
-        A name from ``rodmol.BACKENDS``: ``"cvode"`` (implicit BDF, default),
+        A name from ``rodmol.BACKENDS``: ``"cvode"`` (implicit BDF, the default),
         ``"galpha"`` (fixed-step generalized-alpha for stiff, lightly damped
         rods; options ``dt``, ``rho_inf``) or ``"rk23"`` (explicit, cross-check).
     rtol, atol : float, float or array
@@ -62,8 +62,8 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         ``default_rtol`` (the time error about a tenth of the spatial error
         at N = 100), ``atol=None`` uses :func:`default_atol`.
     output_dt : float
-        Interval between output frames [s], from ``t0``; ``t_end`` is always
-        an output.
+        Interval between output frames [s], from ``t0`` (default 0.01 s);
+        ``t_end`` is always an output.
     output_times : sequence of float, optional
         Output times [s] instead of a uniform ``output_dt`` (e.g. a camera's
         time stamps): increasing, within [t0, t_end]; ``t0`` and ``t_end``
@@ -88,15 +88,29 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         ``rod.xdmf``, see ``docs/paraview.md``) or into a sink object with the
         same protocol; memory then stays bounded by one chunk, the solver
         restarts at every chunk boundary, and the Result returned reads its
-        arrays from the files.
-    resume : bool
-        With ``out``: continue the unfinished (killed) run in that directory
-        from its last complete chunk, on its planned output times; ``t_end``
-        must be the planned end; ``initial``, ``t0``, ``output_dt`` and
-        ``output_times`` are taken from the directory.
+        arrays from the files. ``result.h5`` records the run's settings
+        (``scheme``, ``backend``, ``rtol``, ``atol``, the backend options, the
+        grid, the initial state and a fingerprint of the model's parameters,
+        :mod:`rodmol._settings`). A directory holding an earlier run is
+        refused unless ``overwrite`` or ``resume``.
+    resume : bool or "force"
+        With ``out``: continue the unfinished (killed, interrupted or failed)
+        run in that directory from the last frame of its last complete chunk,
+        on its planned output times, so that it ends exactly as the
+        uninterrupted run; ``t_end`` must be the planned end. The state is
+        the directory's; the settings left None (``scheme``, ``backend``,
+        ``rtol``, ``atol``, ``initial``, the backend options, ``t0``,
+        ``output_dt``, ``output_times``) are the run's, and a value that
+        differs from the run's (or another model) is refused with a
+        ParameterError naming each; ``"force"`` continues with the values given
+        instead (not with another grid or other output times).
+    overwrite : bool
+        With ``out``: replace an earlier run in that directory (every file a
+        run writes there, :mod:`rodmol.io.run_files`; other files are kept).
     **backend_options
         Passed to the backend (e.g. ``linsolver="sparse"`` for CVODE);
-        unknown names and bad values are refused before any work.
+        unknown names and bad values are refused before any work. None given
+        with ``resume``: the run's.
 
     Returns
     -------

@@ -10,6 +10,7 @@ nothing of itself behind. :func:`refuse_replacing` keeps an earlier run from
 being replaced by accident.
 """
 
+import contextlib
 import re
 from pathlib import Path
 
@@ -65,10 +66,8 @@ def clear(directory):
     for file in run_files(directory):
         file.unlink(missing_ok=True)
     for folder in NUMBERED:
-        try:
+        with contextlib.suppress(OSError):  # absent, or holds files not rodmol's
             (directory / folder).rmdir()
-        except OSError:  # absent, or holds files not rodmol's
-            pass
 
 
 def earlier_run(directory):

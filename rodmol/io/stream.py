@@ -34,8 +34,8 @@ from ..errors import ParameterError
 from ..result import STATIC
 from . import h5result, run_files, xdmf
 from .h5result import INDEX, VIEW
-from .run_record import RunRecord
 from .parts import ROD_ARRAYS, cable_arc_lengths, cable_point_array, view_step
+from .run_record import RunRecord
 
 #: Output frames per chunk by default: bounded memory (about 45 kB a frame at
 #: N = 100 with the views), fewer than 100 files for 600 s at 100 frames/s.
@@ -276,12 +276,10 @@ class RunWriter:
         path = self.directory / INDEX
         if not path.is_file():
             raise ParameterError(f"nothing to resume in {str(self.directory)!r}: no {INDEX}")
-        try:
+        with _damaged(path):
             index = h5result.read_index(path)
             info = index["info"]
-            if info.get("complete", True) and info.get("success"):
-                raise ParameterError(f"nothing to resume in {str(self.directory)!r}: the run there finished "
-                                     f"({info['message']})")
+            finished = info.get("complete", True) and info.get("success")
             self.chunks, self.t, self.t_out = dict(index["chunks"]), index["t"].tolist(), index["t_out"]
             self.static = {key: index[key] for key in STATIC}
             # The restart points of the run being resumed, whatever this writer was given.
@@ -289,15 +287,12 @@ class RunWriter:
             self.every = info.get("every") or self.every
             self.meta = dict(info.get("meta") or {}, **self.extra_meta)
             self.record = RunRecord(info)
-            if not self.chunks:
-                raise ParameterError(f"nothing to resume in {str(self.directory)!r}: no frames were kept")
-            self._roll_back()
-        except (OSError, KeyError, ValueError, TypeError, IndexError) as exc:
-            if isinstance(exc, ParameterError):
-                raise
-            raise ParameterError(f"cannot resume the run in {str(self.directory)!r}: its {INDEX} or a chunk "
-                                 f"it lists is damaged or not rodmol's ({type(exc).__name__}: {exc}); "
-                                 "start the run again with --overwrite (overwrite=True)") from None
+        if finished:
+            raise ParameterError(f"nothing to resume in {str(self.directory)!r}: the run there finished "
+                                 f"({info['message']})")
+        if not self.chunks:
+            raise ParameterError(f"nothing to resume in {str(self.directory)!r}: no frames were kept")
+        self._roll_back()
 
     def _roll_back(self):
         """Keep the chunks up to the last restart point (a frame index that is a multiple of
@@ -311,7 +306,8 @@ class RunWriter:
             kept[name], frames = n, frames + n
         # The first chunk cut short: its first frame, the run's initial state, is the restart point.
         chunk, row = (list(kept)[-1], -1) if kept else (list(self.chunks)[0], 0)
-        t, state = h5result.frame_state(self.directory, chunk, row)
+        with _damaged(self.directory / chunk):
+            t, state = h5result.frame_state(self.directory, chunk, row)
         self._dropped = [name for name in self.chunks if name not in kept]
         self.record.drop(self._dropped)
         self.chunks, self.t = kept, self.t[:frames]
@@ -403,6 +399,17 @@ class RunWriter:
         info.update(self.record.info(list(self.chunks), reached, stats))
         info.update(meta=self.meta or {}, chunk_frames=self.chunk_frames, every=self.every)
         return self.directory, self.static, self.t_out if self.t_out is not None else t, t, dict(self.chunks), info
+
+
+@contextmanager
+def _damaged(path):
+    """Turn a failure to read the file ``path`` of the run being resumed into a ParameterError."""
+    try:
+        yield
+    except (OSError, KeyError, ValueError, TypeError, IndexError) as exc:
+        raise ParameterError(f"cannot resume from {str(path)!r}: the file is damaged, truncated or not "
+                             f"rodmol's ({type(exc).__name__}: {exc}); start the run again "
+                             "(`rodmol run ... --overwrite`, simulate(..., overwrite=True))") from None
 
 
 @functools.cache
