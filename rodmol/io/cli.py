@@ -1,11 +1,15 @@
 """The ``rodmol`` command line: run scenario files, render and plot results.
 
     rodmol run SCENARIO.toml [--out DIR] [--backend NAME] [--n-elements N] [--scheme NAME]
-               [--t-end T] [--format xdmf|vtp] [--resume] [--quiet]
+               [--t-end T] [--format xdmf|vtp] [--resume | --resume-anyway | --overwrite] [--quiet]
     rodmol run --example fetching [--out DIR] ...
     rodmol render DIR        # last_frame.png and animation.gif from DIR (result.h5 or result.npz)
     rodmol plot DIR          # tip_path.png, markers.png, tensions.png
     rodmol study | identify | sweep ...   # calibration (see rodmol.io.cli_calibrate)
+
+Options are never abbreviated. A run in ``--out`` is never replaced without
+``--overwrite`` (:mod:`rodmol.io.run_files`); ``--resume`` continues it with
+the settings it recorded (:mod:`rodmol._settings`).
 
 Exit codes: 0 done, 1 the solver failed, 2 bad scenario or arguments (or the
 output directory is in use by another run), 3 outputs could not be written

@@ -7,7 +7,9 @@ A run directory holds
   times ``t_out`` (so a resumed run keeps the same grid), the times reached
   ``t``, the chunk files in order and, as JSON in the attribute ``info``,
   ``success``, ``message``, ``stats``, ``meta`` and ``complete`` (False while
-  the run goes or after it was killed);
+  the run goes or after it was killed), and for a run of ``simulate`` its
+  ``settings``, each chunk's solver statistics and its ``sessions``
+  (:mod:`rodmol.io.run_record`);
 * ``frames/chunk_NNNNNN.h5``: the frames of one chunk: the arrays of
   :data:`rodmol.result.STORED` (``states`` included, so each chunk's last
   frame is a restart point; the Result's other arrays are derived from them

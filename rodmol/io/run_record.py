@@ -15,6 +15,9 @@ settings a forced resume changed): a session's work includes a chunk it
 began that a later resume redid.
 """
 
+from contextlib import contextmanager
+
+from ..errors import ParameterError
 from ..solve.chunked import merge_stats
 
 #: The statistics of a session (its entry of ``stats["sessions"]``).
@@ -70,3 +73,14 @@ class RunRecord:
                     whole[key] = sum(s.get(key, 0.0) for s in sessions)
             whole.update(resumed_at=sessions[-1]["t_start"], sessions=sessions)
         return dict(settings=self.settings, chunk_stats=kept, sessions=sessions, stats=whole)
+
+
+@contextmanager
+def damaged(path):
+    """Turn a failure to read the file ``path`` of a run being resumed into a ParameterError."""
+    try:
+        yield
+    except (OSError, KeyError, ValueError, TypeError, IndexError) as exc:
+        raise ParameterError(f"cannot resume from {str(path)!r}: the file is damaged, truncated or not "
+                             f"rodmol's ({type(exc).__name__}: {exc}); start the run again "
+                             "(`rodmol run ... --overwrite`, simulate(..., overwrite=True))") from None

@@ -35,7 +35,7 @@ from ..result import STATIC
 from . import h5result, run_files, xdmf
 from .h5result import INDEX, VIEW
 from .parts import ROD_ARRAYS, cable_arc_lengths, cable_point_array, view_step
-from .run_record import RunRecord
+from .run_record import RunRecord, damaged
 
 #: Output frames per chunk by default: bounded memory (about 45 kB a frame at
 #: N = 100 with the views), fewer than 100 files for 600 s at 100 frames/s.
@@ -253,6 +253,7 @@ class RunWriter:
         """Write a finished in-memory :class:`rodmol.Result`, chunk by chunk; returns the path of ``rod.xdmf``."""
         self.t_out = np.asarray(result.t, dtype=float)
         self._plan_views(len(self.t_out))
+        self.record.t_start = float(result.t[0]) if len(result.t) else 0.0
         with self._timed():
             for k0 in range(0, len(result.t), self.chunk_frames):
                 self.store(result.select(slice(k0, k0 + self.chunk_frames)))
@@ -276,7 +277,7 @@ class RunWriter:
         path = self.directory / INDEX
         if not path.is_file():
             raise ParameterError(f"nothing to resume in {str(self.directory)!r}: no {INDEX}")
-        with _damaged(path):
+        with damaged(path):
             index = h5result.read_index(path)
             info = index["info"]
             finished = info.get("complete", True) and info.get("success")
@@ -306,7 +307,7 @@ class RunWriter:
             kept[name], frames = n, frames + n
         # The first chunk cut short: its first frame, the run's initial state, is the restart point.
         chunk, row = (list(kept)[-1], -1) if kept else (list(self.chunks)[0], 0)
-        with _damaged(self.directory / chunk):
+        with damaged(self.directory / chunk):
             t, state = h5result.frame_state(self.directory, chunk, row)
         self._dropped = [name for name in self.chunks if name not in kept]
         self.record.drop(self._dropped)
@@ -399,17 +400,6 @@ class RunWriter:
         info.update(self.record.info(list(self.chunks), reached, stats))
         info.update(meta=self.meta or {}, chunk_frames=self.chunk_frames, every=self.every)
         return self.directory, self.static, self.t_out if self.t_out is not None else t, t, dict(self.chunks), info
-
-
-@contextmanager
-def _damaged(path):
-    """Turn a failure to read the file ``path`` of the run being resumed into a ParameterError."""
-    try:
-        yield
-    except (OSError, KeyError, ValueError, TypeError, IndexError) as exc:
-        raise ParameterError(f"cannot resume from {str(path)!r}: the file is damaged, truncated or not "
-                             f"rodmol's ({type(exc).__name__}: {exc}); start the run again "
-                             "(`rodmol run ... --overwrite`, simulate(..., overwrite=True))") from None
 
 
 @functools.cache
