@@ -123,7 +123,7 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
     """
     if not isinstance(model, Model):
         raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
-    if resume not in RESUME:
+    if not (resume is True or resume is False or (isinstance(resume, str) and resume in RESUME)):
         raise ParameterError(f"`resume` must be False, True or 'force', got {_checks.short(resume)}")
     sink, first, plan, recorded = _sink(out, resume, overwrite), 0, None, None
     asked_plan = (t0, output_dt, output_times)
@@ -135,7 +135,8 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         scheme, backend = scheme or recorded.get("scheme"), backend or recorded.get("backend")
         rtol = recorded.get("rtol") if rtol is None else rtol
         atol = recorded.get("atol") if atol is None else atol
-        backend_options = backend_options or recorded.get("backend_options") or {}
+        if not backend_options and backend == recorded.get("backend"):  # (another backend: its own)
+            backend_options = recorded.get("backend_options") or {}
     if isinstance(initial, Result):
         t0 = float(initial.t[-1]) if t0 is None else t0
         initial = _last_state(initial, model)
