@@ -57,13 +57,15 @@ def main(argv=None):
     parser.add_argument("--steps", type=int, default=100, help="control periods (20 ms) per episode")
     parser.add_argument("--n", type=int, default=20, help="elements of the arm")
     parser.add_argument("--seed", type=int, default=3)
+    parser.add_argument("--overwrite", action="store_true", help="replace an episode recorded in --out earlier")
     args = parser.parse_args(argv)
 
     env = ReachEnv(n_elements=args.n, episode_steps=args.steps)
     env.action_space.seed(args.seed)
     random_run = episode(env, lambda env, _: env.action_space.sample(), args.seed)
     env.close()
-    recorded = ReachEnv(n_elements=args.n, episode_steps=args.steps, record=args.out)
+    recorded = ReachEnv(n_elements=args.n, episode_steps=args.steps, record=args.out,
+                        overwrite=args.overwrite)
     p_run = episode(recorded, proportional, args.seed)
     recorded.close()
     for name, (total, start, end) in (("random", random_run), ("proportional", p_run)):

@@ -3,11 +3,11 @@
 import time
 import warnings
 from contextlib import contextmanager, nullcontext
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from . import _checks
+from . import _checks, _settings
 from .discretise.layout import StateLayout
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
 from .discretise.system import SemiDiscrete, field_scales, straight_state
@@ -21,6 +21,10 @@ from .solve.scales import check_scales
 from .solve.watch import state_problem
 
 INITIAL = ("equilibrium", "straight")
+#: Values of ``resume``: "force" continues even with settings other than the run's.
+RESUME = (False, True, "force")
+#: Defaults of the settings ``simulate`` leaves as None (a resumed run takes the run's).
+OUTPUT_DT, DEFAULT_BACKEND = 0.01, "cvode"
 
 
 def default_atol(model, rtol):
@@ -32,9 +36,9 @@ def default_atol(model, rtol):
     return rtol * StateLayout(model.n_elements).scales(field_scales(model))
 
 
-def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, backend="cvode",
-             rtol=None, atol=None, output_dt=0.01, output_times=None, t0=None, progress=None,
-             max_wall_time=None, out=None, resume=False, **backend_options):
+def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None, atol=None,
+             output_dt=None, output_times=None, t0=None, progress=None, max_wall_time=None, out=None,
+             resume=False, overwrite=False, **backend_options):
     """Integrate the model from t = 0 to ``t_end``.
 
     Parameters
@@ -44,15 +48,15 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
         End time [s], absolute (> ``t0``).
     initial : "equilibrium", "straight", Result or array
         Initial state: the static equilibrium under the loads at ``t0`` (the
-        paper's choice), the undeformed straight rod at rest, an earlier
-        :class:`Result` (the run continues from its last state, at its last
-        time unless ``t0`` is given), or a state vector (``Result.states``).
+        paper's choice, the default), the undeformed straight rod at rest, an
+        earlier :class:`Result` (the run continues from its last state, at its
+        last time unless ``t0`` is given), or a state vector (``Result.states``).
     scheme : str
         The spatial scheme, a name from ``rodmol.SCHEMES``: ``"centred"``
-        (second order in ds, default) or ``"upwind"`` (the paper's, first
+        (second order in ds, the default) or ``"upwind"`` (the paper's, first
         order); see ``docs/model.md``.
     backend : str
-        A name from ``rodmol.BACKENDS``: ``"cvode"`` (implicit BDF, default),
+        A name from ``rodmol.BACKENDS``: ``"cvode"`` (implicit BDF, the default),
         ``"galpha"`` (fixed-step generalized-alpha for stiff, lightly damped
         rods; options ``dt``, ``rho_inf``) or ``"rk23"`` (explicit, cross-check).
     rtol, atol : float, float or array
@@ -60,8 +64,8 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
         ``default_rtol`` (the time error about a tenth of the spatial error
         at N = 100), ``atol=None`` uses :func:`default_atol`.
     output_dt : float
-        Interval between output frames [s], from ``t0``; ``t_end`` is always
-        an output.
+        Interval between output frames [s], from ``t0`` (default 0.01 s);
+        ``t_end`` is always an output.
     output_times : sequence of float, optional
         Output times [s] instead of a uniform ``output_dt`` (e.g. a camera's
         time stamps): increasing, within [t0, t_end]; ``t0`` and ``t_end``
@@ -86,15 +90,29 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
         ``rod.xdmf``, see ``docs/paraview.md``) or into a sink object with the
         same protocol; memory then stays bounded by one chunk, the solver
         restarts at every chunk boundary, and the Result returned reads its
-        arrays from the files.
-    resume : bool
-        With ``out``: continue the unfinished (killed) run in that directory
-        from its last complete chunk, on its planned output times; ``t_end``
-        must be the planned end; ``initial``, ``t0``, ``output_dt`` and
-        ``output_times`` are taken from the directory.
+        arrays from the files. ``result.h5`` records the run's settings
+        (``scheme``, ``backend``, ``rtol``, ``atol``, the backend options, the
+        grid, the initial state and a fingerprint of the model's parameters,
+        :mod:`rodmol._settings`). A directory holding an earlier run is
+        refused unless ``overwrite`` or ``resume``.
+    resume : bool or "force"
+        With ``out``: continue the unfinished (killed, interrupted or failed)
+        run in that directory from the last frame of its last complete chunk,
+        on its planned output times, so that it ends exactly as the
+        uninterrupted run; ``t_end`` must be the planned end. The state is
+        the directory's; the settings left None (``scheme``, ``backend``,
+        ``rtol``, ``atol``, ``initial``, the backend options, ``t0``,
+        ``output_dt``, ``output_times``) are the run's, and a value that
+        differs from the run's (or another model) is refused with a
+        ParameterError naming each; ``"force"`` continues with the values given
+        instead (not with another grid or other output times).
+    overwrite : bool
+        With ``out``: replace an earlier run in that directory (every file a
+        run writes there, :mod:`rodmol.io.run_files`; other files are kept).
     **backend_options
         Passed to the backend (e.g. ``linsolver="sparse"`` for CVODE);
-        unknown names and bad values are refused before any work.
+        unknown names and bad values are refused before any work. None given
+        with ``resume``: the run's.
 
     Returns
     -------
@@ -107,24 +125,46 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
     """
     if not isinstance(model, Model):
         raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
-    sink, first, plan = _sink(out, resume), 0, None
+    if not (resume is True or resume is False or (isinstance(resume, str) and resume in RESUME)):
+        raise ParameterError(f"`resume` must be False, True or 'force', got {_checks.short(resume)}")
+    sink, first, plan, recorded = _sink(out, resume, overwrite), 0, None, None
+    asked_plan = (t0, output_dt, output_times)
     if resume:
-        plan, first, initial = sink.resume_point()
+        plan, first, kept = sink.resume_point()
+        recorded = getattr(sink, "settings", None) or {}
+        _settings.check_grid(recorded, model.n_elements, _where(sink))
         t0, output_times = float(plan[first]), plan[first:]
-    run_args = check_run(model, initial=initial, t0=t0, scheme=scheme, backend=backend, rtol=rtol,
+        scheme, backend = scheme or recorded.get("scheme"), backend or recorded.get("backend")
+        rtol = recorded.get("rtol") if rtol is None else rtol
+        atol = recorded.get("atol") if atol is None else atol
+        if not backend_options and backend == recorded.get("backend"):  # (another backend: its own)
+            backend_options = recorded.get("backend_options") or {}
+    given_atol = atol  # None: the default, recorded as such
+    run_args = check_run(model, initial=INITIAL[0] if initial is None else initial, t0=t0,
+                         scheme=scheme or DEFAULT_SCHEME, backend=backend or DEFAULT_BACKEND, rtol=rtol,
                          atol=atol, progress=progress, max_wall_time=max_wall_time,
                          backend_options=backend_options)
-    t0, run, backend_options = run_args.t0, run_args.run, run_args.backend_options
+    t0, run, backend, backend_options = run_args.t0, run_args.run, run_args.backend, run_args.backend_options
     rtol, atol, max_wall_time = run_args.rtol, run_args.atol, run_args.max_wall_time
     t_end = _checks.positive("t_end", t_end, " s")
     if t_end <= t0:
         raise ParameterError(f"`t_end` must be after the start t0 = {t0!r} s, got {t_end!r} s")
-    output_dt = _checks.positive("output_dt", output_dt, " s")
-    t_out = options.output_times(t0, t_end, output_dt, output_times, StateLayout(model.n_elements).size)
+    output_dt = _checks.positive("output_dt", OUTPUT_DT if output_dt is None else output_dt, " s")
+    size = StateLayout(model.n_elements).size
+    t_out = options.output_times(t0, t_end, output_dt, output_times, size)
     if plan is not None:
         if t_end != plan[-1]:
             raise ParameterError(f"`t_end` = {t_end!r} s: the run being resumed ends at {float(plan[-1])!r} s")
+        _check_plan(plan, asked_plan, t_end, size, sink)
         t_out = plan
+    settings = _settings.record(model, scheme=run_args.scheme.name, backend=backend, rtol=rtol,
+                                atol=None if given_atol is None else atol, backend_options=backend_options,
+                                initial=(recorded.get("initial") or "unknown") if resume and initial is None
+                                else run_args.initial)
+    forced = _settings.check(recorded, settings, resume == "force", _where(sink)) if recorded else []
+    if resume:
+        run_args = replace(run_args, initial=kept)
+    getattr(sink, "record_settings", lambda settings, forced: None)(settings, forced)
     progress = run_args.progress
     owned = progress is True
     if owned:
@@ -227,18 +267,45 @@ def _stage(progress, text, timings, key, silent=False):
     timings[key] = time.perf_counter() - start
 
 
-def _sink(out, resume):
+def _sink(out, resume, overwrite):
     if out is None:
         if resume:
             raise ParameterError("`resume=True` needs `out`, the directory of the run to resume")
         return None
+    if resume and overwrite:
+        raise ParameterError("give either `resume` or `overwrite=True`, not both")
     if all(hasattr(out, name) for name in ("begin", "frames", "end", "chunk_frames")):
         if resume and not hasattr(out, "resume_point"):
             raise ParameterError("`resume=True`: this sink cannot resume (no resume_point)")
         return out
     from .io.stream import RunWriter
 
-    return RunWriter(out, resume=resume)
+    return RunWriter(out, resume=bool(resume), overwrite=bool(overwrite))
+
+
+def _where(sink):
+    """The run being resumed, for messages: its directory (quoted), or the sink."""
+    return repr(str(getattr(sink, "directory", sink)))
+
+
+def _check_plan(plan, asked, t_end, size, sink):
+    """Refuse a resumed call whose ``asked`` (t0, output_dt, output_times) give other output
+    times than the run's ``plan``: the frames kept are on it."""
+    t0, output_dt, output_times = asked
+    if t0 is None and output_dt is None and output_times is None:
+        return
+    start = float(plan[0]) if t0 is None else _checks.non_negative("t0", t0, " s")
+    dt = _checks.positive("output_dt", OUTPUT_DT if output_dt is None else output_dt, " s")
+    wanted = options.output_times(start, t_end, dt, output_times, size) if start < t_end else np.array([start])
+    if not np.array_equal(wanted, plan):
+        where = _where(sink)
+
+        def show(times):
+            return f"{len(times)} from {float(times[0])!r} to {float(times[-1])!r} s"
+
+        raise ParameterError(f"cannot resume the run in {where}: its output times are {show(plan)}, this call "
+                             f"asks for {show(wanted)} (leave out `t0`, `output_dt` and `output_times` to "
+                             "continue on the run's)")
 
 
 def _streamed(run, system, y0, t_out, sink, first, backend, timings, **options):

@@ -74,18 +74,21 @@ class ReachEnv(gymnasium.Env):
     record : path, optional
         Stream every episode into ``record/episode_NNNN`` (``result.h5`` and
         ParaView's ``rod.xdmf``), through the Simulator's ``out``.
+    overwrite : bool
+        With ``record``: replace episodes recorded there earlier (otherwise refused).
     """
 
     metadata = {"render_modes": []}
 
     def __init__(self, n_elements=30, period=0.02, episode_steps=100, max_tension=4.0,
-                 effort_weight=1e-3, record=None):
+                 effort_weight=1e-3, record=None, overwrite=False):
         self.period, self.episode_steps = float(period), int(episode_steps)
         self.max_tension, self.effort_weight = float(max_tension), float(effort_weight)
         self.model = paper_arm(n_elements, medium="water")
         self.sim = Simulator(self.model)
         self._start, self._y0 = self.sim.copy(), self.sim.y
         self.record, self._episodes = (None if record is None else Path(record)), 0
+        self._overwrite = bool(overwrite)
         self.action_space = spaces.Box(0.0, self.max_tension, (len(CABLE_OFFSETS),), np.float32)
         self.observation_space = spaces.Box(-np.inf, np.inf, (21,), np.float32)
         self.target, self._steps = self.sim.state.tip.copy(), 0
@@ -99,7 +102,8 @@ class ReachEnv(gymnasium.Env):
             self.sim.close()
             self._episodes += 1
             self.sim = Simulator(self.model, initial=self._y0,
-                                 out=self.record / f"episode_{self._episodes:04d}")
+                                 out=self.record / f"episode_{self._episodes:04d}",
+                                 overwrite=self._overwrite)
         else:
             self.sim.reset(self._start)
         self._steps = 0

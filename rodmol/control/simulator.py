@@ -70,6 +70,9 @@ class Simulator:
         as :func:`rodmol.simulate` does; call :meth:`close` (or use the
         simulator in a ``with`` block) to finish the files. A streamed
         simulator cannot be :meth:`reset` to an earlier time.
+    overwrite : bool
+        With ``out``: replace an earlier run in that directory (as for
+        :func:`rodmol.simulate`, which otherwise refuses it).
     backend : "cvode"
         The only backend (an integrator kept alive between steps).
     **backend_options
@@ -78,7 +81,8 @@ class Simulator:
     """
 
     def __init__(self, model, initial="equilibrium", *, scheme=DEFAULT_SCHEME, rtol=None, atol=None,
-                 t0=None, progress=None, max_wall_time=None, out=None, backend="cvode", **backend_options):
+                 t0=None, progress=None, max_wall_time=None, out=None, overwrite=False, backend="cvode",
+                 **backend_options):
         if backend != "cvode":
             raise ParameterError(f"`backend` {_checks.short(backend)}: the Simulator keeps CVODE alive "
                                  "between steps and has no other backend")
@@ -88,7 +92,7 @@ class Simulator:
         self._inputs = HeldInputs.of(model)
         self._row = self._inputs.initial_row(args.t0)
         live, self._held = self._inputs.live(self._row)
-        self._sink = _sink(out, False)
+        self._sink = _sink(out, False, overwrite)
         self.max_wall_time, self._scheme = args.max_wall_time, args.scheme
         announce = args.progress
         if announce is True:

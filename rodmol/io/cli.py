@@ -1,11 +1,15 @@
 """The ``rodmol`` command line: run scenario files, render and plot results.
 
     rodmol run SCENARIO.toml [--out DIR] [--backend NAME] [--n-elements N] [--scheme NAME]
-               [--t-end T] [--format xdmf|vtp] [--resume] [--quiet]
+               [--t-end T] [--format xdmf|vtp] [--resume | --resume-anyway | --overwrite] [--quiet]
     rodmol run --example fetching [--out DIR] ...
     rodmol render DIR        # last_frame.png and animation.gif from DIR (result.h5 or result.npz)
     rodmol plot DIR          # tip_path.png, markers.png, tensions.png
     rodmol study | identify | sweep ...   # calibration (see rodmol.io.cli_calibrate)
+
+Options are never abbreviated. A run in ``--out`` is never replaced without
+``--overwrite`` (:mod:`rodmol.io.run_files`); ``--resume`` continues it with
+the settings it recorded (:mod:`rodmol._settings`).
 
 Exit codes: 0 done, 1 the solver failed, 2 bad scenario or arguments (or the
 output directory is in use by another run), 3 outputs could not be written
@@ -51,7 +55,7 @@ def _version():
 
 
 def _parser():
-    parser = argparse.ArgumentParser(prog="rodmol", description="Soft cable-driven arms as Cosserat rods.")
+    parser = _Parser(prog="rodmol", description="Soft cable-driven arms as Cosserat rods.")
     parser.add_argument("--version", action="version", version=f"rodmol {_version()}")
     commands = parser.add_subparsers(required=True, metavar="COMMAND")
 
@@ -83,6 +87,15 @@ def _parser():
     return parser
 
 
+class _Parser(argparse.ArgumentParser):
+    """A parser that takes no abbreviated options (argparse would take ``--n-element`` for
+    ``--n-elements``); the subcommands' parsers are of the same class (``add_subparsers``
+    makes them with the class of their parent)."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, allow_abbrev=False, **kwargs)
+
+
 # --------------------------------------------------------------------------- run
 
 def _run(args):
@@ -94,11 +107,22 @@ def _run(args):
 
 
 def _run_locked(args, spec, out):
+    from .run_files import refuse_replacing
+
     say = (lambda *a, **k: None) if args.quiet else print
+    args.resume = "force" if args.resume_anyway else args.resume
+    if args.resume and args.overwrite:
+        raise ParameterError("give either `--resume` or `--overwrite`, not both")
+    if not args.resume:
+        refuse_replacing(out, args.overwrite, "`--resume`", "`--overwrite`")
     model = spec.model
     writer = _stream_writer(args, spec, out)
     say(f"rodmol: {spec.name}: N = {model.n_elements} elements, t_end = {spec.t_end:g} s, "
         f"{spec.solver['scheme']} scheme, backend {spec.solver['backend']} -> {out}")
+    if args.resume:
+        frame, t_restart, _ = writer.restart
+        say(f"rodmol: resuming the run in {out} at t = {t_restart:g} s (frame {frame} of {len(writer.t_out) - 1}, "
+            "its last complete chunk)")
 
     interrupts = _Interrupts()
     previous = {signum: signal.signal(signum, interrupts) for signum in EXIT_SIGNAL}
@@ -165,19 +189,19 @@ def _stream_writer(args, spec, out):
     fmt = args.format or spec.output.format
     if fmt != "xdmf":
         if args.resume:
-            raise ParameterError("`--resume` needs the streamed output (--format xdmf)")
+            raise ParameterError("`--resume` and `--resume-anyway` need the streamed output (--format xdmf)")
         from .._files import refuse_directories
-        from .stream import clear_outputs
+        from .run_files import NPZ, clear
 
-        refuse_directories([out / "result.npz"] if spec.output.npz else [])  # before the run
-        clear_outputs(out)  # a result.h5 of an earlier run would be read instead of result.npz
+        refuse_directories([out / NPZ] if spec.output.npz else [])  # before the run
+        clear(out)  # a result.h5 of an earlier run would be read instead of result.npz
         return None
     from .stream import RunWriter
 
     options = spec.output
     chunk_frames = options.chunk_frames if args.chunk_frames is None else args.chunk_frames
     return RunWriter(out, views=options.vtk, every=options.every, chunk_frames=chunk_frames,
-                     resume=args.resume, meta=dict(scenario=spec.source, name=spec.name))
+                     resume=bool(args.resume), meta=dict(scenario=spec.source, name=spec.name))
 
 
 def _streamed(writer, result):
@@ -235,22 +259,31 @@ def _cannot_write(path, exc):
 
 
 def summary(spec, result, wall, written):
-    """A one-screen account of a run."""
+    """A one-screen account of a run; after a resume, of this part (the last session) and of
+    the whole run (``Result.stats``, :mod:`rodmol.io.run_record`) separately."""
     st, t = result.stats, result.t
     t_done = float(t[-1]) if len(t) else 0.0
     state = "done" if result.success else f"STOPPED: {result.message}"
-    lines = [f"rodmol: {spec.name}: {state}",
+    sessions = st.get("sessions") or []
+    lines = [f"rodmol: {spec.name}: {state}" + (f" (resumed at t = {st['resumed_at']:g} s)" if sessions else ""),
              f"  simulated   {t_done:g} of {spec.t_end:g} s, {len(t)} output frames "
              f"(N = {spec.model.n_elements}, backend {st.get('backend', '?')})",
              f"  solver      {st.get('steps', 0)} steps, {st.get('rhs_evals', 0)} RHS evaluations, "
-             f"{st.get('jac_evals', 0)} Jacobian evaluations"]
-    solver_wall = st.get("wall_time_s", wall)
-    factor = t_done / solver_wall if solver_wall > 0 else float("inf")
-    stages = "".join(f", {st[key]:.2f} s {what}" for key, what in
+             f"{st.get('jac_evals', 0)} Jacobian evaluations" + (" (whole run)" if sessions else "")]
+    part = sessions[-1] if sessions else st  # the work of this process's run
+    span = t_done - (part["t_start"] if sessions else float(t[0]) if len(t) else 0.0)
+    solver_wall = part.get("wall_time_s", wall)
+    stages = "".join(f", {part[key]:.2f} s {what}" for key, what in
                      (("prepare_s", "preparing kernels"), ("equilibrium_s", "equilibrium"))
-                     if st.get(key, 0.0) >= 0.005)
-    lines.append(f"  wall time   {wall:.2f} s run ({solver_wall:.2f} s integrating, {factor:.3g} x real "
-                 f"time{stages}) + {written.get('seconds', 0.0):.2f} s writing")
+                     if part.get(key, 0.0) >= 0.005)
+    label = "this part " if sessions else "wall time "
+    lines.append(f"  {label}  {wall:.2f} s run ({solver_wall:.2f} s integrating"
+                 + (f" {part['t_start']:g} to {t_done:g} s in {part.get('steps', 0)} steps" if sessions else "")
+                 + f", {_speed(span, solver_wall)} x real time{stages}) + {written.get('seconds', 0.0):.2f} s writing")
+    if sessions:
+        whole = st.get("wall_time_s", 0.0)
+        lines.append(f"  whole run   {whole:.2f} s integrating {t_done - float(t[0]):g} s of simulated time in "
+                     f"{len(sessions)} sessions, {_speed(t_done - float(t[0]), whole)} x real time")
     if len(t):
         tip = result.tip[-1]
         lines.append(f"  tip         ({tip[0]:.4f}, {tip[1]:.4f}, {tip[2]:.4f}) m, global, "
@@ -274,6 +307,11 @@ def summary(spec, result, wall, written):
 
 
 # --------------------------------------------------------------------------- render, plot
+
+def _speed(simulated, wall):
+    """Simulated time per wall time, for the summaries."""
+    return f"{simulated / wall:.3g}" if wall > 0 else "inf"
+
 
 def _result_in(directory):
     """The result in a run directory (result.h5, else result.npz), or in the file given."""

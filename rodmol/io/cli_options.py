@@ -24,7 +24,14 @@ def add_run_options(parser):
     parser.add_argument("--chunk-frames", type=int, metavar="N", help="output frames per chunk file, "
                         "the restart points of --resume (default: [output] chunk_frames, else 2000)")
     parser.add_argument("--resume", action="store_true", help="continue the unfinished run in the output "
-                        "directory from its last complete chunk (xdmf format)")
+                        "directory from its last complete chunk (xdmf format), with the settings it was made "
+                        "with; refused if the scenario or the options ask for other ones")
+    parser.add_argument("--resume-anyway", action="store_true", help="--resume even if the scenario or the "
+                        "options changed a setting (rtol, scheme, backend, the model, ...): the run goes on "
+                        "with the new ones (the grid and the output times cannot change)")
+    parser.add_argument("--overwrite", action="store_true", help="replace the run in the output directory "
+                        "(finished or not): all of its files, pictures included, are removed first; "
+                        "without it an earlier run there is kept and the command refused")
     parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
 
 

@@ -7,7 +7,9 @@ A run directory holds
   times ``t_out`` (so a resumed run keeps the same grid), the times reached
   ``t``, the chunk files in order and, as JSON in the attribute ``info``,
   ``success``, ``message``, ``stats``, ``meta`` and ``complete`` (False while
-  the run goes or after it was killed);
+  the run goes or after it was killed), and for a run of ``simulate`` its
+  ``settings``, each chunk's solver statistics and its ``sessions``
+  (:mod:`rodmol.io.run_record`);
 * ``frames/chunk_NNNNNN.h5``: the frames of one chunk: the arrays of
   :data:`rodmol.result.STORED` (``states`` included, so each chunk's last
   frame is a restart point; the Result's other arrays are derived from them
@@ -166,10 +168,15 @@ def read_series(directory, chunks, name):
 
 def last_state(directory, chunks):
     """(time [s], state) of the last frame of the last chunk: the restart point."""
+    return frame_state(directory, list(chunks)[-1], -1)
+
+
+def frame_state(directory, chunk, row):
+    """(time [s], state) of frame ``row`` of the chunk file ``chunk``."""
     import h5py
 
-    with h5py.File(Path(directory) / list(chunks)[-1], "r") as handle:
-        return float(handle["t"][-1]), handle["states"][-1]
+    with h5py.File(Path(directory) / chunk, "r") as handle:
+        return float(handle["t"][row]), handle["states"][row]
 
 
 def read_result(path):

@@ -2,6 +2,8 @@
 
 from pathlib import Path
 
+from .run_files import PLOTTED, RENDERED
+
 
 def render(result, directory, size=(960, 720), frames=60, progress=None):
     """Render ``last_frame.png`` and (``frames`` > 0) ``animation.gif`` into ``directory``.
@@ -48,7 +50,7 @@ def render(result, directory, size=(960, 720), frames=60, progress=None):
     plotter.camera_position = [tuple(centre + 2 * extent * direction), tuple(centre), (0.0, 1.0, 0.0)]
     plotter.reset_camera(bounds=[low[0], high[0], low[1], high[1], low[2], high[2]])
     plotter.camera.zoom(1.3)
-    written = [Path(directory) / "last_frame.png"]
+    written = [Path(directory) / RENDERED[0]]
     plotter.screenshot(written[0])
     if frames > 0 and len(result.t) > 1:
         every = max(1, int(np.ceil(len(result.t) / frames)))
@@ -59,7 +61,7 @@ def render(result, directory, size=(960, 720), frames=60, progress=None):
             plotter.render()
             images.append(Image.fromarray(plotter.screenshot(return_img=True)))
         step_ms = max(20, int(round(1000 * (result.t[-1] - result.t[0]) / max(len(indices) - 1, 1))))
-        written.append(Path(directory) / "animation.gif")
+        written.append(Path(directory) / RENDERED[1])
         images[0].save(written[1], save_all=True, append_images=images[1:], duration=step_ms, loop=0)
     plotter.close()
     return written
@@ -95,7 +97,7 @@ def plot(result, directory):
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=8)
     fig.suptitle("Paths, global frame")
-    written.append(_save(fig, directory / "tip_path.png"))
+    written.append(_save(fig, directory / PLOTTED[0]))
 
     fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True, constrained_layout=True)
     for i, ax in enumerate(axes):
@@ -107,7 +109,7 @@ def plot(result, directory):
     axes[0].legend(fontsize=8, ncol=5)
     axes[-1].set(xlabel="t [s]")
     fig.suptitle("Marker positions, global frame")
-    written.append(_save(fig, directory / "markers.png"))
+    written.append(_save(fig, directory / PLOTTED[1]))
 
     fig, ax = plt.subplots(figsize=(8, 3.5), constrained_layout=True)
     cables = [c["name"] for c in result.meta.get("cables", [])]
@@ -118,7 +120,7 @@ def plot(result, directory):
     ax.grid(alpha=0.3)
     if pulled:
         ax.legend(fontsize=8)
-    written.append(_save(fig, directory / "tensions.png"))
+    written.append(_save(fig, directory / PLOTTED[2]))
     return written
 
 

@@ -25,18 +25,17 @@ import time
 from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import contextmanager
 from functools import partial
-from pathlib import Path
 
 import numpy as np
 
-from .._files import leftover_temporaries, output_directory, refuse_directories
+from .._files import output_directory
 from ..discretise.rotations import rotate
 from ..errors import ParameterError
 from ..result import STATIC
-from ..solve.chunked import merge_stats
-from . import h5result, xdmf
+from . import h5result, run_files, xdmf
 from .h5result import INDEX, VIEW
 from .parts import ROD_ARRAYS, cable_arc_lengths, cable_point_array, view_step
+from .run_record import RunRecord, damaged
 
 #: Output frames per chunk by default: bounded memory (about 45 kB a frame at
 #: N = 100 with the views), fewer than 100 files for 600 s at 100 frames/s.
@@ -62,12 +61,16 @@ class RunWriter:
     resume : bool
         Continue the unfinished run in ``directory`` (see :meth:`resume_point`),
         with its own ``chunk_frames`` and ``every``.
+    overwrite : bool
+        Without ``resume``: replace an earlier run in ``directory`` (all of its
+        files, :mod:`rodmol.io.run_files`); False refuses with a ParameterError
+        if there is one (``simulate(..., out=DIR)`` passes its ``overwrite``).
     meta : dict, optional
         Added to the Result's ``meta`` (e.g. the scenario's name).
     """
 
     def __init__(self, directory, *, views=True, every=None, chunk_frames=CHUNK_FRAMES, resume=False,
-                 meta=None):
+                 overwrite=True, meta=None):
         if (every is not None and int(every) < 1) or int(chunk_frames) < 1:
             raise ParameterError(f"`every` and `chunk_frames` must be >= 1, got {every!r}, {chunk_frames!r}")
         self.directory = output_directory(directory, "out")
@@ -79,12 +82,15 @@ class RunWriter:
         self._pool, self._pending = None, None  # the writer's thread, and the chunk it writes
         self._depth = 0  # of nested _timed blocks
         self._fixed_views = None  # the views' static arrays, made once
-        self.previous = None
+        self.record, self.restart, self._dropped = RunRecord(), None, []
         if resume:
             self._reopen()
-            remove_temporaries(self.directory)
+            for file in run_files.temporaries(self.directory):
+                file.unlink(missing_ok=True)
         else:
-            self._clear()
+            if not overwrite:
+                run_files.refuse_replacing(self.directory, False, "resume=True", "overwrite=True")
+            run_files.clear(self.directory)
 
     # ----------------------------------------------------------------- the sink protocol
 
@@ -106,6 +112,12 @@ class RunWriter:
         if self.static is None:
             self.static, self.meta = static_arrays(system), dict(run_meta(system), **self.extra_meta)
         self._plan_views(0 if self.t_out is None else len(self.t_out))
+        first = self.t[-1] if self.t else None if self.t_out is None else self.t_out[0]
+        self.record.t_start = None if first is None else float(first)
+        if self._dropped:  # list the chunks kept before a chunk of the same name replaces a dropped one
+            self._write(None, None, None, list(self.chunks), self._index(dict(success=True, message="running",
+                                                                             complete=False)))
+            self._dropped = []
 
     def frames(self, t, y):
         """Store the states ``y`` (n, size) at output times ``t`` (n,) as one chunk."""
@@ -113,6 +125,21 @@ class RunWriter:
 
         with self._timed():
             self.store(from_states(self.system, np.asarray(t, dtype=float), np.asarray(y), True, "", {}))
+
+    def account(self, stats):
+        """The solver's statistics of the frames stored next (:func:`rodmol.solve.chunked.run_chunked`
+        calls it before :meth:`frames`): the index records the work of each chunk kept."""
+        self.record.account(stats)
+
+    def record_settings(self, settings, forced=()):
+        """Record the run's settings (:mod:`rodmol._settings`, from ``simulate``) in the index;
+        ``forced``: what a forced resume changed."""
+        self.record.settings, self.record.forced = dict(settings), list(forced)
+
+    @property
+    def settings(self):
+        """The settings of the run in the directory (None: not recorded, an older rodmol's)."""
+        return self.record.settings
 
     def flush(self):
         """Wait until the chunks stored so far are on disk; raises the ``OSError`` of one that
@@ -131,6 +158,7 @@ class RunWriter:
                 job.result()
             except BaseException:
                 del self.t[len(self.t) - self.chunks.pop(name):]
+                self.record.drop([name])
                 if report:
                     raise
 
@@ -143,10 +171,8 @@ class RunWriter:
                 if self._pool is not None:
                     self._pool.shutdown()
                     self._pool = None
-            if self.previous is not None:  # a resumed run: the statistics of both parts
-                stats = merge_stats([self.previous.get("stats", {}), stats])
             h5result.write_index(*self._index(dict(success=bool(success), message=str(message),
-                                                    stats=dict(stats), complete=True)))
+                                                    complete=True), dict(stats)))
         return self.result()
 
     # ----------------------------------------------------------------- other uses
@@ -163,10 +189,11 @@ class RunWriter:
         shown = chunk if len(frames) == n else chunk.select(frames)
         name = h5result.chunk_name(len(self.chunks))
         self.chunks[name] = n
+        self.record.stored(name)
         self.t.extend(np.asarray(chunk.t, dtype=float).tolist())
         # The chunk that ends the planned run leaves the index to end() (a kill before it: resumed there).
         final = self.t_out is not None and len(self.t) == len(self.t_out)
-        index = None if final else self._index(dict(success=True, message="running", stats={}, complete=False))
+        index = None if final else self._index(dict(success=True, message="running", complete=False))
         # The thread writes each batch of arrays while this one computes the next, then the views' text.
         posed, moving = self._view_batches(shown) if self.views else ([], [])
         batches = [*posed, lambda: {key: getattr(chunk, key) for key in LOADS}, *moving]
@@ -213,9 +240,11 @@ class RunWriter:
         function returning their XDMF text, or None without views) and the index that lists
         it (``index``: the arguments of :func:`h5result.write_index`, or None), in the writer's
         thread (h5py lets the solver run meanwhile)."""
-        h5result.write_chunk(self.directory, name, batches)
-        if fragment is not None:
-            xdmf.write_fragment(self.directory / (name[:-3] + ".xmf"), fragment())
+        if name is not None:
+            h5result.write_chunk(self.directory, name, batches)
+        if fragment is not None or (name is None and self.views):
+            if fragment is not None:
+                xdmf.write_fragment(self.directory / (name[:-3] + ".xmf"), fragment())
             fragments = [c[:-3] + ".xmf" for c in chunks]
             for view in self.view_names():
                 xdmf.write_view(self.directory / f"{view}.xdmf", view, fragments)
@@ -226,6 +255,7 @@ class RunWriter:
         """Write a finished in-memory :class:`rodmol.Result`, chunk by chunk; returns the path of ``rod.xdmf``."""
         self.t_out = np.asarray(result.t, dtype=float)
         self._plan_views(len(self.t_out))
+        self.record.t_start = float(result.t[0]) if len(result.t) else 0.0
         with self._timed():
             for k0 in range(0, len(result.t), self.chunk_frames):
                 self.store(result.select(slice(k0, k0 + self.chunk_frames)))
@@ -236,33 +266,55 @@ class RunWriter:
         return h5result.read_result(self.directory / INDEX)
 
     def resume_point(self):
-        """(planned output times, index of the last frame kept, its state) of the run being resumed."""
-        if not self.chunks:
-            raise ParameterError(f"nothing to resume in {str(self.directory)!r}: no frames were kept")
-        _, y = h5result.last_state(self.directory, self.chunks)
-        return self.t_out, len(self.t) - 1, y
+        """(planned output times, index of the restart frame, its state) of the run being resumed:
+        the last frame of its last complete chunk (see :meth:`_reopen`)."""
+        return self.t_out, self.restart[0], self.restart[2]
 
     # ----------------------------------------------------------------- internals
 
     def _reopen(self):
+        """Read the run to resume; its restart point is the last frame of its last complete chunk
+        (the frame the uninterrupted run restarted from): the frames after it, a chunk that
+        Ctrl-C or a failure cut short, are dropped and redone."""
         path = self.directory / INDEX
         if not path.is_file():
             raise ParameterError(f"nothing to resume in {str(self.directory)!r}: no {INDEX}")
-        index = h5result.read_index(path)
-        if index["info"].get("complete", True) and index["info"].get("success"):
+        with damaged(path):
+            index = h5result.read_index(path)
+            info = index["info"]
+            finished = info.get("complete", True) and info.get("success")
+            self.chunks, self.t, self.t_out = dict(index["chunks"]), index["t"].tolist(), index["t_out"]
+            self.static = {key: index[key] for key in STATIC}
+            # The restart points of the run being resumed, whatever this writer was given.
+            self.chunk_frames = int(info.get("chunk_frames", self.chunk_frames))
+            self.every = info.get("every") or self.every
+            self.meta = dict(info.get("meta") or {}, **self.extra_meta)
+            self.record = RunRecord(info)
+        if finished:
             raise ParameterError(f"nothing to resume in {str(self.directory)!r}: the run there finished "
-                                 f"({index['info']['message']})")
-        self.chunks, self.t, self.t_out = dict(index["chunks"]), index["t"].tolist(), index["t_out"]
-        self.static = {key: index[key] for key in STATIC}
-        self.meta = dict(index["info"].get("meta") or {}, **self.extra_meta)
-        # The restart points of the run being resumed, whatever this writer was given.
-        self.chunk_frames = int(index["info"].get("chunk_frames", self.chunk_frames))
-        self.every = index["info"].get("every") or self.every
-        self.previous = index["info"]
+                                 f"({info['message']})")
+        if not self.chunks:
+            raise ParameterError(f"nothing to resume in {str(self.directory)!r}: no frames were kept")
+        self._roll_back()
 
-    def _clear(self):
-        clear_outputs(self.directory)
-        (self.directory / "result.npz").unlink(missing_ok=True)
+    def _roll_back(self):
+        """Keep the chunks up to the last restart point (a frame index that is a multiple of
+        ``chunk_frames``); ``restart``: (its index, time, state)."""
+        last = len(self.t) - 1
+        point = last - last % self.chunk_frames
+        kept, frames = {}, 0
+        for name, n in self.chunks.items():
+            if frames + n - 1 > point:
+                break
+            kept[name], frames = n, frames + n
+        # The first chunk cut short: its first frame, the run's initial state, is the restart point.
+        chunk, row = (list(kept)[-1], -1) if kept else (list(self.chunks)[0], 0)
+        with damaged(self.directory / chunk):
+            t, state = h5result.frame_state(self.directory, chunk, row)
+        self._dropped = [name for name in self.chunks if name not in kept]
+        self.record.drop(self._dropped)
+        self.chunks, self.t = kept, self.t[:frames]
+        self.restart = (point, t, state)
 
     def view_names(self):
         """The views this run has: the rod, and the cables and markers if any."""
@@ -342,12 +394,13 @@ class RunWriter:
 
         return [pose] + ([cables] if "cable_s" in fixed else []) + ([markers] if "marker_s" in fixed else []), [motion]
 
-    def _index(self, info):
-        """The arguments of :func:`h5result.write_index` now (copies: the run goes on)."""
-        if self.previous is not None and not info.get("complete"):
-            info["stats"] = self.previous.get("stats", {})
-        info.update(meta=self.meta or {}, chunk_frames=self.chunk_frames, every=self.every)
+    def _index(self, info, stats=None):
+        """The arguments of :func:`h5result.write_index` now (copies: the run goes on); ``stats``:
+        the session's statistics once it ended (:class:`RunRecord`)."""
         t = np.array(self.t)
+        reached = float(t[-1]) if len(t) else self.record.t_start
+        info.update(self.record.info(list(self.chunks), reached, stats))
+        info.update(meta=self.meta or {}, chunk_frames=self.chunk_frames, every=self.every)
         return self.directory, self.static, self.t_out if self.t_out is not None else t, t, dict(self.chunks), info
 
 
@@ -358,31 +411,3 @@ def _load_once():
     # The views' compiled kernel for their number type: a cable over a two-node rod.
     cable_point_array(np.array([0.0, 1.0]), np.zeros((1, 2, 3)), np.tile(np.eye(3), (1, 2, 1, 1)),
                       {"cables": [{"anchor": 1.0, "offset": [0.0, 0.0]}]}, VIEW)
-
-
-#: The files a run writes in its directory (the chunks are in ``frames/``).
-_RUN_FILES = (INDEX, *(f"{view}.xdmf" for view in xdmf.VIEWS))
-
-
-def clear_outputs(directory):
-    """Remove the streamed outputs of an earlier run in ``directory``, so nothing stale is listed or read."""
-    directory = Path(directory)
-    frames = directory / h5result.FRAMES
-    refuse_directories([directory / name for name in _RUN_FILES])
-    if frames.exists() and not frames.is_dir():
-        raise ParameterError(f"{str(frames)!r} is a file, where rodmol writes the folder of the frames; "
-                             "remove it or choose another output directory")
-    for name in _RUN_FILES:
-        (directory / name).unlink(missing_ok=True)
-    if frames.is_dir():
-        for file in frames.glob("chunk_*"):
-            file.unlink()
-    remove_temporaries(directory)
-
-
-def remove_temporaries(directory):
-    """Remove the half-written files a killed run left (hidden ``.part`` files, never listed)."""
-    directory = Path(directory)
-    for pattern in (*_RUN_FILES, f"{h5result.FRAMES}/chunk_*"):
-        for file in leftover_temporaries(directory / pattern):
-            file.unlink(missing_ok=True)

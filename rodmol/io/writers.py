@@ -19,7 +19,6 @@ and distributed loads and contact, see :mod:`rodmol.loads`) in global ones;
 ``velocity (global) [m/s]`` is the velocity in global components, for glyphs.
 """
 
-import re
 import time
 import xml.etree.ElementTree as ET
 from pathlib import Path
@@ -29,9 +28,10 @@ import numpy as np
 from .._files import output_directory, refuse_directories, write_atomically
 from ..discretise.rotations import rotate
 from ..errors import ParameterError
+from . import run_files
 from .parts import PARTS, ROD_ARRAYS, cable_points, view_step
 
-SUBDIRECTORY = "vtk"
+SUBDIRECTORY = run_files.SERIES
 
 
 def polydata(points, lines=(), vertices=False, point_data=None, cell_data=None, field_data=None):
@@ -195,10 +195,8 @@ class SeriesWriter:
         (self.directory / SUBDIRECTORY).mkdir(parents=True, exist_ok=True)
         self.entries = {part: [] for part in self.parts}
         self.frames, self.flush_interval = 0, float(flush_interval)
-        stale = re.compile(rf"({'|'.join(PARTS)})_\d+\.vtp")
-        for file in (self.directory / SUBDIRECTORY).iterdir():
-            if stale.fullmatch(file.name):
-                file.unlink()
+        for file in run_files.numbered(self.directory, SUBDIRECTORY):
+            file.unlink()
         for part in PARTS:
             pvd = self.pvd(part)
             if part in self.parts:
@@ -271,11 +269,9 @@ def write_series(result, directory, every=None, format="xdmf"):
         from .stream import RunWriter
 
         return RunWriter(directory, every=every).write_result(result)
-    from .stream import clear_outputs
-
-    refuse_directories([directory / "result.npz", *(directory / f"{part}.pvd" for part in PARTS)])
-    clear_outputs(directory)  # load_result would read a stale result.h5 first
-    result.save(Path(directory) / "result.npz")
+    refuse_directories([directory / run_files.NPZ, *(directory / f"{part}.pvd" for part in PARTS)])
+    run_files.clear(directory)  # load_result would read a stale result.h5 first
+    result.save(directory / run_files.NPZ)
     with SeriesWriter.for_result(result, directory) as writer:
         for k in frame_indices(len(result.t), every):
             writer.write(result, k)

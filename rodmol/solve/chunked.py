@@ -7,8 +7,10 @@ chunk integrates exactly what the uninterrupted run did. Memory is bounded by
 one chunk's states. Any sink with ``chunk_frames``, ``begin(system, t_out)``,
 ``frames(t, y)`` and ``end(success, message, stats)`` works (and ``flush()``,
 if it has one, is called before ``end``: where a sink that writes behind the
-run reports a failed write; ``prepare(system)``, if it has one, is called by
-:func:`rodmol.simulate` while the compiled kernels are prepared)
+run reports a failed write; ``account(stats)``, if it has one, gets the
+solver's statistics of each chunk before its ``frames``; ``prepare(system)``
+and ``record_settings(settings, forced)``, if it has them, are called by
+:func:`rodmol.simulate` before the run)
 (:class:`rodmol.io.stream.RunWriter` is the one rodmol ships).
 """
 
@@ -64,6 +66,7 @@ def _chunks(run, system, y, t_out, sink, k, size, report, started, parts, max_wa
         parts.append(raw.stats)
         keep = 0 if k == 0 else 1  # a chunk's first frame is the previous chunk's last
         if len(raw.t) > keep:
+            getattr(sink, "account", lambda stats: None)(raw.stats)
             failed = _store(parts, sink.frames, raw.t[keep:], raw.y[keep:])
             if failed:
                 return failed

@@ -22,7 +22,7 @@ MAX_STATE_BYTES = 2 * 1024**3
 COMMON = ("rtol", "atol", "progress", "max_wall_time")
 #: simulate's own keywords, offered as suggestions for misspelled options.
 SIMULATE_KEYWORDS = ("initial", "scheme", "backend", "rtol", "atol", "output_dt", "output_times",
-                     "t0", "progress", "max_wall_time")
+                     "t0", "progress", "max_wall_time", "out", "resume", "overwrite")
 
 
 def _integer_in(low, high):

@@ -111,7 +111,7 @@ def test_vtp_format_writes_the_series_and_result_npz(tmp_path):
                           "--quiet")
     assert streamed.returncode == 0 and (out / "result.h5").is_file()
     run = rodmol_cli("run", EXAMPLES / "bending.toml", "--out", out, "--n-elements", 6, "--t-end", 0.05,
-                     "--format", "vtp")
+                     "--format", "vtp", "--overwrite")
     assert run.returncode == 0, run.stderr
     assert not (out / "result.h5").exists()  # the streamed run's files are not left to be read instead
     result = rodmol.load_result(out)

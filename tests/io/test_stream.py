@@ -6,6 +6,7 @@ import signal
 import subprocess
 import sys
 import time
+from functools import partial
 
 import numpy as np
 import pytest
@@ -98,27 +99,9 @@ def test_write_series_leaves_a_directory_load_result_reads(model, tmp_path):
     np.testing.assert_allclose(rodmol.load_result(tmp_path / "y").positions, memory.positions)
 
 
-class Killed(BaseException):
-    """Stands for a SIGKILL between two chunks, once the chunks before are on disk."""
-
-
-class DiesAfter(RunWriter):
-    def __init__(self, directory, chunks, **options):
-        super().__init__(directory, **options)
-        self.left = chunks
-
-    def frames(self, t, y):
-        if self.left == 0:
-            self.flush()
-            raise Killed
-        self.left -= 1
-        super().frames(t, y)
-
-
-def test_resume_after_a_kill_repeats_the_uninterrupted_run(model, tmp_path):
+def test_resume_after_a_kill_repeats_the_uninterrupted_run(model, tmp_path, killed):
     whole = rodmol.simulate(model, 0.5, out=RunWriter(tmp_path / "whole", chunk_frames=8))
-    with pytest.raises(Killed):
-        rodmol.simulate(model, 0.5, out=DiesAfter(tmp_path / "cut", 3, chunk_frames=8))
+    killed(partial(rodmol.simulate, model, 0.5), tmp_path / "cut", 3, chunk_frames=8)
     cut = rodmol.load_result(tmp_path / "cut")
     assert not cut.success and "resume" in cut.message and len(cut.t) == 25
     assert assert_valid_views(tmp_path / "cut") == pytest.approx(cut.t)
@@ -135,9 +118,8 @@ def test_resume_after_a_kill_repeats_the_uninterrupted_run(model, tmp_path):
         rodmol.simulate(model, 0.5, out=tmp_path / "cut", resume=True)
 
 
-def test_resume_refuses_another_end_time_and_an_empty_directory(model, tmp_path):
-    with pytest.raises(Killed):
-        rodmol.simulate(model, 0.3, out=DiesAfter(tmp_path, 1, chunk_frames=5))
+def test_resume_refuses_another_end_time_and_an_empty_directory(model, tmp_path, killed):
+    killed(partial(rodmol.simulate, model, 0.3), tmp_path, 1, chunk_frames=5)
     with pytest.raises(rodmol.ParameterError, match="resumed ends at 0.3 s"):
         rodmol.simulate(model, 0.4, out=tmp_path, resume=True)
     with pytest.raises(rodmol.ParameterError, match="nothing to resume"):

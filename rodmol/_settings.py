@@ -1,0 +1,86 @@
+"""How a run was made, as :func:`rodmol.simulate` records it for a streamed run
+(``result.h5``'s ``info["settings"]``), and the check of a resumed run against it.
+
+A resumed run continues with the recorded settings wherever the call gives
+none, and is refused (:func:`check`) when the call or the scenario asks for
+another value, unless it forces the resume (``resume="force"``, the command
+line's ``--resume-anyway``). The grid and the output times cannot be
+forced: the frames kept fix them.
+"""
+
+import json
+
+import numpy as np
+
+from ._fingerprint import fingerprint, model_fingerprint
+from .errors import ParameterError
+
+#: The recorded settings, in the order messages name them, with how a message names each.
+NAMES = {"n_elements": "number of elements N (the grid)", "model": "model (fingerprint of its parameters)",
+         "scheme": "scheme", "backend": "backend", "rtol": "rtol", "atol": "atol",
+         "backend_options": "backend options", "initial": "initial state"}
+
+
+def record(model, *, scheme, backend, rtol, atol, backend_options, initial):
+    """The settings of a run (JSON values): ``scheme`` a scheme's name, ``atol`` None for
+    :func:`rodmol.simulate.default_atol` or the per-entry array, ``initial`` a name or the
+    state vector (recorded as its fingerprint)."""
+    return dict(n_elements=int(model.n_elements), model=model_fingerprint(model), scheme=str(scheme),
+                backend=str(backend), rtol=float(rtol),
+                atol=None if atol is None else np.asarray(atol, dtype=float).tolist(),
+                backend_options=json.loads(json.dumps(dict(backend_options), default=repr)),
+                initial=initial if isinstance(initial, str) else
+                f"a state vector (fingerprint {fingerprint(np.asarray(initial, dtype=float))[:16]})")
+
+
+def differences(recorded, current):
+    """(name, the run's value, this call's value) of each recorded setting that differs."""
+    found = []
+    for key in NAMES:
+        if key not in recorded:  # recorded by an older rodmol
+            continue
+        run, now = recorded[key], current[key]
+        if key == "atol" and run is not None and now is not None:
+            same = np.array_equal(np.asarray(run, dtype=float), np.asarray(now, dtype=float))
+        else:
+            same = run == now
+        if not same:
+            found.append((key, run, now))
+    return found
+
+
+def check_grid(recorded, n_elements, where):
+    """Refuse to resume the run in ``where`` on another grid than its recorded one."""
+    run = recorded.get("n_elements", n_elements)
+    if run != n_elements:
+        raise ParameterError(f"cannot resume the run in {where}: {NAMES['n_elements']}: the run {run!r}, this "
+                             f"call {n_elements!r} (the states kept are on the run's grid: resume with its "
+                             "number of elements, or start a new run)")
+
+
+def check(recorded, current, force, where):
+    """Refuse (ParameterError) to resume the run in ``where`` with ``current`` settings other
+    than ``recorded``, unless ``force`` (then the grid still must match); returns the
+    differences, described (for the record of a forced resume)."""
+    check_grid(recorded, current["n_elements"], where)
+    found = differences(recorded, current)
+    said = [f"{NAMES[key]}: the run {_show(key, run)}, this call {_show(key, now)}" for key, run, now in found]
+    if found and not force:
+        raise ParameterError(
+            f"cannot resume the run in {where} with other settings than it was made with:\n  "
+            + "\n  ".join(said) + "\nleave them out of the call (or the scenario) to continue with the run's, "
+            "or force it: simulate(..., resume='force'), on the command line `--resume-anyway`")
+    return said
+
+
+def _show(key, value):
+    if key == "atol":
+        if value is None:
+            return "default (rtol times the fields' scales)"
+        values = np.asarray(value, dtype=float)
+        return f"{values[0]!r}" if np.all(values == values[0]) else f"an array from {values.min()!r} to {values.max()!r}"
+    if key == "backend_options":
+        return ", ".join(f"{k}={v!r}" for k, v in sorted(value.items())) or "none"
+    if key == "model":
+        return str(value)[:16]
+    return repr(value)
