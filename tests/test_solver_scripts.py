@@ -28,6 +28,7 @@ SCRIPTS = {
     "long_output.py": ["long_output.csv", "long_output.md"],
     "stiff_cantilever.py": ["stiff_cantilever.csv", "stiff_cantilever.md"],
     "view_open.py": ["view_open.csv", "view_open.md"],
+    "quaternion_norm.py": ["quaternion_norm.csv", "quaternion_norm.md"],
 }
 
 

@@ -19,7 +19,9 @@ from .routing import CableRouting
 from .schemes import DEFAULT_SCHEME, get_scheme
 
 #: Rate [1/s] at which the quaternion norm is pulled back to 1; the exact
-#: dynamics keep |Q| = 1, so this only damps integration drift.
+#: dynamics keep |Q| = 1, so this only damps integration drift (larger rates
+#: did not help: the drift is each step's error, up to the tolerance; the
+#: stored states are projected instead, ``StateLayout.project_quaternions``).
 QUATERNION_RESTORING_RATE = 1.0
 #: Smoothing speed [m/s] of |v| in the drag law, so the implicit solver's
 #: Newton iterations see a differentiable right-hand side near v = 0.

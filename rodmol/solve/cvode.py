@@ -103,7 +103,7 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, l
     elif linsolver == "sparse":
         options["sparsity"] = sparse.csc_matrix(system.pattern())
 
-    out = Outputs(t_out, y0, progress)
+    out = Outputs(t_out, y0, progress, system.layout)
     watch = Watch(system, t_out, max_wall_time, progress)
     evals = [0]  # counted here: CVODE's own counter leaves out the Jacobian's evaluations
 

@@ -94,7 +94,7 @@ def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_
     alpha_m, alpha_f, gamma = coefficients(float(rho_inf))
     kappa = alpha_m * (1.0 - gamma) / gamma - (1.0 - alpha_m)  # weight of ydot_n in b
 
-    out = Outputs(t_out, y0, progress)
+    out = Outputs(t_out, y0, progress, system.layout)
     watch = Watch(system, t_out, max_wall_time, progress)
     scale = np.broadcast_to(atol, (system.size,)) / rtol
     matrix = newton_matrix(system, scale)

@@ -22,10 +22,15 @@ class RawSolution:
 
 
 class Outputs:
-    """Collects states at the output times (in one preallocated array) and reports progress."""
+    """Collects states at the output times (in one preallocated array) and reports progress.
 
-    def __init__(self, t_out, y0, progress):
-        self.t_out, self.progress = t_out, progress
+    The states handed back have unit quaternions (``layout.project_quaternions``,
+    once over all frames, when the solution is made); the integration itself
+    is not touched.
+    """
+
+    def __init__(self, t_out, y0, progress, layout):
+        self.t_out, self.progress, self.layout = t_out, progress, layout
         self.start = time.perf_counter()
         self.ys = np.empty((len(t_out), len(y0)))
         self.ys[0] = y0
@@ -54,6 +59,7 @@ class Outputs:
     def solution(self, success, message, error=None, **stats):
         stats["wall_time_s"] = time.perf_counter() - self.start
         n = self.next_index
+        self.layout.project_quaternions(self.ys[:n])
         return RawSolution(self.t_out[:n].copy(), self.ys[:n], success, message, stats, error)
 
 

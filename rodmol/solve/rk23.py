@@ -19,7 +19,7 @@ def rk23(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, ma
         evals[0] += 1
         return system(t, y)
 
-    out = Outputs(t_out, y0, progress)
+    out = Outputs(t_out, y0, progress, system.layout)
     watch = Watch(system, t_out, max_wall_time, progress)
     sizes = []
 
