@@ -16,6 +16,7 @@ from .result import Result, from_states
 from .solve import kernels, options
 from .solve.backends import get_backend
 from .solve.equilibrium import equilibrium
+from .solve.outputs import keep_before_failure
 from .solve.watch import state_problem
 
 INITIAL = ("equilibrium", "straight")
@@ -156,8 +157,8 @@ def simulate(model, t_end, *, initial="equilibrium", scheme=DEFAULT_SCHEME, back
         if sink is not None:
             return _streamed(run, system, y0, t_out, sink, first, backend, timings, rtol=rtol, atol=atol,
                              progress=progress, max_wall_time=max_wall_time, **backend_options)
-        raw = run(system, y0, t_out, rtol=rtol, atol=atol, progress=progress,
-                  max_wall_time=max_wall_time, **backend_options)
+        raw = keep_before_failure(run, system, y0, t_out, rtol=rtol, atol=atol, progress=progress,
+                                  max_wall_time=max_wall_time, **backend_options)
     finally:
         if owned:
             progress.close()
