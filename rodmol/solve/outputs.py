@@ -26,9 +26,9 @@ class RawSolution:
 class Outputs:
     """Collects states at the output times (in one preallocated array) and reports progress.
 
-    The states handed back have unit quaternions (``layout.project_quaternions``,
-    once over all frames, when the solution is made); the integration itself
-    is not touched. ``backend`` names the backend in messages; ``watch`` (a
+    The states handed back after the first (the start, as given) have unit
+    quaternions (``layout.project_quaternions``, once over the frames, when
+    the solution is made); the integration itself is not touched. ``backend`` names the backend in messages; ``watch`` (a
     :class:`rodmol.solve.watch.Watch`) says how far it got.
     """
 
@@ -68,7 +68,7 @@ class Outputs:
     def solution(self, success, message, error=None, reason="", **stats):
         stats["wall_time_s"] = time.perf_counter() - self.start
         n = self.next_index
-        self.layout.project_quaternions(self.ys[:n])
+        self.layout.project_quaternions(self.ys[1:n])
         return RawSolution(self.t_out[:n].copy(), self.ys[:n], success, message, stats, error,
                            self._ending(reason))
 
