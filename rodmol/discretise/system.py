@@ -7,7 +7,8 @@ layout, the Jacobian pattern and bandwidths derived from the scheme's and the
 loads' declared dependencies, and factories for the compiled Jacobian and the
 block preconditioner. Backends and the equilibrium solver use only this
 interface (``size``, ``__call__``, ``layout``, ``pattern``, ``bandwidths``,
-``jacobian``, ``preconditioner``, ``global_coupling``).
+``jacobian``, ``preconditioner``, ``global_coupling``, ``update_inputs``,
+``inputs_vary``).
 """
 
 import numpy as np
@@ -213,6 +214,12 @@ class SemiDiscrete:
         self._entry_params = np.ascontiguousarray(entries.params, dtype=float).reshape(-1, external.N_PARAMS)
         self.entry_values = np.ascontiguousarray(entries.initial, dtype=float).reshape(-1, 3)
         self._grid_loads = entries
+
+    @property
+    def inputs_vary(self):
+        """True if an input changes with time or state: :meth:`update_inputs` then
+        runs at every evaluation (else the inputs were read once)."""
+        return self._inputs_vary
 
     def update_inputs(self, t, y=None, tensions=None):
         """Evaluate the time-dependent inputs at t, in place: the tensions of

@@ -28,7 +28,8 @@ class Outputs:
 
     The states handed back after the first (the start, as given) have unit
     quaternions (``layout.project_quaternions``, once over the frames, when
-    the solution is made); the integration itself is not touched. ``backend`` names the backend in messages; ``watch`` (a
+    the solution is made); the integration itself is not touched.
+    ``backend`` names the backend in messages; ``watch`` (a
     :class:`rodmol.solve.watch.Watch`) says how far it got.
     """
 
@@ -168,6 +169,8 @@ def _inputs_hold(system, raw):
     a function failing from exactly that time on was never called there;
     the Result, which evaluates the inputs at every frame, would then fail.
     """
+    if not system.inputs_vary:  # read once, before the run
+        return raw
     k, error = len(raw.t), None
     while k > 1:
         try:

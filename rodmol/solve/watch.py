@@ -196,7 +196,3 @@ class Watch:
         return ("; or the rod is stiff and lightly damped (no mode of the grid is damped): try "
                 "max_order=2 with CVODE or backend='galpha' (docs/troubleshooting.md)")
 
-    def summary(self):
-        """How far the solver got: time reached, step count and last step size."""
-        return (f"the solver reached t = {self.t:.6g} s in {self.steps} steps, last step "
-                f"{self.h_last:.3g} s")
