@@ -28,7 +28,14 @@ def user_error(what, exc, t=None):
     text = str(exc)
     text = text if len(text) <= SHORT else text[:SHORT] + f"... ({len(text)} characters)"
     when = f" (at t = {float(t):.6g} s)" if t is not None else ""
-    return UserFunctionError(f"{what} raised {type(exc).__name__}: {text}{when}")
+    return UserFunctionError(f"{what} raised {type(exc).__name__}: {text}{when}", t=t)
+
+
+def bad_return(what, value, t, expected):
+    """The :class:`UserFunctionError` for the user's function ``what`` that
+    returned ``value`` at time ``t`` [s] where ``expected`` was due."""
+    shown = repr(float(value)) if isinstance(value, np.floating) else short(value)
+    return UserFunctionError(f"{what} returned {shown} at t = {float(t):.6g} s; {expected}", t=t)
 
 
 def floats(value):

@@ -51,14 +51,24 @@ class BaseMotion:
 
     def velocities(self, t):
         """(v0, w0) at time t [m/s, rad/s], local frame."""
+        return self._velocity("velocity", t), self._velocity("angular_velocity", t)
+
+    def _velocity(self, name, t):
+        """The base's ``name`` function at t, checked: three finite numbers."""
+        function = getattr(self, name)
+        if function is None:
+            return _ZERO
+        what = f"the base motion's `{name}` function"
         try:
-            v = _ZERO if self.velocity is None else _vector(self.velocity(t), "velocity", t)
-            w = _ZERO if self.angular_velocity is None else _vector(self.angular_velocity(t), "angular_velocity", t)
+            value = function(t)
         except RodmolError:
             raise
         except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
-            raise _checks.user_error("a base motion function", exc, t) from exc
-        return v, w
+            raise _checks.user_error(what, exc, t) from exc
+        arr = _checks.floats(value)
+        if arr is None or arr.shape != (3,) or not np.all(np.isfinite(arr)):
+            raise _checks.bad_return(what, value, t, "it must return three finite numbers")
+        return arr
 
     @classmethod
     def from_pose(cls, position, rotation=None, dt=1e-6):
@@ -82,13 +92,6 @@ class BaseMotion:
         r0 = np.eye(3) if rotation is None else np.asarray(rotation(0.0), dtype=float)
         return cls(velocity, angular, tuple(np.asarray(position(0.0), dtype=float)),
                    tuple(map(tuple, r0)))
-
-
-def _vector(value, name, t):
-    arr = _checks.floats(value)
-    if arr is None or arr.shape != (3,) or not np.all(np.isfinite(arr)):
-        raise ParameterError(f"base `{name}`({t!r}) must return three finite numbers, got {value!r}")
-    return arr
 
 
 #: Former name of :class:`BaseMotion`, kept so existing scripts still run.

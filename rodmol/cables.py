@@ -19,6 +19,7 @@ A tension input is any of
 """
 
 import inspect
+import math
 import os
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -39,6 +40,8 @@ class Tension:
     """
 
     feedback = False
+    #: What the input is called in messages.
+    label = "tension input"
 
     def __init__(self, signal: TimeInput):
         self.signal = signal
@@ -58,9 +61,10 @@ class FeedbackTension(Tension):
     function: Callable
     feedback = True
     constant = None
+    label = "feedback law T(t, state)"
 
     def __call__(self, t, state=None):
-        return float(self.function(t, state))
+        return self.function(t, state)  # checked by Cable.tension_at, which names the cable
 
 
 def read_tension_csv(path):
@@ -109,6 +113,7 @@ class ActuatorTension(Tension):
 
     feedback = True
     constant = None
+    label = "displacement-controlled tension"
 
     def __init__(self, name, position, compliance, base_to_actuator, rest_length, straight_length):
         self.name, self.position = name, position
@@ -264,13 +269,20 @@ class Cable:
         return float(np.sum(np.sqrt(np.diff(s) ** 2 + np.sum(np.diff(p, axis=0) ** 2, axis=1))))
 
     def tension_at(self, t, state=None):
-        """Tension [N] at time t; a negative value is an error naming the cable."""
+        """Tension [N] at time t; an exception or a value that is not a finite
+        tension >= 0 is a :class:`UserFunctionError` naming the cable, its input and t."""
+        what = f"cable {self.name!r}: the {self.tension.label}"
         try:
             value = self.tension(t, state)
         except RodmolError:
             raise
         except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
-            raise _checks.user_error(f"cable {self.name!r}: the tension function", exc, t) from exc
-        if not value >= 0.0:  # also catches NaN
-            raise ParameterError(f"cable {self.name!r}: tension must be >= 0 N, got {float(value)!r} at t = {float(t)!r} s")
+            raise _checks.user_error(what, exc, t) from exc
+        if not isinstance(value, float):
+            number = _checks.floats(value)
+            if number is None or number.size != 1:
+                raise _checks.bad_return(what, value, t, "a tension is one number [N]")
+            value = float(number.reshape(()))
+        if not 0.0 <= value < math.inf:  # also catches NaN
+            raise _checks.bad_return(what, value, t, "a tension must be finite and >= 0 N")
         return value

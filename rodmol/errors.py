@@ -25,9 +25,14 @@ class ParameterError(RodmolError, ValueError):
 
 
 class UserFunctionError(ParameterError):
-    """A function the user gave (a tension, a load, a base motion, a radius)
-    raised or returned garbage; the original exception, with its traceback,
-    is the ``__cause__``."""
+    """A function the user gave (a tension, a feedback law, a load, a base
+    motion, a radius, a progress callable) raised or returned garbage; the
+    original exception, with its traceback, is the ``__cause__``. ``t`` is the
+    time [s] at which it failed (None outside a time evaluation)."""
+
+    def __init__(self, message="", *args, t=None):
+        super().__init__(message, *args)
+        self.t = None if t is None else float(t)
 
 
 class IntegrationError(RodmolError, RuntimeError):

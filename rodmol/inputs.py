@@ -20,7 +20,7 @@ from bisect import bisect_right
 
 import numpy as np
 
-from ._checks import floats, short, user_error
+from ._checks import bad_return, floats, short, user_error
 from .errors import ParameterError, RodmolError
 
 
@@ -89,17 +89,19 @@ class Function(TimeInput):
     def value(self, t):
         try:
             raw = self.function(t)
-            if self.width == 1:
-                return float(raw)
         except RodmolError:
             raise
         except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
-            raise user_error(f"`{self.name}` function", exc, t) from exc
+            raise user_error(f"the function of `{self.name}`", exc, t) from exc
+        if self.width == 1 and isinstance(raw, (float, int, np.floating, np.integer)) and math.isfinite(raw):
+            return float(raw)  # the usual answer, without numpy's overhead at every evaluation
         arr = floats(raw)
-        if arr is None or arr.shape != (self.width,) or not np.all(np.isfinite(arr)):
-            raise ParameterError(f"`{self.name}`({float(t)!r} s) must return {self.width} finite "
-                                 f"numbers, got {short(raw)}")
-        return arr
+        if arr is not None and self.width == 1 and arr.size == 1:
+            arr = arr.reshape(())
+        if arr is None or arr.shape != ((self.width,) if self.width > 1 else ()) or not np.all(np.isfinite(arr)):
+            many = f"{self.width} finite numbers" if self.width > 1 else "a finite number"
+            raise bad_return(f"the function of `{self.name}`", raw, t, f"it must return {many}")
+        return float(arr) if self.width == 1 else arr
 
     def __repr__(self):
         return f"Function({self.function!r})"

@@ -163,13 +163,13 @@ class _DistributedLoad:
             raise
         except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
             raise _checks.user_error(f"{self.name}: the {self._what}(s, t) function", exc, t) from exc
+        what = f"{self.name}: the {self._what}(s, t) function"
         try:
             arr = np.broadcast_to(np.asarray(raw, dtype=float), (len(s), 3))
         except (TypeError, ValueError, OverflowError):
-            raise ParameterError(f"{self.name}: {self._what}(s, t) must return (len(s), 3) values "
-                                 f"for an array s, got {raw!r}") from None
+            raise _checks.bad_return(what, raw, t, "it must return (len(s), 3) values for an array s") from None
         if not np.all(np.isfinite(arr)):
-            raise ParameterError(f"{self.name}: {self._what}(s, t = {float(t)!r} s) is not finite")
+            raise _checks.bad_return(what, raw, t, "its values must be finite")
         return arr
 
     def on_grid(self, s_nodes, radius):

@@ -17,6 +17,7 @@ from .result import Result, from_states
 from .solve import kernels, options
 from .solve.backends import get_backend
 from .solve.equilibrium import equilibrium
+from .solve.outputs import keep_before_failure
 from .solve.scales import check_scales
 from .solve.watch import state_problem
 
@@ -177,8 +178,8 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         if sink is not None:
             return _streamed(run, system, y0, t_out, sink, first, backend, timings, rtol=rtol, atol=atol,
                              progress=progress, max_wall_time=max_wall_time, **backend_options)
-        raw = run(system, y0, t_out, rtol=rtol, atol=atol, progress=progress,
-                  max_wall_time=max_wall_time, **backend_options)
+        raw = keep_before_failure(run, system, y0, t_out, rtol=rtol, atol=atol, progress=progress,
+                                  max_wall_time=max_wall_time, **backend_options)
     finally:
         if owned:
             progress.close()

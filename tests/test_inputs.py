@@ -11,6 +11,7 @@ import pytest
 
 import rodmol
 from rodmol import Material, Model, ParameterError, Rod
+from rodmol.discretise.schemes import DEFAULT_SCHEME, get_scheme
 
 NAN, INF = float("nan"), float("inf")
 GOOD_MATERIAL = dict(E=110e3, nu=0.5, mu=300.0, rho=1080.0)
@@ -176,7 +177,7 @@ def negative_after_failure(t):
 @pytest.mark.parametrize("backend", ["cvode", "rk23", "galpha"])
 @pytest.mark.parametrize("tension, reason", [
     (lost_sensor, "RuntimeError: tension sensor lost"),
-    (negative_after_failure, "tension must be >= 0 N, got -1.0"),
+    (negative_after_failure, "the tension input returned -1.0 at t = "),
 ])
 def test_failed_integration_returns_partial_result(backend, tension, reason):
     # The arm is released from straight so that the solver is busy (small
@@ -191,23 +192,31 @@ def test_failed_integration_returns_partial_result(backend, tension, reason):
     # The message names the time reached, and it is the last frame's time.
     reached = float(re.search(r"t = ([-+0-9.e]+) s", res.message).group(1))
     assert reached == pytest.approx(res.t[-1], abs=1e-9)
-    # Frames run up to the failure and no further. A solver's rejected trial
-    # step may overshoot the failure time, so the last frame can be one output
-    # interval earlier, never later.
-    assert T_FAIL - 0.02 - 1e-9 <= res.t[-1] <= T_FAIL + 1e-9
+    # Frames run up to the failure and no further: a solver's trial step that
+    # overshot the failure time does not lose the frames before it.
+    assert res.t[-1] == pytest.approx(T_FAIL, abs=1e-12)
     assert np.allclose(np.diff(res.t), 0.01)
     for name in ("positions", "rotations", "velocity", "tensions", "quaternion_norm_error",
                  "markers"):
         assert len(getattr(res, name)) == len(res.t), name
 
     # The frames computed are the true motion: the same as a run with an input
-    # that agrees with this one up to the failure (to the integration tolerance).
+    # that agrees with this one up to the failure, to the integration's accuracy
+    # (the frames after the last step before the failure are integrated again
+    # from the last frame): rtol L where the step is error-controlled (measured
+    # 1.9e-6 L at rtol 3e-5), else generalized-alpha's own error at its fixed
+    # step (measured 1.7e-4 m against 5.7e-4 m).
     ok = rodmol.simulate(rodmol.paper_arm(10, tensions={11: 0.5}), 0.2, initial="straight",
                          backend=backend, output_dt=0.01)
     assert ok.success
     n = len(res.t)
     assert np.allclose(ok.t[:n], res.t)
-    assert np.max(np.abs(ok.positions[:n] - res.positions)) < 1e-6 * L
+    accuracy = 0.3 * get_scheme(DEFAULT_SCHEME).default_rtol * L
+    if backend == "galpha":
+        exact = rodmol.simulate(rodmol.paper_arm(10, tensions={11: 0.5}), T_FAIL, initial="straight",
+                                rtol=1e-8, output_dt=0.01)
+        accuracy = np.max(np.abs(ok.positions[:n] - exact.positions))
+    assert np.max(np.abs(ok.positions[:n] - res.positions)) < accuracy
 
 
 def test_successful_run_does_not_warn():

@@ -159,6 +159,13 @@ def _linear_mpc(out):
         assert errors[-1] < 5, row
 
 
+def _quaternion_norm(out):
+    for row in rows(out / "quaternion_norm.csv"):
+        # the projection keeps |Q| = 1 to round-off and leaves the motion where it was
+        assert row["max_norm_error_with"] < 1e-12 < row["max_norm_error_without"], row
+        assert row["tip_difference_m"] < 1e-6 and row["steps_with"] == row["steps_without"], row
+
+
 SCRIPTS = {
     "scaling.py": (["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"], _scaling),
     "temporal.py": (["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv", "temporal_options.csv"],
@@ -179,6 +186,7 @@ SCRIPTS = {
     "closed_loop.py": (["closed_loop.csv", "closed_loop.md"], _closed_loop),
     "inverse_statics.py": (["inverse_statics.csv", "inverse_statics.md"], _inverse_statics),
     "linear_mpc.py": (["linear_mpc.csv", "linear_mpc.md"], _linear_mpc),
+    "quaternion_norm.py": (["quaternion_norm.csv", "quaternion_norm.md"], _quaternion_norm),
 }
 
 

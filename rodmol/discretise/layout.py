@@ -20,6 +20,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .rotations import normalise
+
 #: Fields of an element block and their widths, in storage order.
 STATE_FIELDS = {"u": 3, "Q": 4, "q": 3, "k": 3, "v": 3, "w": 3}
 #: Fields of the base header: base position and quaternion.
@@ -159,6 +161,19 @@ class StateLayout(BlockLayout):
     def quaternions(self, y):
         """(..., N+1, 4) orientations of nodes 0..N (node 0: the base)."""
         return np.concatenate([self.base_quaternion(y)[..., None, :], self.field(y, "Q")], axis=-2)
+
+    def project_quaternions(self, y):
+        """Scale every orientation quaternion of ``y`` (..., size) to unit norm, in place.
+
+        The dynamics do not see |Q| (rotations divide by |Q|^2 and the
+        kinematics Q_t = Q (x) (0, w) / 2 are linear in Q), so this moves
+        nothing but the norm: the integrator lets it stray by up to its
+        tolerance during fast motion, and the stored states are put back on
+        the unit sphere.
+        """
+        y = y.reshape(-1, self.size)  # a view: the states are contiguous
+        normalise(y[:, None, 3:HEADER])
+        normalise(self.field(y, "Q"))
 
     def integrated_positions(self, y):
         """(..., N+1, 3) time-integrated positions of nodes 0..N [m], global."""

@@ -27,6 +27,22 @@ def _matrices(quat, out):
             out[n, i, 0], out[n, i, 1], out[n, i, 2] = r[3 * i], r[3 * i + 1], r[3 * i + 2]
 
 
+def normalise(quat):
+    """Scale quaternions (..., m, 4) (a strided view, e.g. of states) to unit norm, in place."""
+    _normalise(quat.reshape((-1,) + quat.shape[-2:]))
+
+
+@jit
+def _normalise(quat):
+    # Compiled: the numpy version took a tenth of the solver's time on 6001
+    # frames at N = 100 (temporaries per entry of a strided view).
+    for i in range(quat.shape[0]):
+        for j in range(quat.shape[1]):
+            norm = np.sqrt(quat[i, j, 0] ** 2 + quat[i, j, 1] ** 2 + quat[i, j, 2] ** 2 + quat[i, j, 3] ** 2)
+            for c in range(4):
+                quat[i, j, c] /= norm
+
+
 def rotate(matrices, vectors, out=None):
     """R v (n_t, n, 3) for rotation matrices R (n_t, n, 3, 3) and vectors v (n_t, n, 3): local
     vectors to the global frame. Strided arrays are read, and ``out`` written, in place."""

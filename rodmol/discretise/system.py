@@ -7,7 +7,8 @@ layout, the Jacobian pattern and bandwidths derived from the scheme's and the
 loads' declared dependencies, and factories for the compiled Jacobian and the
 block preconditioner. Backends and the equilibrium solver use only this
 interface (``size``, ``__call__``, ``layout``, ``pattern``, ``bandwidths``,
-``jacobian``, ``preconditioner``, ``global_coupling``).
+``jacobian``, ``preconditioner``, ``global_coupling``, ``update_inputs``,
+``inputs_vary``).
 """
 
 from dataclasses import replace
@@ -22,7 +23,9 @@ from .routing import CableRouting
 from .schemes import DEFAULT_SCHEME, get_scheme
 
 #: Rate [1/s] at which the quaternion norm is pulled back to 1; the exact
-#: dynamics keep |Q| = 1, so this only damps integration drift.
+#: dynamics keep |Q| = 1, so this only damps integration drift (larger rates
+#: did not help: the drift is each step's error, up to the tolerance; the
+#: stored states are projected instead, ``StateLayout.project_quaternions``).
 QUATERNION_RESTORING_RATE = 1.0
 #: Smoothing speed [m/s] of |v| in the drag law, so the implicit solver's
 #: Newton iterations see a differentiable right-hand side near v = 0.
@@ -237,6 +240,12 @@ class SemiDiscrete:
         self._entry_params = np.ascontiguousarray(entries.params, dtype=float).reshape(-1, external.N_PARAMS)
         self.entry_values = np.ascontiguousarray(entries.initial, dtype=float).reshape(-1, 3)
         self._grid_loads = entries
+
+    @property
+    def inputs_vary(self):
+        """True if an input changes with time or state: :meth:`update_inputs` then
+        runs at every evaluation (else the inputs were read once)."""
+        return self._inputs_vary
 
     def update_inputs(self, t, y=None, tensions=None):
         """Evaluate the time-dependent inputs at t, in place: the tensions of

@@ -18,22 +18,7 @@ import time
 
 import numpy as np
 
-#: Statistics that add up over chunks (the others: smallest, largest, median of medians, last).
-_SUMMED = ("steps", "rhs_evals", "jac_evals", "prec_setups", "prec_solves", "wall_time_s")
-
-
-def merge_stats(parts):
-    """One run's statistics from those of its chunks."""
-    parts = [p for p in parts if p]
-    merged = dict(parts[-1]) if parts else {}
-    for key in _SUMMED:
-        if any(key in p for p in parts):
-            merged[key] = sum(p.get(key, 0) for p in parts)
-    for key, pick in (("h_min", min), ("h_max", max), ("h_median", np.median)):
-        values = [p[key] for p in parts if key in p and p.get("steps", 1)]
-        if values:
-            merged[key] = float(pick(values))
-    return merged
+from .outputs import keep_before_failure, merge_stats  # noqa: F401 (merge_stats: stream.py's)
 
 
 def run_chunked(run, system, y0, t_out, sink, first=0, *, progress=None, max_wall_time=None, **options):
@@ -62,7 +47,8 @@ def _chunks(run, system, y, t_out, sink, k, size, report, started, parts, max_wa
             if budget <= 0:
                 return False, (f"stopped after t = {t_out[k]:.6g} s: the wall-time budget "
                                f"max_wall_time = {max_wall_time:g} s is used up"), merge_stats(parts), None
-        raw = run(system, y, t_out[k:stop + 1], progress=report, max_wall_time=budget, **options)
+        raw = keep_before_failure(run, system, y, t_out[k:stop + 1], progress=report,
+                                  max_wall_time=budget, **options)
         parts.append(raw.stats)
         keep = 0 if k == 0 else 1  # a chunk's first frame is the previous chunk's last
         if len(raw.t) > keep:

@@ -9,15 +9,12 @@ from scipy import sparse
 from ..discretise.preconditioner import check_structure
 from ..errors import ParameterError
 from ..inputs import knot_times
-from .outputs import Outputs, cause, run_steps, step_size_stats
+from .outputs import Outputs, run_steps, step_size_stats
 from .watch import Watch
 
 LINEAR_SOLVERS = ("gmres", "band", "lapackband", "sparse", "dense")
 #: How the direct linear solvers get the Jacobian (see :func:`cvode`).
 JACOBIANS = ("compiled", "sundials")
-#: Failed right-hand-side evaluations after which CVODE gives up: it has
-#: then crept up to where the inputs fail and can go no further.
-MAX_RHS_FAILURES = 50
 #: From this many elements on, linsolver="auto" picks the preconditioned GMRES.
 GMRES_MIN_ELEMENTS = 50
 
@@ -67,22 +64,23 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, l
     options, linsolver, precond = solver_options(system, rtol, atol, linsolver, max_step, jacobian,
                                                  max_order, max_nonlin_iters)
 
-    out = Outputs(t_out, y0, progress)
     watch = Watch(system, t_out, max_wall_time, progress)
+    out = Outputs(t_out, y0, progress, system.layout, "CVODE", watch)
     evals = [0]  # counted here: CVODE's own counter leaves out the Jacobian's evaluations
 
-    failures = []  # (t, exception) raised by the right-hand side
+    failed_at = []  # times [s] of right-hand sides that raised
 
     def rhs(t, y, yp):
         evals[0] += 1
         try:
             system(t, y, yp)
-        except Exception as exc:
-            # scikit-sundae would abort on an exception, throwing away a step that
-            # merely reached past the trouble: NaN rates make CVODE reject the
-            # trial step and retry shorter ones, so the run gets as close as it can.
-            failures.append((t, exc))
-            yp[:] = np.nan
+        except Exception:
+            # Only the inputs raise (a function of the user's): shorter steps would
+            # not help, so the exception stops CVODE at once (scikit-sundae hands
+            # it on); the frames of a step that reached past the failure are
+            # integrated again by keep_before_failure.
+            failed_at.append(t)
+            raise
 
     def stats():
         info = dict(steps=len(sizes), rhs_evals=evals[0], linear_solver=linsolver,
@@ -95,7 +93,7 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, l
         return info
 
     def stop(reason, error=None):
-        return out.stopped("CVODE", watch, reason, error, **stats())
+        return out.stopped(reason, error, **stats())
 
     t_end = float(t_out[-1])
     sizes, r, t_last = [], None, float(t_out[0])  # sizes of the steps taken [s]
@@ -116,10 +114,7 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, l
             while kinks and kinks[-1] <= t_last:
                 kinks.pop()
             r = solver.step(t_end, method="onestep", tstop=kinks[-1] if kinks else t_end)
-            if not r.success or len(failures) > MAX_RHS_FAILURES:
-                if failures:
-                    t_bad, exc = failures[-1]
-                    return stop(cause(exc, t_bad), exc)
+            if not r.success:
                 return stop(r.message)
             # After output times were interpolated inside the last step, CVODE's
             # next one-step call hands that step back again: count real steps only.
@@ -135,7 +130,7 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, l
             slow = watch.pace(r.t, r.y)
             if slow and not out.done:
                 return stop(slow)
-    return run_steps(steps, stop, out, stats)
+    return run_steps(steps, stop, out, stats, now=lambda: failed_at[-1] if failed_at else t_last)
 
 
 def solver_options(system, rtol, atol, linsolver="auto", max_step=0.0, jacobian="auto", max_order="auto",

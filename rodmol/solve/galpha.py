@@ -94,8 +94,8 @@ def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_
     alpha_m, alpha_f, gamma = coefficients(float(rho_inf))
     kappa = alpha_m * (1.0 - gamma) / gamma - (1.0 - alpha_m)  # weight of ydot_n in b
 
-    out = Outputs(t_out, y0, progress)
     watch = Watch(system, t_out, max_wall_time, progress)
+    out = Outputs(t_out, y0, progress, system.layout, "generalized-alpha", watch)
     scale = np.broadcast_to(atol, (system.size,)) / rtol
     matrix = newton_matrix(system, scale)
     weight = np.empty(system.size)
@@ -114,7 +114,7 @@ def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_
                     rho_inf=float(rho_inf), **step_size_stats(sizes))
 
     def stop(reason, error=None):
-        return out.stopped("generalized-alpha", watch, reason, error, **stats())
+        return out.stopped(reason, error, **stats())
 
     def newton(t_star, g, y_n, b, Y, f):
         """Solve Y - g f(t*, Y) = b in place from the guess Y: (outcome, iterations).

@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 from .. import _checks
-from ..errors import ParameterError
+from ..errors import ParameterError, RodmolError
 
 #: Relative tolerances accepted (outside: round-off, or no accuracy at all).
 RTOL_RANGE = (1e-14, 0.1)
@@ -99,12 +99,36 @@ def rtol(value):
 
 
 def progress(value):
+    """None, True (rodmol's display) or the user's callable, guarded (:class:`GuardedProgress`)."""
     if value is None or value is False:
         return None
     if value is not True and not callable(value):
         raise ParameterError(f"`progress` must be True, False, None or a callable progress(t, t_end), "
                              f"got {_checks.short(value)}")
-    return value
+    return value if value is True else GuardedProgress(value)
+
+
+class GuardedProgress:
+    """The user's ``progress(t, t_end)``: an exception it raises becomes a
+    :class:`rodmol.errors.UserFunctionError` naming it and t (the run then ends
+    as a failed run that keeps its frames, as for any function of the user's);
+    its other attributes (a ``stage`` context manager) are its own."""
+
+    def __init__(self, function):
+        self.function = function
+
+    def __call__(self, t, t_end):
+        try:
+            self.function(t, t_end)
+        except RodmolError:
+            raise
+        except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
+            raise _checks.user_error("the `progress` callable", exc, t) from exc
+
+    def __getattr__(self, name):
+        if name == "function":  # not set yet (a copy being made): no recursion
+            raise AttributeError(name)
+        return getattr(self.function, name)
 
 
 def max_wall_time(value):

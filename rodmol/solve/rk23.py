@@ -19,15 +19,15 @@ def rk23(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, ma
         evals[0] += 1
         return system(t, y)
 
-    out = Outputs(t_out, y0, progress)
     watch = Watch(system, t_out, max_wall_time, progress)
+    out = Outputs(t_out, y0, progress, system.layout, "RK23", watch)
     sizes = []
 
     def stats():
         return dict(steps=len(sizes), rhs_evals=evals[0], jac_evals=0, **step_size_stats(sizes))
 
     def stop(reason, error=None):
-        return out.stopped("RK23", watch, reason, error, **stats())
+        return out.stopped(reason, error, **stats())
 
     def steps():
         solver = RK23(rhs, float(t_out[0]), np.array(y0, dtype=float), float(t_out[-1]),

@@ -14,7 +14,7 @@ in a run of :func:`rodmol.simulate`.
 
 import numpy as np
 
-from .cvode import MAX_RHS_FAILURES, _small_pages, solver_options
+from .cvode import _small_pages, solver_options
 from .outputs import cause, step_size_stats
 from .watch import Watch
 
@@ -40,7 +40,7 @@ class Stepper:
 
         self.system = system
         options, self.linsolver, self.precond = solver_options(system, rtol, atol, **options)
-        self.evals, self.failures = 0, []
+        self.evals = 0
         self.sizes = []  # of the internal steps taken [s]
         self.restarts, self._njev, self._njev_before = 0, 0, 0  # CVODE's Jacobian count restarts with it
         self._solver = CVODE(self._rhs, **options)
@@ -50,11 +50,7 @@ class Stepper:
 
     def _rhs(self, t, y, yp):
         self.evals += 1
-        try:
-            self.system(t, y, yp)
-        except Exception as exc:  # noqa: BLE001 (NaN rates: CVODE retries shorter, as in cvode())
-            self.failures.append((t, exc))
-            yp[:] = np.nan
+        self.system(t, y, yp)  # an input's exception stops CVODE at once, as in cvode()
 
     def restart(self, t, y):
         """Re-initialise CVODE at state ``y`` at time ``t`` [s] (its BDF history is dropped)."""
@@ -72,7 +68,6 @@ class Stepper:
         t_start, y_start = self.t, self.y
         if restart and not self._fresh:
             self.restart(t_start, y_start)
-        self.failures.clear()
         watch = Watch(self.system, (t_start, t_end), max_wall_time, progress)
         try:
             self._steps(t_end, watch)
@@ -92,23 +87,22 @@ class Stepper:
         while True:
             r = solver.step(t_end, method="onestep", tstop=t_end)
             self._fresh, self._njev = False, int(r.njev)
-            if not r.success or len(self.failures) > MAX_RHS_FAILURES:
-                if self.failures:
-                    t_bad, exc = self.failures[-1]
-                    raise StepFailed(f"{watch.summary()}: {cause(exc, t_bad)}", exc)
-                raise StepFailed(f"{watch.summary()}: {r.message}")
+            if not r.success:
+                raise StepFailed(_why(watch, r.message))
             if r.t > t_last:
                 self.sizes.append(r.t - t_last)
                 t_last = r.t
                 broken = watch.state(r.t, self.sizes[-1], r.y)
                 if broken:
-                    raise StepFailed(f"{watch.summary()}: {broken}")
+                    raise StepFailed(_why(watch, broken))
             if r.t >= t_end:
-                self.t, self.y = float(t_end), r.y
+                # unit quaternions, as simulate's frames (the dynamics do not see |Q|)
+                self.t, self.y = float(t_end), np.array(r.y)
+                self.system.layout.project_quaternions(self.y)
                 return
             slow = watch.pace(r.t, r.y)
             if slow:
-                raise StepFailed(f"{watch.summary()}: {slow}")
+                raise StepFailed(_why(watch, slow))
 
     def stats(self):
         """Steps, evaluations and step sizes so far, as a run's ``stats``."""
@@ -120,3 +114,9 @@ class Stepper:
         else:
             info["jac_evals"] = self._njev_before + self._njev
         return info
+
+
+def _why(watch, reason):
+    """Why a step failed, with how far CVODE got (``watch``: its :class:`Watch`)."""
+    return (f"CVODE reached t = {watch.t:.6g} s in {watch.steps} steps "
+            f"(last step {watch.h_last:.3g} s): {reason}")

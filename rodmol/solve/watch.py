@@ -40,8 +40,9 @@ MIN_STRETCH = 0.05
 MAX_STRETCH = 10.0
 #: Largest rotation [rad] of the cross-section over one element, |k| ds.
 MAX_TURN = 0.5 * math.pi
-#: Largest departure of a quaternion's norm from 1 (the integration keeps it
-#: within ~1e-6; see ``QUATERNION_RESTORING_RATE``).
+#: Largest departure of a quaternion's norm from 1 inside the integration
+#: (which keeps it within about its tolerance; the stored states are projected
+#: back to |Q| = 1, see ``StateLayout.project_quaternions``).
 MAX_QUATERNION_DRIFT = 0.1
 #: Steps per stall check, and the mean step [fraction of the run's span]
 #: below which the window counts as a stall (1e8 steps or more to go).
@@ -195,7 +196,3 @@ class Watch:
         return ("; or the rod is stiff and lightly damped (no mode of the grid is damped): try "
                 "max_order=2 with CVODE or backend='galpha' (docs/troubleshooting.md)")
 
-    def summary(self):
-        """How far the solver got: time reached, step count and last step size."""
-        return (f"the solver reached t = {self.t:.6g} s in {self.steps} steps, last step "
-                f"{self.h_last:.3g} s")

@@ -10,6 +10,8 @@ vanishes by accident, and compared with the layout's structural pattern.
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from sksundae.jacband import bandwidth, j_pattern
 
 import rodmol
@@ -155,3 +157,29 @@ def test_state_accessors_and_straight_state():
     # Without gravity the straight rod is at rest: every rate vanishes.
     weightless = rodmol.Model(model.rod, 4, gravity=(0.0, 0.0, 0.0))
     assert np.all(rodmol.SemiDiscrete(weightless)(0.0, straight) == 0.0)
+
+
+@settings(max_examples=15, deadline=None)
+@given(scale=st.floats(0.5, 2.0), seed=st.integers(0, 2**16), case=st.sampled_from(CASES))
+def test_rates_do_not_see_the_quaternion_norm(scale, seed, case):
+    """What makes the projection of the stored states harmless: with every
+    quaternion scaled by c, the rates of the positions, strains and velocities
+    are unchanged (rotations divide by |Q|^2) and the quaternions' own rates
+    are c times the kinematics Q (x) (0, w) / 2 plus the norm's restoring term."""
+    model = models(4)[case]
+    system = rodmol.SemiDiscrete(model)
+    lay = system.layout
+    y = generic_state(model, np.random.default_rng(seed))
+    scaled = y.copy()
+    lay.field(scaled, "Q")[:] *= scale
+    scaled[3:lay.header] *= scale
+    f, f_scaled = system(0.3, y), system(0.3, scaled)
+    rate = rodmol.discretise.system.QUATERNION_RESTORING_RATE
+    for name in ("u", "q", "k", "v", "w"):
+        np.testing.assert_allclose(lay.field(f_scaled, name), lay.field(f, name), rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(lay.field(f_scaled, "Q"), scale * lay.field(f, "Q")
+                               + rate * (1.0 - scale**2) * lay.field(scaled, "Q"), rtol=1e-9, atol=1e-9)
+    # The projection puts the norm back and touches nothing else.
+    lay.project_quaternions(scaled)
+    np.testing.assert_allclose(scaled, y, rtol=1e-14, atol=1e-15)
+    np.testing.assert_allclose(np.linalg.norm(lay.quaternions(scaled), axis=-1), 1.0, rtol=1e-15)
