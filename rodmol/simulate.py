@@ -135,14 +135,16 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         recorded = getattr(sink, "settings", None) or {}
         _settings.check_grid(recorded, model.n_elements, _where(sink))
         t0, output_times = float(plan[first]), plan[first:]
-        scheme, backend = scheme or recorded.get("scheme"), backend or recorded.get("backend")
+        scheme = recorded.get("scheme") if scheme is None else scheme
+        backend = recorded.get("backend") if backend is None else backend
         rtol = recorded.get("rtol") if rtol is None else rtol
         atol = recorded.get("atol") if atol is None else atol
         if not backend_options and backend == recorded.get("backend"):  # (another backend: its own)
             backend_options = recorded.get("backend_options") or {}
     given_atol = atol  # None: the default, recorded as such
     run_args = check_run(model, initial=INITIAL[0] if initial is None else initial, t0=t0,
-                         scheme=scheme or DEFAULT_SCHEME, backend=backend or DEFAULT_BACKEND, rtol=rtol,
+                         scheme=DEFAULT_SCHEME if scheme is None else scheme,
+                         backend=DEFAULT_BACKEND if backend is None else backend, rtol=rtol,
                          atol=atol, progress=progress, max_wall_time=max_wall_time,
                          backend_options=backend_options)
     t0, run, backend, backend_options = run_args.t0, run_args.run, run_args.backend, run_args.backend_options

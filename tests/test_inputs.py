@@ -82,7 +82,7 @@ CASES = (
     + [(f"rtol={v}", lambda v=v: rodmol.simulate(small_model(), 0.1, rtol=v), "`rtol`", v)
        for v in BAD_NUMBERS]
     + [(f"backend={v!r}", lambda v=v: rodmol.simulate(small_model(), 0.1, backend=v),
-        "`backend`", v) for v in ["rk45", "CVODE", None]]
+        "`backend`", v) for v in ["rk45", "CVODE", ""]]
     + [(f"initial={v!r}", lambda v=v: rodmol.simulate(small_model(), 0.1, initial=v),
         "`initial`", v) for v in ["relaxed", "Straight"]]
     + [(f"atol={v}", lambda v=v: rodmol.simulate(small_model(), 0.1, atol=v), "`atol`", v)
