@@ -93,11 +93,12 @@ def test_out_being_a_file(tmp_path, capsys):
     assert code == cli.EXIT_USAGE and "cannot create the output directory" in err
 
 
-def test_vtk_being_a_file(tmp_path, capsys):
+def test_vtk_being_a_file_is_refused_before_the_run(tmp_path, capsys):
     (tmp_path / "vtk").write_text("not a directory")
     code, err = run_cli(capsys, "--out", tmp_path, "--format", "vtp")
-    assert code == cli.EXIT_OUTPUT and "cannot write" in err
-    assert rodmol.load_result(tmp_path / "result.npz").success
+    assert code == cli.EXIT_USAGE and "vtk" in err and "is a file, where rodmol writes a folder" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["vtk"]  # nothing written, the file kept
+    assert (tmp_path / "vtk").read_text() == "not a directory"
 
 
 def _full_disk(*args, **kwargs):
