@@ -15,6 +15,7 @@ simulator, inverse statics; the gymnasium environments in ``rodmol.control.envs`
 """
 
 from . import scenarios
+from ._version import __version__ as __version__
 from .analysis import energy, marker_errors, oscillation_period
 from .arm import paper_arm
 from .base_motion import Base, BaseMotion
@@ -34,9 +35,6 @@ from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
 from .discretise.system import SemiDiscrete, StateView
 from .errors import EquilibriumError, IntegrationError, ParameterError, RodmolError, UserFunctionError
-from .io.load import load_result
-from .io.scenario_file import ScenarioError, load_scenario
-from .io.writers import write_series
 from .loads import (
     CapsuleContact,
     DistributedForce,
@@ -48,14 +46,14 @@ from .loads import (
 )
 from .markers import Marker
 from .model import Model
+from .output.formats import load_result, write_series
 from .parameters import MEDIA, Material, Medium
 from .result import Result
 from .rod import Rod
+from .scenario.file import ScenarioError, load_scenario
 from .simulate import default_atol, simulate, straight_state
 from .solve.backends import BACKENDS
 from .solve.equilibrium import equilibrium
-
-__version__ = "0.1.0"
 
 __all__ = [
     "BACKENDS", "Base", "BaseMotion", "Cable", "CapsuleContact", "DistributedForce",

@@ -7,7 +7,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from . import _checks, _settings
+from . import _checks, _settings, run_sinks
 from .discretise.layout import StateLayout
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
 from .discretise.system import SemiDiscrete, field_scales, straight_state
@@ -87,7 +87,7 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         Wall-time budget [s]: the run stops there with ``success=False``.
     out : path or sink, optional
         Stream the frames while the run goes into this directory
-        (:class:`rodmol.io.stream.RunWriter`: ``result.h5`` and ParaView's
+        (:class:`rodmol.output.stream.RunWriter`: ``result.h5`` and ParaView's
         ``rod.xdmf``, see ``docs/paraview.md``) or into a sink object with the
         same protocol; memory then stays bounded by one chunk, the solver
         restarts at every chunk boundary, and the Result returned reads its
@@ -109,7 +109,7 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         instead (not with another grid or other output times).
     overwrite : bool
         With ``out``: replace an earlier run in that directory (every file a
-        run writes there, :mod:`rodmol.io.run_files`; other files are kept).
+        run writes there, :mod:`rodmol.output.run_files`; other files are kept).
     **backend_options
         Passed to the backend (e.g. ``linsolver="sparse"`` for CVODE);
         unknown names and bad values are refused before any work. None given
@@ -281,9 +281,7 @@ def _sink(out, resume, overwrite):
         if resume and not hasattr(out, "resume_point"):
             raise ParameterError("`resume=True`: this sink cannot resume (no resume_point)")
         return out
-    from .io.stream import RunWriter
-
-    return RunWriter(out, resume=bool(resume), overwrite=bool(overwrite))
+    return run_sinks.directory_sink(out, resume=bool(resume), overwrite=bool(overwrite))
 
 
 def _where(sink):
