@@ -7,8 +7,9 @@ The package follows the data flow. The user's nouns are flat at the top:
 parameters, rod, cables, base motion, loads, markers, model, simulate,
 result, analysis. The machinery sits in folders: ``discretise/`` (state
 layout, the compiled physics and the semi-discrete scheme, its Jacobian),
-``solve/`` (static equilibrium and the time-integration backends) and
-``io/`` (scenario files, ParaView series, pictures, command line) and
+``solve/`` (static equilibrium and the time-integration backends),
+``output/`` (run directories, ParaView views and series, the formats' table,
+pictures), ``scenario/`` (TOML scenario files), ``cli/`` (the command line),
 ``calibrate/`` (measured data, stereo reconstruction, the paper's error
 study, identification, sweeps, linearisation) and ``control/`` (the stepping
 simulator, inverse statics; the gymnasium environments in ``rodmol.control.envs``).

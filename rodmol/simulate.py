@@ -8,9 +8,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from . import _checks, _settings, run_sinks
-from .discretise.layout import StateLayout
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
-from .discretise.system import SemiDiscrete, field_scales, straight_state
+from .discretise.system import SemiDiscrete, straight_state
 from .errors import ParameterError
 from .model import Model
 from .result import Result, from_states
@@ -33,8 +32,9 @@ def default_atol(model, rtol):
     each field (``rodmol.discretise.system.field_scales``: positions L,
     strains 1, curvatures 1/L, velocities L/T, angular velocities L/(T r_min)
     with T the first bending period), so that every field's error moves the
-    rod by about ``rtol`` L."""
-    return rtol * StateLayout(model.n_elements).scales(field_scales(model))
+    rod by about ``rtol`` L: ``rtol`` times the system's own
+    :meth:`~rodmol.discretise.system.SemiDiscrete.atol_scale`, as ``simulate`` takes it."""
+    return rtol * SemiDiscrete(model).atol_scale()
 
 
 def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None, atol=None,
@@ -153,7 +153,7 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
     if t_end <= t0:
         raise ParameterError(f"`t_end` must be after the start t0 = {t0!r} s, got {t_end!r} s")
     output_dt = _checks.positive("output_dt", OUTPUT_DT if output_dt is None else output_dt, " s")
-    size = StateLayout(model.n_elements).size
+    size = run_args.system.size
     t_out = options.output_times(t0, t_end, output_dt, output_times, size)
     if plan is not None:
         if t_end != plan[-1]:
@@ -174,7 +174,7 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         from ._progress import Progress
 
         progress = Progress()
-    system, y0, timings = prepare_run(model, run_args, progress, sink)
+    system, y0, timings = prepare_run(run_args, progress, sink)
 
     try:
         if sink is not None:
@@ -208,12 +208,15 @@ class RunArguments:
     backend: str
     run: object
     backend_options: dict
+    system: SemiDiscrete  # the run's one system, of the model and scheme checked
 
 
 def check_run(model, *, initial, t0, scheme, backend, rtol, atol, progress, max_wall_time,
               backend_options):
     """Check the arguments every run takes (see :func:`simulate`), before any work;
-    an ``initial`` Result gives its last state and, unless ``t0`` is given, its last time."""
+    an ``initial`` Result gives its last state and, unless ``t0`` is given, its last time.
+    The system of ``model`` is built here, once: the state's layout, size and tolerance
+    scales are its own."""
     if not isinstance(model, Model):
         raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
     if isinstance(initial, Result):
@@ -226,7 +229,8 @@ def check_run(model, *, initial, t0, scheme, backend, rtol, atol, progress, max_
     max_wall_time = options.max_wall_time(max_wall_time)
     run = get_backend(backend)
     backend_options = options.backend_options(backend, run, backend_options)
-    layout = StateLayout(model.n_elements)
+    system = SemiDiscrete(model, scheme)  # the one system of this run
+    layout = system.layout
     if isinstance(initial, str):
         if initial not in INITIAL:
             raise ParameterError(f"unknown `initial` {_checks.short(initial)}"
@@ -237,20 +241,21 @@ def check_run(model, *, initial, t0, scheme, backend, rtol, atol, progress, max_
     if atol is not None:
         atol = _state_sized("atol", atol, layout.size, positive=True, layout=layout)
     if atol is None:
-        atol = default_atol(model, rtol)
+        atol = rtol * system.atol_scale()
     return RunArguments(initial, t0, scheme, rtol, atol, progress, max_wall_time, backend, run,
-                        backend_options)
+                        backend_options, system)
 
 
-def prepare_run(model, args, progress, sink=None):
-    """The system of ``model``, its compiled kernels made ready, and the initial state, each
-    stage announced through ``progress``: returns (system, y0, timings [s])."""
+def prepare_run(args, progress, sink=None, system=None):
+    """The run's system (``args.system``, or ``system``: the Simulator's of its held inputs)
+    with its compiled kernels made ready, and the initial state, each stage announced
+    through ``progress``: returns (system, y0, timings [s])."""
     timings = {}
+    system = args.system if system is None else system
     with _stage(progress, "preparing the compiled kernels", timings, "prepare_s",
                 kernels.ready(args.run, args.backend_options)):
-        system = SemiDiscrete(model, args.scheme)  # the one system of this run
         check_scales(system, args.t0, args.atol)  # before the kernels' first run, which would fail on them
-        kernels.prepare(system, args.t0, straight_state(model), args.run, args.rtol, args.atol,
+        kernels.prepare(system, args.t0, straight_state(system.model), args.run, args.rtol, args.atol,
                         args.backend_options)
         getattr(sink, "prepare", lambda system: None)(system)
     initial = args.initial
@@ -335,7 +340,7 @@ def _last_state(result, model):
 def _initial_state(system, initial, t0):
     if isinstance(initial, str):
         if initial == "equilibrium":
-            return equilibrium(system.model, t0, system=system)
+            return equilibrium(system, t0)
         if initial == "straight":
             return straight_state(system.model)
     y0 = _state_sized("initial", initial, system.size, layout=system.layout)

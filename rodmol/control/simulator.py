@@ -100,7 +100,8 @@ class Simulator:
 
             announce = Progress()
         try:
-            self._system, y0, self._timings = prepare_run(live, args, announce, self._sink)
+            self._system, y0, self._timings = prepare_run(args, announce, self._sink,
+                                                          SemiDiscrete(live, args.scheme))
         finally:
             if args.progress is True:
                 announce.close()
