@@ -8,6 +8,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from . import _checks, _settings, run_sinks
+from .discretise.layout import StateLayout
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
 from .discretise.system import SemiDiscrete, straight_state
 from .errors import ParameterError
@@ -15,6 +16,7 @@ from .model import Model
 from .result import Result, from_states
 from .solve import kernels, options
 from .solve.backends import get_backend
+from .solve.chunked import run_chunked
 from .solve.equilibrium import equilibrium
 from .solve.outputs import keep_before_failure
 from .solve.scales import check_scales
@@ -141,7 +143,6 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         atol = recorded.get("atol") if atol is None else atol
         if not backend_options and backend == recorded.get("backend"):  # (another backend: its own)
             backend_options = recorded.get("backend_options") or {}
-    given_atol = atol  # None: the default, recorded as such
     run_args = check_run(model, initial=INITIAL[0] if initial is None else initial, t0=t0,
                          scheme=DEFAULT_SCHEME if scheme is None else scheme,
                          backend=DEFAULT_BACKEND if backend is None else backend, rtol=rtol,
@@ -153,7 +154,7 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
     if t_end <= t0:
         raise ParameterError(f"`t_end` must be after the start t0 = {t0!r} s, got {t_end!r} s")
     output_dt = _checks.positive("output_dt", OUTPUT_DT if output_dt is None else output_dt, " s")
-    size = run_args.system.size
+    size = run_args.layout.size
     t_out = options.output_times(t0, t_end, output_dt, output_times, size)
     if plan is not None:
         if t_end != plan[-1]:
@@ -161,7 +162,7 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         _check_plan(plan, asked_plan, t_end, size, sink)
         t_out = plan
     settings = _settings.record(model, scheme=run_args.scheme.name, backend=backend, rtol=rtol,
-                                atol=None if given_atol is None else atol, backend_options=backend_options,
+                                atol=atol, backend_options=backend_options,  # None: the default
                                 initial=(recorded.get("initial") or "unknown") if resume and initial is None
                                 else run_args.initial)
     forced = _settings.check(recorded, settings, resume == "force", _where(sink)) if recorded else []
@@ -174,22 +175,27 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         from ._progress import Progress
 
         progress = Progress()
-    system, y0, timings = prepare_run(run_args, progress, sink)
+    system, y0, timings, run_args = prepare_run(model, run_args, progress, sink)
+    atol = run_args.atol
 
+    solver = dict(rtol=rtol, atol=atol, progress=progress, max_wall_time=max_wall_time, **backend_options)
     try:
-        if sink is not None:
-            return _streamed(run, system, y0, t_out, sink, first, backend, timings, rtol=rtol, atol=atol,
-                             progress=progress, max_wall_time=max_wall_time, **backend_options)
-        raw = keep_before_failure(run, system, y0, t_out, rtol=rtol, atol=atol, progress=progress,
-                                  max_wall_time=max_wall_time, **backend_options)
+        if sink is None:
+            raw = keep_before_failure(run, system, y0, t_out, **solver)
+            success, message, stats, error = raw.success, raw.message, raw.stats, raw.error
+        else:  # in chunks into the sink, whose Result it is
+            success, message, stats, error = run_chunked(run, system, y0, t_out, sink, first, **solver)
+            stats.update(timings, backend=backend)
+            result = sink.end(success, message, stats)
     finally:
         if owned:
             progress.close()
-    raw.stats.update(timings, backend=backend)
-    result = from_states(system, raw.t, raw.y, raw.success, raw.message, raw.stats)
-    result.error = raw.error
-    if not raw.success:
-        warnings.warn(raw.message, RuntimeWarning, stacklevel=2)
+    if sink is None:
+        stats.update(timings, backend=backend)
+        result = from_states(system, raw.t, raw.y, success, message, stats)
+    result.error = error
+    if not success:
+        warnings.warn(message, RuntimeWarning, stacklevel=2)
     return result
 
 
@@ -202,21 +208,20 @@ class RunArguments:
     t0: float
     scheme: object
     rtol: float
-    atol: np.ndarray
+    atol: np.ndarray  # None: the default, the system's atol_scale() times rtol (prepare_run)
     progress: object  # None, True or a callable
     max_wall_time: float | None
     backend: str
     run: object
     backend_options: dict
-    system: SemiDiscrete  # the run's one system, of the model and scheme checked
+    layout: StateLayout  # the state's, which sized ``initial`` and ``atol`` before the system exists
 
 
 def check_run(model, *, initial, t0, scheme, backend, rtol, atol, progress, max_wall_time,
               backend_options):
     """Check the arguments every run takes (see :func:`simulate`), before any work;
     an ``initial`` Result gives its last state and, unless ``t0`` is given, its last time.
-    The system of ``model`` is built here, once: the state's layout, size and tolerance
-    scales are its own."""
+    Building the system is work: the state's size comes from its layout, built once here."""
     if not isinstance(model, Model):
         raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
     if isinstance(initial, Result):
@@ -229,8 +234,7 @@ def check_run(model, *, initial, t0, scheme, backend, rtol, atol, progress, max_
     max_wall_time = options.max_wall_time(max_wall_time)
     run = get_backend(backend)
     backend_options = options.backend_options(backend, run, backend_options)
-    system = SemiDiscrete(model, scheme)  # the one system of this run
-    layout = system.layout
+    layout = StateLayout(model.n_elements)
     if isinstance(initial, str):
         if initial not in INITIAL:
             raise ParameterError(f"unknown `initial` {_checks.short(initial)}"
@@ -240,20 +244,20 @@ def check_run(model, *, initial, t0, scheme, backend, rtol, atol, progress, max_
         initial = _state_sized("initial", initial, layout.size, layout=layout)
     if atol is not None:
         atol = _state_sized("atol", atol, layout.size, positive=True, layout=layout)
-    if atol is None:
-        atol = rtol * system.atol_scale()
     return RunArguments(initial, t0, scheme, rtol, atol, progress, max_wall_time, backend, run,
-                        backend_options, system)
+                        backend_options, layout)
 
 
-def prepare_run(args, progress, sink=None, system=None):
-    """The run's system (``args.system``, or ``system``: the Simulator's of its held inputs)
-    with its compiled kernels made ready, and the initial state, each stage announced
-    through ``progress``: returns (system, y0, timings [s])."""
+def prepare_run(model, args, progress, sink=None):
+    """The one system of ``model``, its compiled kernels made ready, and the initial state, each
+    stage announced through ``progress``: returns (system, y0, timings [s], args), the
+    default ``atol`` of ``args`` taken from the system (:meth:`SemiDiscrete.atol_scale`)."""
     timings = {}
-    system = args.system if system is None else system
     with _stage(progress, "preparing the compiled kernels", timings, "prepare_s",
                 kernels.ready(args.run, args.backend_options)):
+        system = SemiDiscrete(model, args.scheme)  # the one system of this run
+        if args.atol is None:
+            args = replace(args, atol=args.rtol * system.atol_scale())
         check_scales(system, args.t0, args.atol)  # before the kernels' first run, which would fail on them
         kernels.prepare(system, args.t0, straight_state(system.model), args.run, args.rtol, args.atol,
                         args.backend_options)
@@ -262,7 +266,7 @@ def prepare_run(args, progress, sink=None, system=None):
     with _stage(progress, f"solving the initial equilibrium at t = {args.t0:g} s", timings, "equilibrium_s",
                 not (isinstance(initial, str) and initial == "equilibrium")):
         y0 = _initial_state(system, initial, args.t0)
-    return system, y0, timings
+    return system, y0, timings, args
 
 
 @contextmanager
@@ -314,19 +318,6 @@ def _check_plan(plan, asked, t_end, size, sink):
                              "continue on the run's)")
 
 
-def _streamed(run, system, y0, t_out, sink, first, backend, timings, **options):
-    """The run in chunks into ``sink`` (rodmol.solve.chunked); the Result is the sink's."""
-    from .solve.chunked import run_chunked
-
-    success, message, stats, error = run_chunked(run, system, y0, t_out, sink, first, **options)
-    stats.update(timings, backend=backend)
-    result = sink.end(success, message, stats)
-    result.error = error
-    if not success:
-        warnings.warn(message, RuntimeWarning, stacklevel=3)
-    return result
-
-
 def _last_state(result, model):
     states = getattr(result, "states", None)
     if states is None or len(states) == 0:
@@ -343,7 +334,7 @@ def _initial_state(system, initial, t0):
             return equilibrium(system, t0)
         if initial == "straight":
             return straight_state(system.model)
-    y0 = _state_sized("initial", initial, system.size, layout=system.layout)
+    y0 = np.array(initial, dtype=float)  # sized by check_run, or the resumed run's own state
     problem = state_problem(system.layout, system.model.ds, t0, y0)
     if problem:
         raise ParameterError(f"`initial` is not a state of this rod: {problem}")

@@ -100,8 +100,7 @@ class Simulator:
 
             announce = Progress()
         try:
-            self._system, y0, self._timings = prepare_run(args, announce, self._sink,
-                                                          SemiDiscrete(live, args.scheme))
+            self._system, y0, self._timings, args = prepare_run(live, args, announce, self._sink)
         finally:
             if args.progress is True:
                 announce.close()
