@@ -1,7 +1,7 @@
 """Scenario files: one TOML file describes one run (arm, loads, solver, outputs).
 
 :func:`load_scenario` reads a file, checks all of it and returns a
-:class:`RunSpec` (the model plus the solver and output settings). Every problem
+:class:`rodmol.run_spec.RunSpec` (the model plus the solver and output settings). Every problem
 in the file is reported at once, each with its line number and table, in one
 :class:`ScenarioError`. The schema is documented in
 ``docs/scenario-reference.md``; relative paths are relative to the file.
@@ -12,8 +12,9 @@ The work is shared by
 :mod:`~rodmol.scenario.readers` (one value each),
 :mod:`~rodmol.scenario.arm` (rod, material, medium, cables, markers, base),
 :mod:`~rodmol.scenario.loads` (``[[load]]``),
-:mod:`~rodmol.scenario.build` (solver, output, the Model) and
-:mod:`~rodmol.run_spec` (what a checked file gives).
+:mod:`~rodmol.scenario.build` (solver, output, the Model); what a checked
+file gives is a :class:`rodmol.run_spec.RunSpec`, with the outputs'
+:class:`rodmol.output.options.OutputOptions`.
 """
 
 import re
@@ -33,7 +34,7 @@ __all__ = ["Override", "Problem", "RadiusProfile", "ScenarioError", "load_scenar
 
 
 def load_scenario(path, overrides=None):
-    """Read and check the scenario file at ``path``; return a :class:`RunSpec`.
+    """Read and check the scenario file at ``path``; return a :class:`rodmol.run_spec.RunSpec`.
 
     ``overrides`` maps dotted keys (``"solver.t_end"``) to values that replace
     the file's (the command line's options); their problems name the option

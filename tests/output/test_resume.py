@@ -163,7 +163,7 @@ def test_resume_after_ctrl_c_in_the_first_chunk_starts_from_the_initial_state(mo
 
 @pytest.mark.subprocess
 def test_sigint_then_resume_ends_in_the_uninterrupted_state(tmp_path):
-    # As the SIGKILL test (tests/io/test_stream.py), with Ctrl-C: it lands inside a chunk.
+    # As the SIGKILL test (tests/output/test_stream.py), with Ctrl-C: it lands inside a chunk.
     command = [sys.executable, "-m", "rodmol", "run", "--example", "fetching", "--backend", "rk23",
                "--n-elements", "30", "--t-end", "2", "--chunk-frames", "10", "--quiet"]
     whole = subprocess.run([*command, "--out", str(tmp_path / "whole")], capture_output=True, text=True,
