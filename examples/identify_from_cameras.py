@@ -41,7 +41,7 @@ from rodmol.calibrate import (
     worsened_models,
 )
 from rodmol.calibrate.paper_errors import table
-from rodmol.io.scenario_file import parse_scenario
+from rodmol.scenario.file import parse_scenario
 
 DATA = Path(__file__).resolve().parent / "synthetic_experiment"
 CAMERAS = ("front", "top")

@@ -7,14 +7,16 @@ The package follows the data flow. The user's nouns are flat at the top:
 parameters, rod, cables, base motion, loads, markers, model, simulate,
 result, analysis. The machinery sits in folders: ``discretise/`` (state
 layout, the compiled physics and the semi-discrete scheme, its Jacobian),
-``solve/`` (static equilibrium and the time-integration backends) and
-``io/`` (scenario files, ParaView series, pictures, command line) and
+``solve/`` (static equilibrium and the time-integration backends),
+``output/`` (run directories, ParaView views and series, the formats' table,
+pictures), ``scenario/`` (TOML scenario files), ``cli/`` (the command line),
 ``calibrate/`` (measured data, stereo reconstruction, the paper's error
 study, identification, sweeps, linearisation) and ``control/`` (the stepping
 simulator, inverse statics; the gymnasium environments in ``rodmol.control.envs``).
 """
 
 from . import scenarios
+from ._version import __version__ as __version__
 from .analysis import energy, marker_errors, oscillation_period
 from .arm import paper_arm
 from .base_motion import Base, BaseMotion
@@ -34,9 +36,6 @@ from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
 from .discretise.system import SemiDiscrete, StateView
 from .errors import EquilibriumError, IntegrationError, ParameterError, RodmolError, UserFunctionError
-from .io.load import load_result
-from .io.scenario_file import ScenarioError, load_scenario
-from .io.writers import write_series
 from .loads import (
     CapsuleContact,
     DistributedForce,
@@ -48,14 +47,14 @@ from .loads import (
 )
 from .markers import Marker
 from .model import Model
+from .output.formats import load_result, write_series
 from .parameters import MEDIA, Material, Medium
 from .result import Result
 from .rod import Rod
+from .scenario.file import ScenarioError, load_scenario
 from .simulate import default_atol, simulate, straight_state
 from .solve.backends import BACKENDS
 from .solve.equilibrium import equilibrium
-
-__version__ = "0.1.0"
 
 __all__ = [
     "BACKENDS", "Base", "BaseMotion", "Cable", "CapsuleContact", "DistributedForce",

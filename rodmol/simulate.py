@@ -7,15 +7,16 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from . import _checks, _settings
+from . import _checks, _settings, run_sinks
 from .discretise.layout import StateLayout
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
-from .discretise.system import SemiDiscrete, field_scales, straight_state
+from .discretise.system import SemiDiscrete, straight_state
 from .errors import ParameterError
 from .model import Model
 from .result import Result, from_states
 from .solve import kernels, options
 from .solve.backends import get_backend
+from .solve.chunked import run_chunked
 from .solve.equilibrium import equilibrium
 from .solve.outputs import keep_before_failure
 from .solve.scales import check_scales
@@ -33,8 +34,9 @@ def default_atol(model, rtol):
     each field (``rodmol.discretise.system.field_scales``: positions L,
     strains 1, curvatures 1/L, velocities L/T, angular velocities L/(T r_min)
     with T the first bending period), so that every field's error moves the
-    rod by about ``rtol`` L."""
-    return rtol * StateLayout(model.n_elements).scales(field_scales(model))
+    rod by about ``rtol`` L: ``rtol`` times the system's own
+    :meth:`~rodmol.discretise.system.SemiDiscrete.atol_scale`, as ``simulate`` takes it."""
+    return rtol * SemiDiscrete(model).atol_scale()
 
 
 def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None, atol=None,
@@ -87,7 +89,7 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         Wall-time budget [s]: the run stops there with ``success=False``.
     out : path or sink, optional
         Stream the frames while the run goes into this directory
-        (:class:`rodmol.io.stream.RunWriter`: ``result.h5`` and ParaView's
+        (:class:`rodmol.output.stream.RunWriter`: ``result.h5`` and ParaView's
         ``rod.xdmf``, see ``docs/paraview.md``) or into a sink object with the
         same protocol; memory then stays bounded by one chunk, the solver
         restarts at every chunk boundary, and the Result returned reads its
@@ -109,7 +111,7 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         instead (not with another grid or other output times).
     overwrite : bool
         With ``out``: replace an earlier run in that directory (every file a
-        run writes there, :mod:`rodmol.io.run_files`; other files are kept).
+        run writes there, :mod:`rodmol.output.run_files`; other files are kept).
     **backend_options
         Passed to the backend (e.g. ``linsolver="sparse"`` for CVODE);
         unknown names and bad values are refused before any work. None given
@@ -141,7 +143,6 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         atol = recorded.get("atol") if atol is None else atol
         if not backend_options and backend == recorded.get("backend"):  # (another backend: its own)
             backend_options = recorded.get("backend_options") or {}
-    given_atol = atol  # None: the default, recorded as such
     run_args = check_run(model, initial=INITIAL[0] if initial is None else initial, t0=t0,
                          scheme=DEFAULT_SCHEME if scheme is None else scheme,
                          backend=DEFAULT_BACKEND if backend is None else backend, rtol=rtol,
@@ -153,7 +154,7 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
     if t_end <= t0:
         raise ParameterError(f"`t_end` must be after the start t0 = {t0!r} s, got {t_end!r} s")
     output_dt = _checks.positive("output_dt", OUTPUT_DT if output_dt is None else output_dt, " s")
-    size = StateLayout(model.n_elements).size
+    size = run_args.layout.size
     t_out = options.output_times(t0, t_end, output_dt, output_times, size)
     if plan is not None:
         if t_end != plan[-1]:
@@ -161,7 +162,7 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         _check_plan(plan, asked_plan, t_end, size, sink)
         t_out = plan
     settings = _settings.record(model, scheme=run_args.scheme.name, backend=backend, rtol=rtol,
-                                atol=None if given_atol is None else atol, backend_options=backend_options,
+                                atol=atol, backend_options=backend_options,  # None: the default
                                 initial=(recorded.get("initial") or "unknown") if resume and initial is None
                                 else run_args.initial)
     forced = _settings.check(recorded, settings, resume == "force", _where(sink)) if recorded else []
@@ -174,22 +175,27 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         from ._progress import Progress
 
         progress = Progress()
-    system, y0, timings = prepare_run(model, run_args, progress, sink)
+    system, y0, timings, run_args = prepare_run(model, run_args, progress, sink)
+    atol = run_args.atol
 
+    solver = dict(rtol=rtol, atol=atol, progress=progress, max_wall_time=max_wall_time, **backend_options)
     try:
-        if sink is not None:
-            return _streamed(run, system, y0, t_out, sink, first, backend, timings, rtol=rtol, atol=atol,
-                             progress=progress, max_wall_time=max_wall_time, **backend_options)
-        raw = keep_before_failure(run, system, y0, t_out, rtol=rtol, atol=atol, progress=progress,
-                                  max_wall_time=max_wall_time, **backend_options)
+        if sink is None:
+            raw = keep_before_failure(run, system, y0, t_out, **solver)
+            success, message, stats, error = raw.success, raw.message, raw.stats, raw.error
+        else:  # in chunks into the sink, whose Result it is
+            success, message, stats, error = run_chunked(run, system, y0, t_out, sink, first, **solver)
+            stats.update(timings, backend=backend)
+            result = sink.end(success, message, stats)
     finally:
         if owned:
             progress.close()
-    raw.stats.update(timings, backend=backend)
-    result = from_states(system, raw.t, raw.y, raw.success, raw.message, raw.stats)
-    result.error = raw.error
-    if not raw.success:
-        warnings.warn(raw.message, RuntimeWarning, stacklevel=2)
+    if sink is None:
+        stats.update(timings, backend=backend)
+        result = from_states(system, raw.t, raw.y, success, message, stats)
+    result.error = error
+    if not success:
+        warnings.warn(message, RuntimeWarning, stacklevel=2)
     return result
 
 
@@ -202,18 +208,20 @@ class RunArguments:
     t0: float
     scheme: object
     rtol: float
-    atol: np.ndarray
+    atol: np.ndarray  # None: the default, the system's atol_scale() times rtol (prepare_run)
     progress: object  # None, True or a callable
     max_wall_time: float | None
     backend: str
     run: object
     backend_options: dict
+    layout: StateLayout  # the state's, which sized ``initial`` and ``atol`` before the system exists
 
 
 def check_run(model, *, initial, t0, scheme, backend, rtol, atol, progress, max_wall_time,
               backend_options):
     """Check the arguments every run takes (see :func:`simulate`), before any work;
-    an ``initial`` Result gives its last state and, unless ``t0`` is given, its last time."""
+    an ``initial`` Result gives its last state and, unless ``t0`` is given, its last time.
+    Building the system is work: the state's size comes from its layout, built once here."""
     if not isinstance(model, Model):
         raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
     if isinstance(initial, Result):
@@ -236,28 +244,29 @@ def check_run(model, *, initial, t0, scheme, backend, rtol, atol, progress, max_
         initial = _state_sized("initial", initial, layout.size, layout=layout)
     if atol is not None:
         atol = _state_sized("atol", atol, layout.size, positive=True, layout=layout)
-    if atol is None:
-        atol = default_atol(model, rtol)
     return RunArguments(initial, t0, scheme, rtol, atol, progress, max_wall_time, backend, run,
-                        backend_options)
+                        backend_options, layout)
 
 
 def prepare_run(model, args, progress, sink=None):
-    """The system of ``model``, its compiled kernels made ready, and the initial state, each
-    stage announced through ``progress``: returns (system, y0, timings [s])."""
+    """The one system of ``model``, its compiled kernels made ready, and the initial state, each
+    stage announced through ``progress``: returns (system, y0, timings [s], args), the
+    default ``atol`` of ``args`` taken from the system (:meth:`SemiDiscrete.atol_scale`)."""
     timings = {}
     with _stage(progress, "preparing the compiled kernels", timings, "prepare_s",
                 kernels.ready(args.run, args.backend_options)):
         system = SemiDiscrete(model, args.scheme)  # the one system of this run
+        if args.atol is None:
+            args = replace(args, atol=args.rtol * system.atol_scale())
         check_scales(system, args.t0, args.atol)  # before the kernels' first run, which would fail on them
-        kernels.prepare(system, args.t0, straight_state(model), args.run, args.rtol, args.atol,
+        kernels.prepare(system, args.t0, straight_state(system.model), args.run, args.rtol, args.atol,
                         args.backend_options)
         getattr(sink, "prepare", lambda system: None)(system)
     initial = args.initial
     with _stage(progress, f"solving the initial equilibrium at t = {args.t0:g} s", timings, "equilibrium_s",
                 not (isinstance(initial, str) and initial == "equilibrium")):
         y0 = _initial_state(system, initial, args.t0)
-    return system, y0, timings
+    return system, y0, timings, args
 
 
 @contextmanager
@@ -281,9 +290,7 @@ def _sink(out, resume, overwrite):
         if resume and not hasattr(out, "resume_point"):
             raise ParameterError("`resume=True`: this sink cannot resume (no resume_point)")
         return out
-    from .io.stream import RunWriter
-
-    return RunWriter(out, resume=bool(resume), overwrite=bool(overwrite))
+    return run_sinks.directory_sink(out, resume=bool(resume), overwrite=bool(overwrite))
 
 
 def _where(sink):
@@ -311,19 +318,6 @@ def _check_plan(plan, asked, t_end, size, sink):
                              "continue on the run's)")
 
 
-def _streamed(run, system, y0, t_out, sink, first, backend, timings, **options):
-    """The run in chunks into ``sink`` (rodmol.solve.chunked); the Result is the sink's."""
-    from .solve.chunked import run_chunked
-
-    success, message, stats, error = run_chunked(run, system, y0, t_out, sink, first, **options)
-    stats.update(timings, backend=backend)
-    result = sink.end(success, message, stats)
-    result.error = error
-    if not success:
-        warnings.warn(message, RuntimeWarning, stacklevel=3)
-    return result
-
-
 def _last_state(result, model):
     states = getattr(result, "states", None)
     if states is None or len(states) == 0:
@@ -337,10 +331,10 @@ def _last_state(result, model):
 def _initial_state(system, initial, t0):
     if isinstance(initial, str):
         if initial == "equilibrium":
-            return equilibrium(system.model, t0, system=system)
+            return equilibrium(system, t0)
         if initial == "straight":
             return straight_state(system.model)
-    y0 = _state_sized("initial", initial, system.size, layout=system.layout)
+    y0 = np.array(initial, dtype=float)  # sized by check_run, or the resumed run's own state
     problem = state_problem(system.layout, system.model.ds, t0, y0)
     if problem:
         raise ParameterError(f"`initial` is not a state of this rod: {problem}")

@@ -2,7 +2,7 @@
 
 Each case runs ``examples/fetching.toml`` (N = 100, default settings, output
 every 10 ms) in a fresh subprocess as ``rodmol run`` does (the scenario's
-``simulate`` with a :class:`rodmol.io.stream.RunWriter`), after a short
+``simulate`` with a :class:`rodmol.output.stream.RunWriter`), after a short
 warm-up run there (numba's cache). It reports the solver's own wall time
 (``stats["wall_time_s"]``), the writer's (the time the run spends in the
 writer: computing each chunk's stresses, loads and view arrays, handing the
@@ -35,8 +35,8 @@ CHILD = textwrap.dedent("""
     import json, resource, sys, time
     sys.path.insert(0, sys.argv[1])
     import rodmol
-    from rodmol.io.scenario_file import Override, load_scenario
-    from rodmol.io.stream import RunWriter
+    from rodmol.scenario.file import Override, load_scenario
+    from rodmol.output.stream import RunWriter
     scenario, t_end, out, fmt = sys.argv[2], float(sys.argv[3]), sys.argv[4], sys.argv[5]
     overrides = {"solver.t_end": Override(t_end, "--t-end")}
     if sys.argv[6] != "0":
@@ -51,7 +51,7 @@ CHILD = textwrap.dedent("""
     elif fmt == "none":
         result, writing = spec.simulate(), 0.0
     else:
-        from rodmol.io.writers import write_series
+        from rodmol.output.formats import write_series
         result = spec.simulate()
         begun = time.perf_counter()
         write_series(result, out, format="vtp")

@@ -23,7 +23,7 @@ import _common as C
 from _common import np, rodmol
 
 from rodmol.discretise.layout import StateLayout
-from rodmol.io.stream import RunWriter
+from rodmol.output.stream import RunWriter
 
 SCRIPT = "quaternion_norm.py"
 PROJECT = StateLayout.project_quaternions

@@ -1,5 +1,5 @@
 """How long ParaView takes to open a streamed view, by the number of frames it
-shows: why the views of long runs show at most ``rodmol.io.parts.MAX_SHOWN``
+shows: why the views of long runs show at most ``rodmol.output.parts.MAX_SHOWN``
 frames by default.
 
 Each case runs ``examples/fetching.toml`` at N = 10 (the XML of a frame does
@@ -39,8 +39,8 @@ OPEN = textwrap.dedent("""
 
 
 def write_views(t_end, out):
-    from rodmol.io.scenario_file import Override, load_scenario
-    from rodmol.io.stream import RunWriter
+    from rodmol.output.stream import RunWriter
+    from rodmol.scenario.file import Override, load_scenario
 
     overrides = {"solver.t_end": Override(t_end, "--t-end"),
                  "discretization.n_elements": Override(10, "--n-elements")}

@@ -141,7 +141,7 @@ def test_bad_routings_are_refused(offset, match):
 def test_routing_drawn_in_paraview_output():
     model = _model(helix, 10)
     result = rodmol.simulate(model, 0.01, output_dt=0.01)
-    from rodmol.io.writers import cable_paths
+    from rodmol.output.writers import cable_paths
 
     s, points = cable_paths(result, 0)[0]
     rot, u = result.rotations[0], result.positions[0]

@@ -10,7 +10,7 @@ from scenario_texts import MINIMAL
 
 import rodmol
 from rodmol.errors import MAX_LINE, ParameterError
-from rodmol.io.scenario_file import ScenarioError, parse_scenario
+from rodmol.scenario.file import ScenarioError, parse_scenario
 
 MATERIAL = rodmol.Material(E=110e3, nu=0.5, mu=300.0, rho=1080.0)
 ROD = rodmol.Rod(0.3, (0.012, 0.005), MATERIAL)

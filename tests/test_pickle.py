@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import rodmol
-from rodmol.io.scenario_file import parse_scenario
+from rodmol.scenario.file import parse_scenario
 
 #: A scenario with every kind of input a file can give: the paper's tensions,
 #: a moving base, a point force from knots, a distributed force and a floor.

@@ -29,7 +29,7 @@ def test_taper_and_volume():
 
 def test_radius_points_as_in_a_scenario_file():
     """Rod(radius=[(s, r), ...]) is the same rod as a scenario file's points."""
-    from rodmol.io.scenario_file import RadiusProfile
+    from rodmol.scenario.file import RadiusProfile
 
     mat = rodmol.Material(E=1e5, nu=0.5, rho=1000.0)
     points = [(0.0, 0.012), (0.1, 0.01), (0.3, 0.005)]

@@ -20,7 +20,7 @@ from rodmol.calibrate import (
     write_pixel_tracks,
     write_tension_log,
 )
-from rodmol.io.scenario_file import parse_scenario
+from rodmol.scenario.file import parse_scenario
 
 HERE = Path(__file__).resolve().parent
 N_ELEMENTS = 20

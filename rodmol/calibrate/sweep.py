@@ -35,7 +35,7 @@ class Sweep:
         """The Result of run ``i``: kept in memory, or read from ``out``."""
         run = self.runs[i]
         if run.result is None and (run.value or {}).get("path"):
-            from ..io.load import load_result
+            from ..output.formats import load_result
 
             return load_result(run.value["path"])
         return run.result

@@ -28,10 +28,10 @@ from ..cables import Tension, as_tension
 from ..discretise.schemes import DEFAULT_SCHEME, get_scheme
 from ..errors import ParameterError
 from ..inputs import TimeInput
-from ..io.scenario_spec import RunSpec
 from ..model import Model
 from ..parameters import Material, Medium
 from ..rod import Rod
+from ..run_spec import RunSpec
 
 MATERIAL = ("E", "nu", "G", "mu", "rho")
 MEDIUM = ("rho", "Cx", "Cy", "Cz", "By", "Bz")
@@ -61,7 +61,7 @@ def as_spec(spec):
     if isinstance(spec, RunSpec):
         return spec
     if isinstance(spec, (str, os.PathLike)):
-        from ..io.scenario_file import load_scenario
+        from ..scenario.file import load_scenario
 
         return load_scenario(spec)
     raise ParameterError(f"expected a scenario (rodmol.load_scenario(...), a RunSpec or a path), got {spec!r}")

@@ -2,7 +2,7 @@
 
 The top floor with analysis and calibration: a model stepped by a controller
 (:class:`Simulator`, which drives :mod:`rodmol.solve`, builds Results and
-streams into :mod:`rodmol.io`) and inverse statics (:func:`inverse_statics`:
+streams into :mod:`rodmol.output`) and inverse statics (:func:`inverse_statics`:
 the tensions whose equilibrium puts the tip on a target). The learning
 environment (``rodmol.control.envs``, needs ``gymnasium``) is imported on demand.
 """

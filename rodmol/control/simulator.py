@@ -1,7 +1,7 @@
 """The stepping simulator: a model advanced one control period at a time.
 
 It sits on the control floor: it drives the integrator (:mod:`rodmol.solve`),
-builds a :class:`rodmol.Result` and streams into :mod:`rodmol.io`, as
+builds a :class:`rodmol.Result` and streams into :mod:`rodmol.output`, as
 :func:`rodmol.simulate` does, for a controller that runs outside it.
 """
 
@@ -100,7 +100,7 @@ class Simulator:
 
             announce = Progress()
         try:
-            self._system, y0, self._timings = prepare_run(live, args, announce, self._sink)
+            self._system, y0, self._timings, args = prepare_run(live, args, announce, self._sink)
         finally:
             if args.progress is True:
                 announce.close()

@@ -11,7 +11,7 @@ run reports a failed write; ``account(stats)``, if it has one, gets the
 solver's statistics of each chunk before its ``frames``; ``prepare(system)``
 and ``record_settings(settings, forced)``, if it has them, are called by
 :func:`rodmol.simulate` before the run)
-(:class:`rodmol.io.stream.RunWriter` is the one rodmol ships).
+(:class:`rodmol.output.stream.RunWriter` is the one rodmol ships).
 """
 
 import time

@@ -46,7 +46,9 @@ def equilibrium(model, t=0.0, *, scheme=DEFAULT_SCHEME, tol=1e-10, max_iter=40, 
 
     Parameters
     ----------
-    model : Model
+    model : Model or SemiDiscrete
+        The model, or its system if one is built already (``simulate`` passes
+        its own): then the system's scheme is used.
     t : float
         Time [s] at which the time-dependent inputs are evaluated.
     scheme : str
@@ -76,6 +78,8 @@ def equilibrium(model, t=0.0, *, scheme=DEFAULT_SCHEME, tol=1e-10, max_iter=40, 
         If no equilibrium is found (e.g. a buckling load), or the one found
         has degenerate elements (see :mod:`rodmol.solve.watch`).
     """
+    if isinstance(model, SemiDiscrete):  # a system built already (simulate's): its model and scheme
+        model, system = model.model, model
     if not isinstance(model, Model):
         raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
     system = SemiDiscrete(model, scheme) if system is None else system

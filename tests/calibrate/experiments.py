@@ -4,7 +4,7 @@ import numpy as np
 
 import rodmol
 from rodmol.calibrate import calibrate_dlt, spec_of, synthetic, triangulate
-from rodmol.io.scenario_file import parse_scenario
+from rodmol.scenario.file import parse_scenario
 
 #: The paper's values of the parameters the tests identify.
 TRUTH = {"material.E": 110e3, "material.mu": 300.0, "medium.Cy,Cz": 2.5}

@@ -6,7 +6,7 @@ import numpy as np
 from experiments import paper_spec
 
 from rodmol.calibrate import MarkerTracks, write_marker_tracks
-from rodmol.io.cli import main
+from rodmol.cli.commands import main
 
 
 def measured_bending(path, **overrides):

@@ -10,7 +10,7 @@ from vibration import measure_free_vibration
 
 import rodmol
 from rodmol.discretise.schemes import DEFAULT_SCHEME, get_scheme
-from rodmol.io.stream import RunWriter
+from rodmol.output.stream import RunWriter
 
 # Table I, restated so that the reference calculations do not read rodmol.
 L = 0.418  # m

@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 import rodmol
 from rodmol.discretise.schemes import DEFAULT_SCHEME, get_scheme
-from rodmol.io.stream import RunWriter
+from rodmol.output.stream import RunWriter
 
 T_END, DT = 0.2, 0.01  # s: the run and its output interval
 LENGTH = 0.3  # m
