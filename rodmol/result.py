@@ -5,7 +5,6 @@ from functools import partial
 
 import numpy as np
 
-from . import markers
 from ._files import refuse_directories, write_atomically
 from .discretise import centreline, physics, rotations
 from .discretise.layout import StateLayout
@@ -259,7 +258,7 @@ def _pose(result):
     offsets = np.array([m["offset"] for m in marks]).reshape(-1, 2)
     return dict(
         positions=positions, rotations=rots,
-        markers=markers.track([m["s"] for m in marks], offsets, result.s, positions, rots),
+        markers=centreline.track([m["s"] for m in marks], offsets, result.s, positions, rots),
     )
 
 

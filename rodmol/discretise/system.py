@@ -15,7 +15,6 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..markers import track
 from . import centreline, external, rotations, stencil
 from .layout import StateLayout, merge
 from .physics import compile_signatures
@@ -138,7 +137,7 @@ class StateView:
             return self.positions[-1]
         if name == "markers" and self._markers is not None:
             m = self._markers
-            return track([mk.s for mk in m.markers], m.marker_offsets[:, 1:], m.s_nodes,
+            return centreline.track([mk.s for mk in m.markers], m.marker_offsets[:, 1:], m.s_nodes,
                          self.positions[None], self.rotations[None])[0]
         raise AttributeError(name)
 
