@@ -93,6 +93,20 @@ def _put(out, i, x):
     out[i], out[i + 1], out[i + 2] = x[0], x[1], x[2]
 
 
+@jit
+def compatibility(q, k, v, w, v_prev, w_prev, ds, centred):
+    """The strain rates (q_t, k_t) of a cell, local frame, from the compatibility
+    laws (eq. 2) with the difference of the velocities (v, w) of its tip-side
+    node and (v_prev, w_prev) of its base-side node across the cell; the
+    non-derivative terms read the base-side node (upwind) or the average of
+    both (``centred``)."""
+    if centred:
+        terms_q, terms_k = strain_rate_terms(q, k, scale(0.5, add(v, v_prev)), scale(0.5, add(w, w_prev)))
+    else:
+        terms_q, terms_k = strain_rate_terms(q, k, v_prev, w_prev)
+    return add(scale(1.0 / ds, sub(v, v_prev)), terms_q), add(scale(1.0 / ds, sub(w, w_prev)), terms_k)
+
+
 def _signature():
     # The state comes read-only from CVODE and writable from everywhere else;
     # typing it read-only accepts both with a single compilation.
@@ -121,12 +135,7 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
             v_prev, w_prev = _vec(base, 0), _vec(base, 3)
         else:
             v_prev, w_prev = _vec(y, o - BLOCK + V), _vec(y, o - BLOCK + W)
-        if centred:
-            terms_q, terms_k = strain_rate_terms(q, k, scale(0.5, add(v, v_prev)), scale(0.5, add(w, w_prev)))
-        else:
-            terms_q, terms_k = strain_rate_terms(q, k, v_prev, w_prev)
-        q_t = add(scale(1.0 / ds, sub(v, v_prev)), terms_q)
-        k_t = add(scale(1.0 / ds, sub(w, w_prev)), terms_k)
+        q_t, k_t = compatibility(q, k, v, w, v_prev, w_prev, ds, centred)
         _put(out, o + QS, q_t)
         _put(out, o + K, k_t)
         pr = params[i]
