@@ -17,7 +17,7 @@ import numpy as np
 from ..cable_routing import cell_geometry
 from . import physics
 from .physics import jit
-from .stencil import compatibility
+from .stencil import CENTRED, compatibility
 
 
 class CableRouting:
@@ -82,7 +82,7 @@ def _strain_rates(q, k, v, w, base_velocities, ds, q_t, k_t):
             w_prev = (base_velocities[3], base_velocities[4], base_velocities[5])
         else:
             v_prev, w_prev = _row(v, i - 1), _row(w, i - 1)
-        q_t[i], k_t[i] = compatibility(_row(q, i), _row(k, i), _row(v, i), _row(w, i), v_prev, w_prev, ds, True)
+        q_t[i], k_t[i] = compatibility(_row(q, i), _row(k, i), _row(v, i), _row(w, i), v_prev, w_prev, ds, CENTRED)
 
 
 @jit

@@ -7,11 +7,11 @@ neighbouring cells in the balance laws. The schemes differ in where the
 non-derivative terms are evaluated (:mod:`rodmol.discretise.schemes` holds
 the definitions, their dependency tables and sampling):
 
-* ``upwind`` (the paper's, section IV-C, ``consts[CENTRED] = 0``): the strain
+* ``upwind`` (the paper's, section IV-C, ``consts[SCHEME] = Kernel.UPWIND``): the strain
   rates use the velocities of the cell's base-side node, a node's balance uses
   the products k x N, k x M, q x N of the cell on its tip side (zero beyond
   the tip); first order in ds.
-* ``centred`` (``consts[CENTRED] = 1``): the strain rates use the average of
+* ``centred`` (``consts[SCHEME] = Kernel.CENTRED``): the strain rates use the average of
   the cell's two node velocities, a node's balance the average of its two
   cells' products, and the tip node carries half a cell; second order in ds,
   and the discrete energy is conserved exactly without dissipation.
@@ -24,7 +24,7 @@ Packing of the sampled model (built once by ``SemiDiscrete``):
 * ``params`` (N, 25): per element, the constant sectional data, one row per
   element (columns ``P_*``);
 * ``consts`` (9,): ds, quaternion restoring rate, drag smoothing speed^2,
-  Munk switch (0/1), gravity (3, global), centred switch (0/1), drag law
+  Munk switch (0/1), gravity (3, global), the scheme's kernel code, drag law
   (0 Morison, 1 componentwise C v|v|: then ``P_DRAG`` holds C);
 * ``offsets`` (n_c, N, 6), ``weights`` (n_c, N): per cable and cell the
   offset p and its slope p' (local, :mod:`rodmol.discretise.routing`), and
@@ -60,9 +60,12 @@ from .physics import (
     sub,
     to_global,
 )
+from .schemes import Kernel
 
-#: Index of the scheme switch in ``consts`` (0 upwind, 1 centred).
-CENTRED = 7
+#: Index of the scheme's :class:`~rodmol.discretise.schemes.Kernel` code in ``consts``.
+SCHEME = 7
+#: The kernel codes as plain integers (numba compares them as constants).
+UPWIND, CENTRED = int(Kernel.UPWIND), int(Kernel.CENTRED)
 #: Index of the drag law switch in ``consts`` (0 Morison, 1 componentwise).
 COMPONENTWISE_DRAG = 8
 N_CONSTS = 9
@@ -94,13 +97,13 @@ def _put(out, i, x):
 
 
 @jit
-def compatibility(q, k, v, w, v_prev, w_prev, ds, centred):
+def compatibility(q, k, v, w, v_prev, w_prev, ds, kernel):
     """The strain rates (q_t, k_t) of a cell, local frame, from the compatibility
     laws (eq. 2) with the difference of the velocities (v, w) of its tip-side
     node and (v_prev, w_prev) of its base-side node across the cell; the
-    non-derivative terms read the base-side node (upwind) or the average of
-    both (``centred``)."""
-    if centred:
+    non-derivative terms read the base-side node (``UPWIND``) or the average
+    of both (``CENTRED``), as the scheme's ``kernel`` code says."""
+    if kernel == CENTRED:
         terms_q, terms_k = strain_rate_terms(q, k, scale(0.5, add(v, v_prev)), scale(0.5, add(w, w_prev)))
     else:
         terms_q, terms_k = strain_rate_terms(q, k, v_prev, w_prev)
@@ -123,7 +126,8 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
     n = params.shape[0]
     ds, restoring, smoothing2, munk = consts[0], consts[1], consts[2], consts[3] != 0.0
     gravity = (consts[4], consts[5], consts[6])
-    centred = consts[CENTRED] != 0.0
+    kernel = int(consts[SCHEME])
+    centred = kernel == CENTRED
     componentwise = consts[COMPONENTWISE_DRAG] != 0.0
 
     # Pass 1, cells i = 0..N-1: compatibility with the differences of v, w
@@ -135,7 +139,7 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
             v_prev, w_prev = _vec(base, 0), _vec(base, 3)
         else:
             v_prev, w_prev = _vec(y, o - BLOCK + V), _vec(y, o - BLOCK + W)
-        q_t, k_t = compatibility(q, k, v, w, v_prev, w_prev, ds, centred)
+        q_t, k_t = compatibility(q, k, v, w, v_prev, w_prev, ds, kernel)
         _put(out, o + QS, q_t)
         _put(out, o + K, k_t)
         pr = params[i]

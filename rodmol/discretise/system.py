@@ -183,7 +183,7 @@ class SemiDiscrete:
         self._consts = np.zeros(stencil.N_CONSTS)
         self._consts[:7] = (m.ds, QUATERNION_RESTORING_RATE, DRAG_SMOOTHING_SPEED**2,
                             1.0 if m.munk_moment else 0.0, *m.gravity)
-        self._consts[stencil.CENTRED] = 1.0 if self.scheme.centred else 0.0
+        self._consts[stencil.SCHEME] = self.scheme.kernel
         self._consts[stencil.COMPONENTWISE_DRAG] = 1.0 if m.drag_law == "componentwise" else 0.0
         self._work = np.zeros((m.n_elements, stencil.WORK_COLUMNS))
         self.base_velocities = np.zeros(6)
