@@ -73,6 +73,9 @@ N_CONSTS = 9
 P_KL, P_KTH, P_VL, P_VTH, P_MASS, P_INERTIA = 0, 3, 6, 9, 12, 15
 P_NET_MASS, P_DRAG, P_ADDED = 18, 19, 22
 N_PARAMS = 25
+#: Columns of a ``work`` row: the Kelvin-Voigt N, M (6), the total N, M with
+#: the cables (6) and the external force and moment densities (6).
+WORK_STRESS, WORK_TOTAL, WORK_LOADS = 0, 6, 12
 WORK_COLUMNS = 18
 
 
@@ -146,11 +149,11 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
         n_el, m_el = kelvin_voigt(_vec(pr, P_KL), _vec(pr, P_KTH), _vec(pr, P_VL), _vec(pr, P_VTH),
                                   q, k, q_t, k_t)
         row = work[i]
-        _put(row, 0, n_el)
-        _put(row, 3, m_el)
-        _put(row, 6, n_el)
-        _put(row, 9, m_el)
-        for j in range(12, 18):
+        _put(row, WORK_STRESS, n_el)
+        _put(row, WORK_STRESS + 3, m_el)
+        _put(row, WORK_TOTAL, n_el)
+        _put(row, WORK_TOTAL + 3, m_el)
+        for j in range(WORK_LOADS, WORK_LOADS + 6):
             row[j] = 0.0
 
     # Cables as actuation stress on their path (weights: share of each cell).
@@ -165,8 +168,8 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
             n_a, m_a = cable_stress(_vec(y, o + QS), _vec(y, o + K), _vec(route, 0), _vec(route, 3),
                                     tensions[c] * weights[c, i])
             row = work[i]
-            _put(row, 6, add(_vec(row, 6), n_a))
-            _put(row, 9, add(_vec(row, 9), m_a))
+            _put(row, WORK_TOTAL, add(_vec(row, WORK_TOTAL), n_a))
+            _put(row, WORK_TOTAL + 3, add(_vec(row, WORK_TOTAL + 3), m_a))
 
     # External loads at their velocity nodes.
     for e in range(kinds.shape[0]):
@@ -175,8 +178,8 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
                     (y[o + QUAT], y[o + QUAT + 1], y[o + QUAT + 2], y[o + QUAT + 3]),
                     _vec(y, o + V), _vec(y, o + W))
         row = work[nodes[e]]
-        _put(row, 12, add(_vec(row, 12), scale(entry_weights[e], f)))
-        _put(row, 15, add(_vec(row, 15), scale(entry_weights[e], m)))
+        _put(row, WORK_LOADS, add(_vec(row, WORK_LOADS), scale(entry_weights[e], f)))
+        _put(row, WORK_LOADS + 3, add(_vec(row, WORK_LOADS + 3), scale(entry_weights[e], m)))
 
     # Pass 2, velocity nodes 1..N (element i): balance laws with the
     # difference of the total stress of the cells around the node; beyond the
@@ -187,10 +190,10 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
     for i in range(n):
         o = HEADER + BLOCK * i
         row = work[i]
-        n_here, m_here = _vec(row, 6), _vec(row, 9)
+        n_here, m_here = _vec(row, WORK_TOTAL), _vec(row, WORK_TOTAL + 3)
         q_here, k_here = _vec(y, o + QS), _vec(y, o + K)
         if i + 1 < n:
-            n_next, m_next = _vec(work[i + 1], 6), _vec(work[i + 1], 9)
+            n_next, m_next = _vec(work[i + 1], WORK_TOTAL), _vec(work[i + 1], WORK_TOTAL + 3)
             k_next, q_next = _vec(y, o + BLOCK + K), _vec(y, o + BLOCK + QS)
         else:
             n_next, m_next, k_next, q_next = zero, zero, zero, (1.0, 0.0, 0.0)
@@ -216,10 +219,10 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
             f = sub(f, componentwise_drag(_vec(pr, P_DRAG), v, smoothing2))
         else:
             f = add(f, body_force(mass, pr[P_NET_MASS], _vec(pr, P_DRAG), r, gravity, v, w, smoothing2))
-        f = add(f, _vec(row, 12))
+        f = add(f, _vec(row, WORK_LOADS))
         t = add(scale(1.0 / length, sub(m_next, m_here)), t_cells)
         t = add(t, body_torque(inertia, _vec(pr, P_ADDED), munk, v, w))
-        t = add(t, _vec(row, 15))
+        t = add(t, _vec(row, WORK_LOADS + 3))
 
         _put(out, o + V, (f[0] / mass[0], f[1] / mass[1], f[2] / mass[2]))
         _put(out, o + W, (t[0] / inertia[0], t[1] / inertia[1], t[2] / inertia[2]))

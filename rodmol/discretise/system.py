@@ -365,7 +365,8 @@ class SemiDiscrete:
         out = np.empty(self.size)
         for i, (ti, yi) in enumerate(zip(np.asarray(t, dtype=float), states)):
             self(float(ti), yi, out)
-            stress[i], loads[i] = self._work[:, 0:6], self._work[:, 12:18]
+            stress[i] = self._work[:, stencil.WORK_STRESS:stencil.WORK_STRESS + 6]
+            loads[i] = self._work[:, stencil.WORK_LOADS:stencil.WORK_LOADS + 6]
         return stress, loads
 
     # ------------------------------------------------------------------ structure
