@@ -17,6 +17,7 @@ import numpy as np
 from scipy.linalg import solve_banded
 
 from ..discretise import centreline, rotations
+from ..discretise.jacobian import BandedDifferences
 from ..discretise.layout import BlockLayout
 from ..discretise.schemes import DEFAULT_SCHEME
 from ..discretise.system import SemiDiscrete, straight_state
@@ -337,36 +338,3 @@ def _newton(fun, z, tol, max_iter, jacobian):
                 return None
         z, f, norm = z_try, f_try, norm_try
     return z if np.max(np.abs(f)) < tol else None
-
-
-class BandedDifferences:
-    """The finite-difference Jacobian of a function of a vector laid out as
-    ``layout`` (a ``BlockLayout``) with the couplings ``depends``, in
-    ``solve_banded`` storage with :attr:`bands`: one evaluation per column
-    group of ``layout.colouring(depends)``, the groups the compiled Jacobian
-    of the dynamics perturbs (:mod:`rodmol.discretise.jacobian`)."""
-
-    def __init__(self, layout, depends):
-        self.bands = lo, up = layout.bandwidths(depends)
-        n, block, size = layout.n_blocks, layout.block, layout.size
-        self._groups = []  # (columns, their rows, the rows' diagonals in the band storage)
-        for entry, residue, period, low in layout.colouring(depends):
-            members = np.arange(residue, n, period)
-            row_blocks = members[:, None] + low + np.arange(period)  # the blocks each member reaches
-            rows = layout.header + block * row_blocks[..., None] + np.arange(block)
-            cols = np.broadcast_to((layout.header + block * members + entry)[:, None, None], rows.shape)
-            diagonal = up + rows - cols
-            ok = ((row_blocks[..., None] >= 0) & (row_blocks[..., None] < n) & (diagonal >= 0)
-                  & (diagonal <= lo + up) & (rows < size))
-            self._groups.append((layout.header + block * members + entry, rows[ok], cols[ok], diagonal[ok]))
-        self._shape = (lo + up + 1, size)
-
-    def __call__(self, fun, z, f0):
-        """dfun/dz at ``z`` (``f0`` = fun(z)) in ``solve_banded`` storage."""
-        ab = np.zeros(self._shape)
-        h = 1.5e-8 * np.maximum(np.abs(z), 1.0)
-        for members, rows, cols, diagonal in self._groups:
-            zp = z.copy()
-            zp[members] += h[members]
-            ab[diagonal, cols] = (fun(zp) - f0)[rows] / h[cols]
-        return ab
