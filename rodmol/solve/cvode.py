@@ -48,9 +48,8 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, l
     The steps are :class:`rodmol.solve.stepping.Stepper`'s, the stepping
     simulator's too; the outputs are interpolated inside them.
     """
-    stepper = Stepper(system, t_out[0], y0, rtol=rtol, atol=atol, start=False, linsolver=linsolver,
-                      max_step=max_step, jacobian=jacobian, max_order=max_order,
-                      max_nonlin_iters=max_nonlin_iters)
+    stepper = Stepper(system, t_out[0], y0, rtol=rtol, atol=atol, linsolver=linsolver, max_step=max_step,
+                      jacobian=jacobian, max_order=max_order, max_nonlin_iters=max_nonlin_iters)
     watch = Watch(system, t_out, max_wall_time, progress)
     out = Outputs(t_out, y0, progress, system.layout, "CVODE", watch)
 
@@ -65,7 +64,6 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, l
     t_end = float(t_out[-1])
 
     def steps():
-        stepper.restart(stepper.t, stepper.y)  # the solver's memory is allocated here
         # Steps stop at the inputs' knots: a rod at rest takes long steps and
         # would stride over a short ramp that starts between two of them.
         kinks = [t for t in knot_times(system.model) if t_out[0] < t < t_end][::-1]

@@ -46,11 +46,10 @@ class Stepper:
     ``rtol``, ``atol`` and ``options`` (the CVODE backend's options:
     ``linsolver``, ``jacobian``, ``max_order``, ``max_step``,
     ``max_nonlin_iters``) as for :func:`rodmol.solve.cvode.cvode`; they are
-    checked here, before any work. ``start=False`` leaves CVODE
-    uninitialised (its memory unallocated) until :meth:`restart`.
+    checked here, before any work.
     """
 
-    def __init__(self, system, t0, y0, *, rtol, atol, start=True, **options):
+    def __init__(self, system, t0, y0, *, rtol, atol, **options):
         from sksundae.cvode import CVODE
 
         self.system = system
@@ -69,8 +68,7 @@ class Stepper:
         #: Time [s] CVODE's steps have reached (beyond ``t`` inside an advance).
         self.reached = self.t
         self._fresh = False  # CVODE holds no history to continue from
-        if start:
-            self.restart(self.t, self.y)
+        self.restart(self.t, self.y)
 
     def _rhs(self, t, y, yp):
         self.evals += 1
