@@ -84,17 +84,13 @@ def modified_newton(y, b, g, f, r, x, weight, tolerance, max_iters, max_rate, de
     The one Newton loop of the fixed-step schemes: compiled
     (:func:`block_newton`) where the inputs depend on time only, run by
     Python where they read the state or the factors are a sparse LU."""
-    n = y.size
     previous, rate = -1.0, 1.0
     for k in range(1, max_iters + 1):
         rates(inputs, y, f)
-        if not np.all(np.isfinite(f)):
+        if not _residual(b, g, f, y, r):
             return NOT_FINITE, k
-        r[:] = b + g * f - y
         solve(factors, r, x)
-        y += x
-        e = x * weight
-        size = math.sqrt(np.sum(e * e) / n)
+        size = _correct(y, x, weight)
         if previous > 0.0:
             rate = max(decay * rate, size / previous)
         elif previous == 0.0:
@@ -108,6 +104,29 @@ def modified_newton(y, b, g, f, r, x, weight, tolerance, max_iters, max_rate, de
 
 
 block_newton = jit(modified_newton)
+
+
+# The loop's vector work as compiled helpers, so that run by Python it costs
+# a call each, and compiled it is the loop it always was (no temporaries).
+@jit
+def _residual(b, g, f, y, r):
+    """r = b + g f - y; False (r unfinished) if f has a non-finite entry."""
+    for i in range(y.size):
+        if not np.isfinite(f[i]):
+            return False
+        r[i] = b[i] + g * f[i] - y[i]
+    return True
+
+
+@jit
+def _correct(y, x, weight):
+    """y += x; returns the weighted RMS norm of the correction x."""
+    total = 0.0
+    for i in range(y.size):
+        y[i] += x[i]
+        e = x[i] * weight[i]
+        total += e * e
+    return math.sqrt(total / y.size)
 
 
 class _Matrix:
