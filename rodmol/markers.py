@@ -5,7 +5,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _checks
-from .discretise import centreline
 from .errors import ParameterError
 
 
@@ -43,18 +42,3 @@ def marker_offsets(markers, rod):
                                  f"outside the body, whose radius at s = {m.s!r} m is {radius:.6g} m "
                                  "(a marker is a point of the body or of its surface)")
     return out
-
-
-def track(s_markers, offsets, s_nodes, positions, rotations):
-    """Global marker positions (n_t, n_markers, 3) from nodal poses, for markers
-    at arc lengths ``s_markers`` [m] with local offsets ``offsets`` (n_markers, 2),
-    (p_y, p_z) [m].
-
-    Each marker is ``u + R p`` evaluated at the two nodes around it and
-    interpolated linearly in s (:func:`rodmol.discretise.centreline.section_points`).
-    """
-    pairs = [centreline.bracket(s_nodes, s) for s in s_markers]
-    nodes = np.array([[j, j + 1] for j, _ in pairs], dtype=np.int64).reshape(-1, 2)
-    weights = np.array([[1.0 - w, w] for _, w in pairs]).reshape(-1, 2)
-    at_nodes = np.repeat(np.asarray(offsets, dtype=float).reshape(-1, 1, 2), 2, axis=1)  # the same at both
-    return centreline.section_points(positions, rotations, nodes, weights, at_nodes)

@@ -29,7 +29,7 @@ Q_STAR.flags.writeable = False
 MAX_ELEMENTS = 100_000
 #: The sampled arrays of a Model (read-only once built).
 SAMPLED = ("s_nodes", "kl", "kth", "vl", "vth", "added", "mass", "inertia", "net_mass",
-           "drag_coefficient", "cable_offsets", "cable_weights")
+           "drag_coefficient", "cable_weights")
 
 
 class Model:
@@ -71,7 +71,7 @@ class Model:
 
     The sampled sectional arrays (``kl``, ``kth``, ``vl``, ``vth``, ``mass``,
     ``inertia``, ``net_mass``, ``drag_coefficient``, ``added``,
-    ``cable_offsets``, ``cable_weights``, ``s_nodes``) are read-only: the
+    ``cable_weights``, ``s_nodes``) are read-only: the
     compiled system copies them once, so they must not change afterwards.
     Build a new Model to change a parameter. ``kl`` ... ``vth`` are sampled at
     the strain nodes s_0..s_N-1, as the paper's upwind scheme reads them; a
@@ -192,7 +192,6 @@ class Model:
         # Fraction of each strain node's cell on the cable path: moving the
         # anchor inside a cell shifts its concentrated load smoothly between
         # the neighbouring nodes.
-        self.cable_offsets = np.array([c.offset3 for c in self.cables]).reshape(-1, 3)
         anchors = np.array([c.anchor for c in self.cables]).reshape(-1, 1)
         self.cable_weights = np.clip((anchors - s_str[None, :]) / ds, 0.0, 1.0)
         self.grid_loads = load_types.on_grid(self.loads, self.s_nodes, rod.radius_at(self.s_nodes))

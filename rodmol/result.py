@@ -5,7 +5,6 @@ from functools import partial
 
 import numpy as np
 
-from . import markers
 from ._files import refuse_directories, write_atomically
 from .discretise import centreline, physics, rotations
 from .discretise.layout import StateLayout
@@ -133,7 +132,8 @@ class Result:
 
 #: Arrays of a Result that do not change in time.
 STATIC = ("s", "radius", "node_length")
-#: (n_t, 12) the rows of the strains and velocities that are not state fields:
+#: (n_t, 12) the rows of the strains and velocities that are not state fields
+#: (``StateLayout.boundary``, fields ``layout.BOUNDARY_FIELDS``):
 #: the base's velocity v0 [m/s] and angular velocity w0 [rad/s] (prescribed) and
 #: the tip's strains q [-] and k [1/m] (from the tip load), local frame.
 BOUNDARY = "boundary_rows"
@@ -200,7 +200,8 @@ def _loads(system, result):
     t, y, tensions = result.t, result.states, result.tensions
     n_t = len(t)
     q, k = layout.field(y, "q"), layout.field(y, "k")
-    base = np.array([np.concatenate(model.base.velocities(ti)) for ti in t]).reshape(n_t, 6)
+    base = [model.base.velocities(ti) for ti in t]
+    v0, w0 = (np.array([v[j] for v in base]).reshape(n_t, 3) for j in (0, 1))
     stress, loads = system.frames(t, y)
     # Tip node: the body carries the load concentrated on the tip node (a
     # point load at s = L; distributed loads give an O(ds) share) minus the
@@ -220,6 +221,9 @@ def _loads(system, result):
             n_tip[i] -= n_a
             m_tip[i] -= m_a
     kl_tip, kth_tip = model.rod.stiffness(model.rod.length)
+    boundary = np.empty((n_t, layout.boundary.size))
+    for name, value in dict(v=v0, w=w0, q=Q_STAR + n_tip / kl_tip, k=m_tip / kth_tip).items():
+        layout.boundary.field(boundary, name)[:, 0] = value
     rots = result.rotations[:, 1:]  # the pose's (a writer needs both)
     external_force, external_moment = np.zeros((2, n_t, len(result.s), 3))  # none at the clamp, node 0
     rotations.rotate(rots, loads[..., :3], external_force[:, 1:])
@@ -228,7 +232,7 @@ def _loads(system, result):
         "internal_force": np.concatenate([stress[..., :3], n_tip[:, None]], axis=1),
         "internal_moment": np.concatenate([stress[..., 3:], m_tip[:, None]], axis=1),
         "external_force": external_force, "external_moment": external_moment,
-        BOUNDARY: np.concatenate([base, Q_STAR + n_tip / kl_tip, m_tip / kth_tip], axis=1),
+        BOUNDARY: boundary,
     }
 
 
@@ -239,12 +243,13 @@ def _layout(result):
 
 def _kinematics(result):
     """Strains and velocities at all nodes: the state's fields and the boundary rows."""
-    y, rows = result.states, getattr(result, BOUNDARY)
-    field = partial(_layout(result).field, y)
-    return dict(linear_strain=np.concatenate([field("q"), rows[:, None, 6:9]], axis=1),
-                curvature=np.concatenate([field("k"), rows[:, None, 9:12]], axis=1),
-                velocity=np.concatenate([rows[:, None, 0:3], field("v")], axis=1),
-                angular_velocity=np.concatenate([rows[:, None, 3:6], field("w")], axis=1))
+    layout = _layout(result)
+    field = partial(layout.field, result.states)
+    row = partial(layout.boundary.field, getattr(result, BOUNDARY))  # (n_t, 1, 3) each
+    return dict(linear_strain=np.concatenate([field("q"), row("q")], axis=1),
+                curvature=np.concatenate([field("k"), row("k")], axis=1),
+                velocity=np.concatenate([row("v"), field("v")], axis=1),
+                angular_velocity=np.concatenate([row("w"), field("w")], axis=1))
 
 
 def _pose(result):
@@ -259,7 +264,7 @@ def _pose(result):
     offsets = np.array([m["offset"] for m in marks]).reshape(-1, 2)
     return dict(
         positions=positions, rotations=rots,
-        markers=markers.track([m["s"] for m in marks], offsets, result.s, positions, rots),
+        markers=centreline.track([m["s"] for m in marks], offsets, result.s, positions, rots),
     )
 
 

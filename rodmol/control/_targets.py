@@ -3,7 +3,7 @@ weighted functions of a rest state, with their derivatives in the state."""
 
 import numpy as np
 
-from .. import _checks, markers
+from .. import _checks
 from ..discretise import centreline, rotations
 from ..errors import ParameterError
 
@@ -62,7 +62,7 @@ class Targets:
         if self.direction:
             parts.append(self.direction_weight * frames[-1][:, 0])
         if self.marker_names:
-            points = markers.track(self._s, self._offsets, self._s_nodes, positions[None], frames[None])[0]
+            points = centreline.track(self._s, self._offsets, self._s_nodes, positions[None], frames[None])[0]
             parts.append(self.marker_weight * points.ravel())
         return np.concatenate(parts)
 

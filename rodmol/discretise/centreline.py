@@ -83,3 +83,18 @@ def _section_points(positions, rotations, nodes, weights, offsets, out):
                     total += weights[i, e] * (positions[f, n, c] + offsets[i, e, 0] * rotations[f, n, c, 1]
                                               + offsets[i, e, 1] * rotations[f, n, c, 2])
                 out[f, i, c] = total
+
+
+def track(s_markers, offsets, s_nodes, positions, rotations):
+    """Global marker positions (n_t, n_markers, 3) from nodal poses, for markers
+    at arc lengths ``s_markers`` [m] with local offsets ``offsets`` (n_markers, 2),
+    (p_y, p_z) [m].
+
+    Each marker is ``u + R p`` evaluated at the two nodes around it and
+    interpolated linearly in s (:func:`rodmol.discretise.section_points`).
+    """
+    pairs = [bracket(s_nodes, s) for s in s_markers]
+    nodes = np.array([[j, j + 1] for j, _ in pairs], dtype=np.int64).reshape(-1, 2)
+    weights = np.array([[1.0 - w, w] for _, w in pairs]).reshape(-1, 2)
+    at_nodes = np.repeat(np.asarray(offsets, dtype=float).reshape(-1, 1, 2), 2, axis=1)  # the same at both
+    return section_points(positions, rotations, nodes, weights, at_nodes)

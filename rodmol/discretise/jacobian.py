@@ -1,8 +1,10 @@
-"""Compiled finite-difference Jacobian of the semi-discrete right-hand side.
+"""Finite-difference Jacobians: the compiled one of the semi-discrete
+right-hand side, and :class:`BandedDifferences` for any function of a block
+layout (the static equilibrium's).
 
 Columns are perturbed in groups that touch disjoint rows; the groups come from
-the system's dependency table (``BlockLayout.colouring``), so a load that reads
-a new field or a wider stencil changes the colouring by itself. The blocks are
+the dependency table (``BlockLayout.colouring``), so a load that reads a new
+field or a wider stencil changes the colouring by itself. The compiled blocks are
 ``jb[b, d, i, j]`` = d f(element b, entry i) / d y(element b + d - 1, entry j)
 (storage order within the block) and ``jh``, the base pose's own block.
 """
@@ -187,3 +189,37 @@ def _sparse_structure(pattern, n):
     csc = sparse.csc_matrix((np.ones(len(rows)), (rows, cols)), shape=pattern.shape)
     csc.sort_indices()
     return csc, src
+
+
+class BandedDifferences:
+    """The finite-difference Jacobian of a function of a vector laid out as
+    ``layout`` (a ``BlockLayout``) with the couplings ``depends``, in
+    ``solve_banded`` storage with :attr:`bands`: one evaluation per column
+    group of ``layout.colouring(depends)``, the groups
+    :class:`CompiledJacobian` perturbs. For functions numba cannot call (the
+    static equilibrium's rest equations)."""
+
+    def __init__(self, layout, depends):
+        self.bands = lo, up = layout.bandwidths(depends)
+        n, block, size = layout.n_blocks, layout.block, layout.size
+        self._groups = []  # (columns, their rows, the rows' diagonals in the band storage)
+        for entry, residue, period, low in layout.colouring(depends):
+            members = np.arange(residue, n, period)
+            row_blocks = members[:, None] + low + np.arange(period)  # the blocks each member reaches
+            rows = layout.header + block * row_blocks[..., None] + np.arange(block)
+            cols = np.broadcast_to((layout.header + block * members + entry)[:, None, None], rows.shape)
+            diagonal = up + rows - cols
+            ok = ((row_blocks[..., None] >= 0) & (row_blocks[..., None] < n) & (diagonal >= 0)
+                  & (diagonal <= lo + up) & (rows < size))
+            self._groups.append((layout.header + block * members + entry, rows[ok], cols[ok], diagonal[ok]))
+        self._shape = (lo + up + 1, size)
+
+    def __call__(self, fun, z, f0):
+        """dfun/dz at ``z`` (``f0`` = fun(z)) in ``solve_banded`` storage."""
+        ab = np.zeros(self._shape)
+        h = 1.5e-8 * np.maximum(np.abs(z), 1.0)
+        for members, rows, cols, diagonal in self._groups:
+            zp = z.copy()
+            zp[members] += h[members]
+            ab[diagonal, cols] = (fun(zp) - f0)[rows] / h[cols]
+        return ab

@@ -42,6 +42,18 @@ HEADER = sum(HEADER_FIELDS.values())
 # Integer offsets of each field inside a block, for the compiled kernels (numba
 # freezes module-level ints into the machine code).
 U, QUAT, Q, K, V, W = (FIELDS[f].start for f in ("u", "Q", "q", "k", "v", "w"))
+#: The fields of the strain and velocity rows a state leaves out, as a Result
+#: stores them: the base node's velocities v0, w0 (prescribed) and the tip's
+#: strains q, k (from the tip load).
+BOUNDARY_FIELDS = {"v": 3, "w": 3, "q": 3, "k": 3}
+
+
+def span(names):
+    """The slice of a block covering the fields ``names``, which must be adjacent."""
+    slices = [FIELDS[f] for f in names]
+    if any(a.stop != b.start for a, b in zip(slices, slices[1:])):
+        raise ValueError(f"the fields {names} are not adjacent in a block")
+    return slice(slices[0].start, slices[-1].stop)
 
 
 def merge(*tables):
@@ -178,6 +190,11 @@ class StateLayout(BlockLayout):
     def integrated_positions(self, y):
         """(..., N+1, 3) time-integrated positions of nodes 0..N [m], global."""
         return np.concatenate([self.base_position(y)[..., None, :], self.field(y, "u")], axis=-2)
+
+    @property
+    def boundary(self):
+        """The layout of the rows of :data:`BOUNDARY_FIELDS` (one block)."""
+        return BlockLayout(1, dict(BOUNDARY_FIELDS))
 
     def tip_slice(self, name):
         """Index range of field ``name`` of the tip node's block."""

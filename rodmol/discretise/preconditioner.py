@@ -27,7 +27,7 @@ plus a positive second-difference operator.
 import numpy as np
 
 from .jacobian import read_only
-from .layout import BLOCK, HEADER
+from .layout import BLOCK, HEADER, span
 from .physics import jit
 
 _POSE, _STRAIN, _VELOCITY = ("u", "Q"), ("q", "k"), ("v", "w")
@@ -38,15 +38,19 @@ TEMPLATE = {
     **{f: {-1: _VELOCITY, 0: _POSE + _STRAIN + _VELOCITY, 1: _STRAIN + _VELOCITY}
        for f in _VELOCITY},
 }
-_P0, _X0, _Z0 = 0, 7, 13
-NP, NX = 7, 6
+# Where P, X and Z stand in a block, and their sizes (Z has X's), from the layout.
+_P, _X, _Z = span(_POSE), span(_STRAIN), span(_VELOCITY)
+_P0, _X0, _Z0 = _P.start, _X.start, _Z.start
+NP, NX = _P.stop - _P.start, _X.stop - _X.start
+if _Z.stop - _Z.start != NX:
+    raise ImportError("the block elimination needs as many velocities as strains per block")
 
 # Per-element factors, one row per element so that a solve streams them from
 # one array: AINV 7x7, BINV 6x6, SX 6x6, TX 6x6, WP 7x6, LOW, DINV, FWD 6x6,
 # copies of J blocks C0 = J_ZX(b), CP = J_ZX(b+1) 6x6, G = J_ZP 6x7.
-F_AINV, F_BINV, F_SX, F_TX, F_WP = 0, 49, 85, 121, 157
-F_LOW, F_DINV, F_FWD, F_C0, F_CP, F_G = 199, 235, 271, 307, 343, 379
-N_FACTORS = 421
+_FACTOR_SIZES = (NP * NP, NX * NX, NX * NX, NX * NX, NP * NX, NX * NX, NX * NX, NX * NX, NX * NX, NX * NX, NX * NP)
+(F_AINV, F_BINV, F_SX, F_TX, F_WP, F_LOW, F_DINV, F_FWD, F_C0, F_CP, F_G,
+ N_FACTORS) = (int(i) for i in np.cumsum((0, *_FACTOR_SIZES)))
 
 
 def check_structure(depends):

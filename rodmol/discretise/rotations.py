@@ -59,18 +59,6 @@ def _rotate(m, v, out):
             out[f, n, 0], out[f, n, 1], out[f, n, 2] = to_global(m[f, n], (v[f, n, 0], v[f, n, 1], v[f, n, 2]))
 
 
-def rate(quat, omega):
-    """dQ/dt = Q (x) (0, omega) / 2 for a body-frame angular velocity omega (..., 3)."""
-    a, b, c, d = (quat[..., i] for i in range(4))
-    w1, w2, w3 = (omega[..., i] for i in range(3))
-    out = np.empty(quat.shape)
-    out[..., 0] = -0.5 * (b * w1 + c * w2 + d * w3)
-    out[..., 1] = 0.5 * (a * w1 + c * w3 - d * w2)
-    out[..., 2] = 0.5 * (a * w2 + d * w1 - b * w3)
-    out[..., 3] = 0.5 * (a * w3 + b * w2 - c * w1)
-    return out
-
-
 def multiply(p, q):
     """Quaternion product p (x) q, rows broadcast (``physics.quaternion_product``)."""
     p, q = np.broadcast_arrays(np.asarray(p, dtype=float), np.asarray(q, dtype=float))

@@ -17,6 +17,7 @@ import numpy as np
 from ..cable_routing import cell_geometry
 from . import physics
 from .physics import jit
+from .stencil import CENTRED, compatibility
 
 
 class CableRouting:
@@ -37,11 +38,6 @@ class CableRouting:
         self.friction = np.array([c.friction for c in cables])
         self.slip_speed = np.array([c.slip_speed for c in cables])
         self.index = {c.name: i for i, c in enumerate(cables)}
-
-    def path_vectors(self, q, k):
-        """c = q + k x p + p' (..., n_cables, N, 3), local frame, for strains q, k (..., N, 3)."""
-        p, dp = self.geometry[..., :3], self.geometry[..., 3:]
-        return q[..., None, :, :] + np.cross(k[..., None, :, :], p) + dp
 
     def lengths(self, q, k):
         """Path lengths [m] from the base to each anchor, (..., n_cables), for strains q, k (..., N, 3)."""
@@ -79,18 +75,14 @@ class CableRouting:
 
 @jit
 def _strain_rates(q, k, v, w, base_velocities, ds, q_t, k_t):
-    # The compatibility laws with v, w averaged over each cell (v0, w0 before the first).
+    # The stencil's compatibility law, with v, w averaged over each cell (v0, w0 before the first).
     for i in range(q.shape[0]):
-        v_i, w_i = _row(v, i), _row(w, i)
         if i == 0:
             v_prev = (base_velocities[0], base_velocities[1], base_velocities[2])
             w_prev = (base_velocities[3], base_velocities[4], base_velocities[5])
         else:
             v_prev, w_prev = _row(v, i - 1), _row(w, i - 1)
-        terms_q, terms_k = physics.strain_rate_terms(_row(q, i), _row(k, i), physics.scale(0.5, physics.add(v_i, v_prev)),
-                                                     physics.scale(0.5, physics.add(w_i, w_prev)))
-        q_t[i] = physics.add(physics.scale(1.0 / ds, physics.sub(v_i, v_prev)), terms_q)
-        k_t[i] = physics.add(physics.scale(1.0 / ds, physics.sub(w_i, w_prev)), terms_k)
+        q_t[i], k_t[i] = compatibility(_row(q, i), _row(k, i), _row(v, i), _row(w, i), v_prev, w_prev, ds, CENTRED)
 
 
 @jit

@@ -11,11 +11,13 @@ one compiled loop (:mod:`rodmol.discretise.stencil`); a scheme says
 * the length of the rod each velocity node stands for (its control volume),
   which weighs the node in the energy, in point loads and in the tip wrench.
 
-To add a scheme, add a :class:`Scheme` to :data:`SCHEMES` (and, if its loop
-differs, a switch in the stencil).
+To add a scheme, add a :class:`Scheme` to :data:`SCHEMES` and, if its loop
+differs from the existing ones, a :class:`Kernel` code and that code's branch
+in the stencil.
 """
 
 from dataclasses import dataclass
+from enum import IntEnum
 
 import numpy as np
 
@@ -45,14 +47,31 @@ _CENTRED = {
 }
 
 
+class Kernel(IntEnum):
+    """The branch of the compiled loop (:mod:`rodmol.discretise.stencil`) a
+    scheme runs: where the non-derivative terms are evaluated."""
+
+    #: Strain rates at the cell's base-side node, balances with the tip-side cell's products.
+    UPWIND = 0
+    #: Strain rates and balances with the averages over the cell's nodes and the node's cells.
+    CENTRED = 1
+
+
 @dataclass(frozen=True)
 class Scheme:
-    """A spatial scheme on the staggered grid (see the module docstring)."""
+    """A spatial scheme on the staggered grid (see the module docstring).
+
+    ``kernel`` is the stencil's branch; ``cell_point`` the fraction of a cell
+    (from its base-side node) where its properties are sampled; ``tip_share``
+    the fraction of a cell the tip node stands for (the other nodes: one cell).
+    """
 
     name: str
     summary: str
     order: int
-    centred: bool
+    kernel: Kernel
+    cell_point: float
+    tip_share: float
     depends: dict
     #: Default relative tolerance: the time error at most a tenth of the
     #: spatial error at N = 100 on the paper's tests (docs/model.md,
@@ -62,13 +81,14 @@ class Scheme:
     def cell_points(self, s_nodes):
         """Arc lengths [m] where the properties of cells 0..N-1 are sampled."""
         s_nodes = np.asarray(s_nodes, dtype=float)
-        return 0.5 * (s_nodes[:-1] + s_nodes[1:]) if self.centred else s_nodes[:-1]
+        if self.cell_point == 0.0:
+            return s_nodes[:-1]
+        return (1.0 - self.cell_point) * s_nodes[:-1] + self.cell_point * s_nodes[1:]
 
     def node_lengths(self, n, ds):
         """Length of rod [m] each velocity node 1..N stands for, shape (N,)."""
         lengths = np.full(n, float(ds))
-        if self.centred:
-            lengths[-1] *= 0.5
+        lengths[-1] *= self.tip_share
         return lengths
 
 
@@ -76,11 +96,11 @@ SCHEMES = {
     "centred": Scheme(
         "centred",
         "second order: cell properties at cell midpoints, centred non-derivative "
-        "terms, half a cell at the tip", 2, True, _CENTRED, 3e-5),
+        "terms, half a cell at the tip", 2, Kernel.CENTRED, 0.5, 0.5, _CENTRED, 3e-5),
     "upwind": Scheme(
         "upwind",
         "the paper's scheme (section IV-C): one-sided non-derivative terms, first order",
-        1, False, _UPWIND, 1e-4),
+        1, Kernel.UPWIND, 0.0, 1.0, _UPWIND, 1e-4),
 }
 DEFAULT_SCHEME = "centred"
 

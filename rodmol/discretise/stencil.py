@@ -7,11 +7,11 @@ neighbouring cells in the balance laws. The schemes differ in where the
 non-derivative terms are evaluated (:mod:`rodmol.discretise.schemes` holds
 the definitions, their dependency tables and sampling):
 
-* ``upwind`` (the paper's, section IV-C, ``consts[CENTRED] = 0``): the strain
+* ``upwind`` (the paper's, section IV-C, ``consts[SCHEME] = Kernel.UPWIND``): the strain
   rates use the velocities of the cell's base-side node, a node's balance uses
   the products k x N, k x M, q x N of the cell on its tip side (zero beyond
   the tip); first order in ds.
-* ``centred`` (``consts[CENTRED] = 1``): the strain rates use the average of
+* ``centred`` (``consts[SCHEME] = Kernel.CENTRED``): the strain rates use the average of
   the cell's two node velocities, a node's balance the average of its two
   cells' products, and the tip node carries half a cell; second order in ds,
   and the discrete energy is conserved exactly without dissipation.
@@ -24,7 +24,7 @@ Packing of the sampled model (built once by ``SemiDiscrete``):
 * ``params`` (N, 25): per element, the constant sectional data, one row per
   element (columns ``P_*``);
 * ``consts`` (9,): ds, quaternion restoring rate, drag smoothing speed^2,
-  Munk switch (0/1), gravity (3, global), centred switch (0/1), drag law
+  Munk switch (0/1), gravity (3, global), the scheme's kernel code, drag law
   (0 Morison, 1 componentwise C v|v|: then ``P_DRAG`` holds C);
 * ``offsets`` (n_c, N, 6), ``weights`` (n_c, N): per cable and cell the
   offset p and its slope p' (local, :mod:`rodmol.discretise.routing`), and
@@ -60,9 +60,12 @@ from .physics import (
     sub,
     to_global,
 )
+from .schemes import Kernel
 
-#: Index of the scheme switch in ``consts`` (0 upwind, 1 centred).
-CENTRED = 7
+#: Index of the scheme's :class:`~rodmol.discretise.schemes.Kernel` code in ``consts``.
+SCHEME = 7
+#: The kernel codes as plain integers (numba compares them as constants).
+UPWIND, CENTRED = int(Kernel.UPWIND), int(Kernel.CENTRED)
 #: Index of the drag law switch in ``consts`` (0 Morison, 1 componentwise).
 COMPONENTWISE_DRAG = 8
 N_CONSTS = 9
@@ -70,6 +73,9 @@ N_CONSTS = 9
 P_KL, P_KTH, P_VL, P_VTH, P_MASS, P_INERTIA = 0, 3, 6, 9, 12, 15
 P_NET_MASS, P_DRAG, P_ADDED = 18, 19, 22
 N_PARAMS = 25
+#: Columns of a ``work`` row: the Kelvin-Voigt N, M (6), the total N, M with
+#: the cables (6) and the external force and moment densities (6).
+WORK_STRESS, WORK_TOTAL, WORK_LOADS = 0, 6, 12
 WORK_COLUMNS = 18
 
 
@@ -93,6 +99,20 @@ def _put(out, i, x):
     out[i], out[i + 1], out[i + 2] = x[0], x[1], x[2]
 
 
+@jit
+def compatibility(q, k, v, w, v_prev, w_prev, ds, kernel):
+    """The strain rates (q_t, k_t) of a cell, local frame, from the compatibility
+    laws (eq. 2) with the difference of the velocities (v, w) of its tip-side
+    node and (v_prev, w_prev) of its base-side node across the cell; the
+    non-derivative terms read the base-side node (``UPWIND``) or the average
+    of both (``CENTRED``), as the scheme's ``kernel`` code says."""
+    if kernel == CENTRED:
+        terms_q, terms_k = strain_rate_terms(q, k, scale(0.5, add(v, v_prev)), scale(0.5, add(w, w_prev)))
+    else:
+        terms_q, terms_k = strain_rate_terms(q, k, v_prev, w_prev)
+    return add(scale(1.0 / ds, sub(v, v_prev)), terms_q), add(scale(1.0 / ds, sub(w, w_prev)), terms_k)
+
+
 def _signature():
     # The state comes read-only from CVODE and writable from everywhere else;
     # typing it read-only accepts both with a single compilation.
@@ -109,7 +129,8 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
     n = params.shape[0]
     ds, restoring, smoothing2, munk = consts[0], consts[1], consts[2], consts[3] != 0.0
     gravity = (consts[4], consts[5], consts[6])
-    centred = consts[CENTRED] != 0.0
+    kernel = int(consts[SCHEME])
+    centred = kernel == CENTRED
     componentwise = consts[COMPONENTWISE_DRAG] != 0.0
 
     # Pass 1, cells i = 0..N-1: compatibility with the differences of v, w
@@ -121,23 +142,18 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
             v_prev, w_prev = _vec(base, 0), _vec(base, 3)
         else:
             v_prev, w_prev = _vec(y, o - BLOCK + V), _vec(y, o - BLOCK + W)
-        if centred:
-            terms_q, terms_k = strain_rate_terms(q, k, scale(0.5, add(v, v_prev)), scale(0.5, add(w, w_prev)))
-        else:
-            terms_q, terms_k = strain_rate_terms(q, k, v_prev, w_prev)
-        q_t = add(scale(1.0 / ds, sub(v, v_prev)), terms_q)
-        k_t = add(scale(1.0 / ds, sub(w, w_prev)), terms_k)
+        q_t, k_t = compatibility(q, k, v, w, v_prev, w_prev, ds, kernel)
         _put(out, o + QS, q_t)
         _put(out, o + K, k_t)
         pr = params[i]
         n_el, m_el = kelvin_voigt(_vec(pr, P_KL), _vec(pr, P_KTH), _vec(pr, P_VL), _vec(pr, P_VTH),
                                   q, k, q_t, k_t)
         row = work[i]
-        _put(row, 0, n_el)
-        _put(row, 3, m_el)
-        _put(row, 6, n_el)
-        _put(row, 9, m_el)
-        for j in range(12, 18):
+        _put(row, WORK_STRESS, n_el)
+        _put(row, WORK_STRESS + 3, m_el)
+        _put(row, WORK_TOTAL, n_el)
+        _put(row, WORK_TOTAL + 3, m_el)
+        for j in range(WORK_LOADS, WORK_LOADS + 6):
             row[j] = 0.0
 
     # Cables as actuation stress on their path (weights: share of each cell).
@@ -152,8 +168,8 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
             n_a, m_a = cable_stress(_vec(y, o + QS), _vec(y, o + K), _vec(route, 0), _vec(route, 3),
                                     tensions[c] * weights[c, i])
             row = work[i]
-            _put(row, 6, add(_vec(row, 6), n_a))
-            _put(row, 9, add(_vec(row, 9), m_a))
+            _put(row, WORK_TOTAL, add(_vec(row, WORK_TOTAL), n_a))
+            _put(row, WORK_TOTAL + 3, add(_vec(row, WORK_TOTAL + 3), m_a))
 
     # External loads at their velocity nodes.
     for e in range(kinds.shape[0]):
@@ -162,8 +178,8 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
                     (y[o + QUAT], y[o + QUAT + 1], y[o + QUAT + 2], y[o + QUAT + 3]),
                     _vec(y, o + V), _vec(y, o + W))
         row = work[nodes[e]]
-        _put(row, 12, add(_vec(row, 12), scale(entry_weights[e], f)))
-        _put(row, 15, add(_vec(row, 15), scale(entry_weights[e], m)))
+        _put(row, WORK_LOADS, add(_vec(row, WORK_LOADS), scale(entry_weights[e], f)))
+        _put(row, WORK_LOADS + 3, add(_vec(row, WORK_LOADS + 3), scale(entry_weights[e], m)))
 
     # Pass 2, velocity nodes 1..N (element i): balance laws with the
     # difference of the total stress of the cells around the node; beyond the
@@ -174,10 +190,10 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
     for i in range(n):
         o = HEADER + BLOCK * i
         row = work[i]
-        n_here, m_here = _vec(row, 6), _vec(row, 9)
+        n_here, m_here = _vec(row, WORK_TOTAL), _vec(row, WORK_TOTAL + 3)
         q_here, k_here = _vec(y, o + QS), _vec(y, o + K)
         if i + 1 < n:
-            n_next, m_next = _vec(work[i + 1], 6), _vec(work[i + 1], 9)
+            n_next, m_next = _vec(work[i + 1], WORK_TOTAL), _vec(work[i + 1], WORK_TOTAL + 3)
             k_next, q_next = _vec(y, o + BLOCK + K), _vec(y, o + BLOCK + QS)
         else:
             n_next, m_next, k_next, q_next = zero, zero, zero, (1.0, 0.0, 0.0)
@@ -203,10 +219,10 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
             f = sub(f, componentwise_drag(_vec(pr, P_DRAG), v, smoothing2))
         else:
             f = add(f, body_force(mass, pr[P_NET_MASS], _vec(pr, P_DRAG), r, gravity, v, w, smoothing2))
-        f = add(f, _vec(row, 12))
+        f = add(f, _vec(row, WORK_LOADS))
         t = add(scale(1.0 / length, sub(m_next, m_here)), t_cells)
         t = add(t, body_torque(inertia, _vec(pr, P_ADDED), munk, v, w))
-        t = add(t, _vec(row, 15))
+        t = add(t, _vec(row, WORK_LOADS + 3))
 
         _put(out, o + V, (f[0] / mass[0], f[1] / mass[1], f[2] / mass[2]))
         _put(out, o + W, (t[0] / inertia[0], t[1] / inertia[1], t[2] / inertia[2]))

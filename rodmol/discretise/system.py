@@ -15,7 +15,6 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..markers import track
 from . import centreline, external, rotations, stencil
 from .layout import StateLayout, merge
 from .physics import compile_signatures
@@ -138,7 +137,7 @@ class StateView:
             return self.positions[-1]
         if name == "markers" and self._markers is not None:
             m = self._markers
-            return track([mk.s for mk in m.markers], m.marker_offsets[:, 1:], m.s_nodes,
+            return centreline.track([mk.s for mk in m.markers], m.marker_offsets[:, 1:], m.s_nodes,
                          self.positions[None], self.rotations[None])[0]
         raise AttributeError(name)
 
@@ -184,7 +183,7 @@ class SemiDiscrete:
         self._consts = np.zeros(stencil.N_CONSTS)
         self._consts[:7] = (m.ds, QUATERNION_RESTORING_RATE, DRAG_SMOOTHING_SPEED**2,
                             1.0 if m.munk_moment else 0.0, *m.gravity)
-        self._consts[stencil.CENTRED] = 1.0 if self.scheme.centred else 0.0
+        self._consts[stencil.SCHEME] = self.scheme.kernel
         self._consts[stencil.COMPONENTWISE_DRAG] = 1.0 if m.drag_law == "componentwise" else 0.0
         self._work = np.zeros((m.n_elements, stencil.WORK_COLUMNS))
         self.base_velocities = np.zeros(6)
@@ -366,7 +365,8 @@ class SemiDiscrete:
         out = np.empty(self.size)
         for i, (ti, yi) in enumerate(zip(np.asarray(t, dtype=float), states)):
             self(float(ti), yi, out)
-            stress[i], loads[i] = self._work[:, 0:6], self._work[:, 12:18]
+            stress[i] = self._work[:, stencil.WORK_STRESS:stencil.WORK_STRESS + 6]
+            loads[i] = self._work[:, stencil.WORK_LOADS:stencil.WORK_LOADS + 6]
         return stress, loads
 
     # ------------------------------------------------------------------ structure

@@ -6,8 +6,10 @@ system's own right-hand side at rest (v = w = 0), so every load the dynamics
 sees acts here too, and the pose compatibility of the element, Q_{b+1} =
 Q_b exp(ds k_b) and u_{b+1} = u_b + the chord of ``centreline.chords`` (so
 the resting state's positions are the ones ``Result.positions`` rebuilds).
-The Jacobian is banded, with half-bandwidths derived from the system's
-dependency table, built by grouped finite differences and factorised with
+The Jacobian is banded: its half-bandwidths and the column groups of its
+finite differences are the block layout's, derived from the system's
+dependency table (``BlockLayout.bandwidths``, ``BlockLayout.colouring``, as
+the compiled Jacobian of the dynamics takes them), and it is factorised with
 ``scipy.linalg.solve_banded``: the cost grows linearly with N.
 """
 
@@ -15,6 +17,7 @@ import numpy as np
 from scipy.linalg import solve_banded
 
 from ..discretise import centreline, rotations
+from ..discretise.jacobian import BandedDifferences
 from ..discretise.layout import BlockLayout
 from ..discretise.schemes import DEFAULT_SCHEME
 from ..discretise.system import SemiDiscrete, straight_state
@@ -169,7 +172,8 @@ class RestEquations:
         self.system, self.t, self.tensions = system, t, tensions
         self.layout = system.layout
         self.static = BlockLayout(model.n_elements, dict(STATIC_FIELDS))
-        self.bands = self.static.bandwidths(static_dependencies(system.depends))
+        self.differences = BandedDifferences(self.static, static_dependencies(system.depends))
+        self.bands = self.differences.bands
         base = model.base
         self._quat0 = rotations.from_matrix(base.rotation)
         self._u0 = np.asarray(base.position, dtype=float)
@@ -226,7 +230,7 @@ class RestEquations:
     def jacobian(self, z):
         """dR/dz at full load, in ``solve_banded`` storage with :attr:`bands`."""
         fun = self.residual
-        return _banded_jacobian(fun, z, fun(z), self.bands)
+        return self.differences(fun, z, fun(z))
 
 
 def tension_sensitivity(system, y, tensions, t=0.0):
@@ -294,15 +298,15 @@ def _rest_state(system, t, tol, max_iter, tensions=None, start=None):
         return y
     z = equations.unknowns(y)
     tol = equations.tolerance(tol)
-    residual, bands = equations.residual, equations.bands
+    residual, jacobian = equations.residual, equations.differences
     lam, step = 0.0, 1.0
     if start is not None:
-        z_warm = _newton(residual, equations.unknowns(start), tol, max_iter, bands)
+        z_warm = _newton(residual, equations.unknowns(start), tol, max_iter, jacobian)
         if z_warm is not None:
             z, lam = z_warm, 1.0
     while lam < 1.0:
         target = min(1.0, lam + step)
-        z_new = _newton(lambda x, lam=target: residual(x, lam), z, tol, max_iter, bands)
+        z_new = _newton(lambda x, lam=target: residual(x, lam), z, tol, max_iter, jacobian)
         if z_new is not None:
             z, lam, step = z_new, target, min(1.0, 2.0 * step)
         else:
@@ -314,15 +318,16 @@ def _rest_state(system, t, tol, max_iter, tensions=None, start=None):
     return equations.state(z)
 
 
-def _newton(fun, z, tol, max_iter, bands):
-    """Damped Newton on a banded system; None if it does not converge."""
+def _newton(fun, z, tol, max_iter, jacobian):
+    """Damped Newton on a banded system (``jacobian``: its :class:`BandedDifferences`);
+    None if it does not converge."""
     f = fun(z)
     norm = np.linalg.norm(f)
     for _ in range(max_iter):
         if np.max(np.abs(f)) < tol:
             return z
         try:
-            dz = solve_banded(bands, _banded_jacobian(fun, z, f, bands), -f)
+            dz = solve_banded(jacobian.bands, jacobian(fun, z, f), -f)
         except (np.linalg.LinAlgError, ValueError):
             return None
         alpha = 1.0
@@ -337,24 +342,3 @@ def _newton(fun, z, tol, max_iter, bands):
                 return None
         z, f, norm = z_try, f_try, norm_try
     return z if np.max(np.abs(f)) < tol else None
-
-
-def _banded_jacobian(fun, z, f0, bands):
-    """Finite-difference Jacobian in ``solve_banded`` storage, one group of
-    columns per evaluation (columns further apart than the band never share rows)."""
-    lo, up = bands
-    width = lo + up + 1
-    size = z.size
-    ab = np.zeros((width, size))
-    h = 1.5e-8 * np.maximum(np.abs(z), 1.0)
-    offsets = np.arange(-up, lo + 1)[:, None]
-    for group in range(min(width, size)):
-        cols = np.arange(group, size, width)
-        zp = z.copy()
-        zp[cols] += h[cols]
-        df = fun(zp) - f0
-        rows = cols[None, :] + offsets  # one row per diagonal of the band
-        ok = (rows >= 0) & (rows < size)
-        diagonal, column = np.nonzero(ok)
-        ab[diagonal, cols[column]] = df[rows[ok]] / h[cols[column]]
-    return ab

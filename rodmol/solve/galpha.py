@@ -29,10 +29,12 @@ whose iterations fail even with a fresh Jacobian is halved, up to
 boundary.
 """
 
+from functools import partial
+
 import numpy as np
 
 from ..errors import ParameterError
-from .newton_matrix import CONVERGED, DIVERGED, NOT_FINITE, SLOW, converged, newton_matrix
+from .newton_matrix import CONVERGED, DIVERGED, NOT_FINITE, SLOW, newton_matrix
 from .outputs import Outputs, run_steps, step_size_stats
 from .watch import STALL_STEP, Watch
 
@@ -81,8 +83,8 @@ def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_
     (energy kept), 0 the most. ``rtol``/``atol`` set the accuracy of the
     Newton solve of each step, not the step (there is no error control).
     The outputs are cubic Hermite interpolants of the step ends.
-    ``python_loop=True`` runs the Newton iterations in Python even where the
-    compiled loop could (a cross-check for the tests).
+    ``python_loop=True`` runs the Newton iterations' loop by Python even
+    where it could run compiled (a cross-check for the tests).
     """
     t0, t_end = float(t_out[0]), float(t_out[-1])
     dt = auto_dt(system) if dt == "auto" else float(dt)
@@ -125,30 +127,14 @@ def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_
         the steel cantilever's swing grow by 3% in 25 s."""
         np.multiply(np.abs(y_n), rtol, out=weight)
         weight[:] = 1.0 / (weight + atol)
-        if matrix.compiled and not python_loop:
+        compiled = matrix.compiled and not python_loop
+        if compiled:  # the kernel reads the inputs set here
             system.update_inputs(t_star)
-            outcome, k = matrix.iterate(Y, b, g, f, weight, NEWTON_TOLERANCE,
-                                        MAX_NEWTON_ITERATIONS, MAX_RATE, RATE_DECAY)
-            count["rhs_evals"] += k
-            count["newton_iters"] += k
-            return outcome, k
-        previous, rate = None, 1.0
-        for k in range(1, MAX_NEWTON_ITERATIONS + 1):
-            count["newton_iters"] += 1
-            rates(t_star, Y, f)
-            if not np.all(np.isfinite(f)):
-                return NOT_FINITE, k
-            delta = matrix.solve(b + g * f - Y)
-            Y += delta
-            size = np.sqrt(np.mean((delta * weight) ** 2))
-            if previous is not None:
-                rate = max(RATE_DECAY * rate, size / previous if previous else 0.0)
-            if converged(size, rate, NEWTON_TOLERANCE):
-                return CONVERGED, k
-            if previous is not None and size > MAX_RATE * previous:
-                return DIVERGED, k
-            previous = size
-        return SLOW, MAX_NEWTON_ITERATIONS
+        outcome, k = matrix.iterate(Y, b, g, f, weight, NEWTON_TOLERANCE, MAX_NEWTON_ITERATIONS, MAX_RATE,
+                                    RATE_DECAY, rates=None if compiled else partial(system, t_star))
+        count["rhs_evals"] += k
+        count["newton_iters"] += k
+        return outcome, k
 
     y = np.array(y0, dtype=float)
     t = t0

@@ -60,7 +60,7 @@ def _choice(options):
 
 
 def _values():
-    from .cvode import JACOBIANS, LINEAR_SOLVERS
+    from .stepping import JACOBIANS, LINEAR_SOLVERS
 
     return {
         "max_order": _auto_or(_integer_in(1, 5)),

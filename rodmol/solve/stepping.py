@@ -1,22 +1,35 @@
-"""CVODE kept alive between calls: the integrator of a stepping simulation.
+"""CVODE kept alive between calls: scikit-sundae's CVODE for a system, its
+options, and the one step loop every CVODE run takes.
 
-:class:`Stepper` builds scikit-sundae's CVODE once for a system (options from
-:func:`rodmol.solve.cvode.solver_options`, so the linear solver, the compiled
-Jacobian or block preconditioner and the tolerances are those of
-:func:`rodmol.solve.cvode.cvode`) and advances it from its current time to the
-next on request. Between calls the caller may change the system's inputs;
-:meth:`Stepper.restart` then re-initialises CVODE at the current state
-(``CVodeReInit``: the memory, the linear solver and the kernels are kept, only
-the BDF history is dropped), which :meth:`Stepper.advance` does on its own when
-asked. Each internal step is checked by :class:`rodmol.solve.watch.Watch`, as
-in a run of :func:`rodmol.simulate`.
+:func:`solver_options` turns the CVODE backend's options into scikit-sundae's
+(the linear solver, the compiled Jacobian or block preconditioner, the
+tolerances). :class:`Stepper` builds CVODE once for a system and takes its
+internal steps (:meth:`Stepper.step`, each checked by
+:class:`rodmol.solve.watch.Watch`): :func:`rodmol.solve.cvode.cvode` drives it
+through a run's output times, and the stepping simulator advances it from its
+current time to the next on request (:meth:`Stepper.advance`). Between calls
+the caller may change the system's inputs; :meth:`Stepper.restart` then
+re-initialises CVODE at the current state (``CVodeReInit``: the memory, the
+linear solver and the kernels are kept, only the BDF history is dropped),
+which :meth:`Stepper.advance` does on its own when asked.
 """
 
-import numpy as np
+import contextlib
+import warnings
 
-from .cvode import _small_pages, solver_options
+import numpy as np
+from scipy import sparse
+
+from ..discretise.preconditioner import check_structure
+from ..errors import ParameterError
 from .outputs import cause, step_size_stats
 from .watch import Watch
+
+LINEAR_SOLVERS = ("gmres", "band", "lapackband", "sparse", "dense")
+#: How the direct linear solvers get the Jacobian (see :func:`rodmol.solve.cvode.cvode`).
+JACOBIANS = ("compiled", "sundials")
+#: From this many elements on, linsolver="auto" picks the preconditioned GMRES.
+GMRES_MIN_ELEMENTS = 50
 
 
 class StepFailed(Exception):
@@ -32,7 +45,8 @@ class Stepper:
 
     ``rtol``, ``atol`` and ``options`` (the CVODE backend's options:
     ``linsolver``, ``jacobian``, ``max_order``, ``max_step``,
-    ``max_nonlin_iters``) as for :func:`rodmol.solve.cvode.cvode`.
+    ``max_nonlin_iters``) as for :func:`rodmol.solve.cvode.cvode`; they are
+    checked here, before any work.
     """
 
     def __init__(self, system, t0, y0, *, rtol, atol, **options):
@@ -43,23 +57,62 @@ class Stepper:
         self.evals = 0
         self.sizes = []  # of the internal steps taken [s]
         self.restarts, self._njev, self._njev_before = 0, 0, 0  # CVODE's Jacobian count restarts with it
-        self._solver = CVODE(self._rhs, **options)
+        #: Time [s] of the last right-hand side that raised (None: none did).
+        self.failed_at = None
+        with warnings.catch_warnings():
+            # scikit-sundae warns that its own coloured differences are not used
+            # when both `sparsity` and `jacfn` are given: that is the point.
+            warnings.filterwarnings("ignore", "Custom sparse Jacobian", UserWarning)
+            self._solver = CVODE(self._rhs, **options)
         self.t, self.y = float(t0), np.array(y0, dtype=float)
+        #: Time [s] CVODE's steps have reached (beyond ``t`` inside an advance).
+        self.reached = self.t
         self._fresh = False  # CVODE holds no history to continue from
         self.restart(self.t, self.y)
 
     def _rhs(self, t, y, yp):
         self.evals += 1
-        self.system(t, y, yp)  # an input's exception stops CVODE at once, as in cvode()
+        try:
+            self.system(t, y, yp)
+        except Exception:
+            # Only the inputs raise (a function of the user's): shorter steps would
+            # not help, so the exception stops CVODE at once (scikit-sundae hands
+            # it on); the frames of a step that reached past the failure are
+            # integrated again by outputs.keep_before_failure.
+            self.failed_at = t
+            raise
 
     def restart(self, t, y):
         """Re-initialise CVODE at state ``y`` at time ``t`` [s] (its BDF history is dropped)."""
         self.t, self.y = float(t), np.array(y, dtype=float)
+        self.reached = self.t
         self._njev_before, self._njev = self._njev_before + self._njev, 0
         with _small_pages():  # the first call allocates the solver's memory
             self._solver.init_step(self.t, self.y)
         self.restarts += 1
         self._fresh = True
+
+    def step(self, t_end, tstop, watch):
+        """One internal CVODE step towards ``t_end`` [s], ending at ``tstop`` [s]
+        at the latest, checked by ``watch``: returns (scikit-sundae's result,
+        None) or (the result, why the integration must stop)."""
+        r = self._solver.step(t_end, method="onestep", tstop=tstop)
+        self._fresh, self._njev = False, int(r.njev)
+        if not r.success:
+            return r, r.message
+        # After output times were interpolated inside the last step, CVODE's
+        # next one-step call hands that step back again: count real steps only.
+        if r.t > self.reached:
+            self.sizes.append(r.t - self.reached)
+            self.reached = r.t
+            broken = watch.state(r.t, self.sizes[-1], r.y)
+            if broken:
+                return r, broken
+        return r, None
+
+    def interpolate(self, t):
+        """The state at ``t`` [s] inside the last step, by CVODE's interpolant."""
+        return self._solver.step(t).y
 
     def advance(self, t_end, restart=False, max_wall_time=None, progress=None):
         """Integrate to ``t_end`` [s]; ``restart`` re-initialises CVODE first (the inputs
@@ -83,18 +136,10 @@ class Stepper:
         return None
 
     def _steps(self, t_end, watch):
-        solver, t_last = self._solver, self.t
         while True:
-            r = solver.step(t_end, method="onestep", tstop=t_end)
-            self._fresh, self._njev = False, int(r.njev)
-            if not r.success:
-                raise StepFailed(_why(watch, r.message))
-            if r.t > t_last:
-                self.sizes.append(r.t - t_last)
-                t_last = r.t
-                broken = watch.state(r.t, self.sizes[-1], r.y)
-                if broken:
-                    raise StepFailed(_why(watch, broken))
+            r, problem = self.step(t_end, t_end, watch)
+            if problem:
+                raise StepFailed(_why(watch, problem))
             if r.t >= t_end:
                 # unit quaternions, as simulate's frames (the dynamics do not see |Q|)
                 self.t, self.y = float(t_end), np.array(r.y)
@@ -120,3 +165,83 @@ def _why(watch, reason):
     """Why a step failed, with how far CVODE got (``watch``: its :class:`Watch`)."""
     return (f"CVODE reached t = {watch.t:.6g} s in {watch.steps} steps "
             f"(last step {watch.h_last:.3g} s): {reason}")
+
+
+def solver_options(system, rtol, atol, linsolver="auto", max_step=0.0, jacobian="auto", max_order="auto",
+                   max_nonlin_iters=3):
+    """scikit-sundae's ``CVODE`` options for ``system`` (see :func:`rodmol.solve.cvode.cvode` for the
+    arguments): returns (options, the linear solver chosen, the block preconditioner
+    or None)."""
+    from sksundae.cvode import CVODEPrecond
+
+    if linsolver == "auto":
+        # GMRES's Jacobian-vector products are differences of the full right-hand
+        # side, so they carry the global coupling of feedback tensions that any
+        # banded Jacobian leaves out (20x fewer steps on a P controller, N = 12).
+        big = system.layout.n_blocks >= GMRES_MIN_ELEMENTS
+        linsolver = "gmres" if (big or system.global_coupling) and _block_solvable(system) else "band"
+    if linsolver not in LINEAR_SOLVERS:
+        raise ParameterError(f"unknown `linsolver` {linsolver!r}; valid: {['auto', *LINEAR_SOLVERS]}")
+    if jacobian == "auto":
+        jacobian = "compiled" if linsolver in ("sparse", "gmres") else "sundials"
+    if jacobian not in JACOBIANS:
+        raise ParameterError(f"unknown `jacobian` {jacobian!r}; valid: {['auto', *JACOBIANS]}")
+    if linsolver == "gmres" and jacobian != "compiled":
+        raise ParameterError("linsolver='gmres' is preconditioned with the compiled Jacobian; "
+                             "use jacobian='auto' or 'compiled'")
+    if max_order == "auto":
+        max_order = 2 if system.lightly_damped else 5
+    options = dict(method="BDF", rtol=rtol, atol=atol, linsolver=linsolver,
+                   max_num_steps=1_000_000, max_step=max_step, max_order=int(max_order),
+                   max_nonlin_iters=int(max_nonlin_iters))
+    scale = np.broadcast_to(atol, (system.size,)) / rtol
+    precond = None
+    if linsolver == "gmres":
+        precond = system.preconditioner(scale)
+        # Left preconditioning, SUNDIALS' default Krylov dimension (5): the
+        # fastest of {left, right} x {1, 5} on the bending test.
+        options["precond"] = CVODEPrecond(precond.setup, precond.solve, "left")
+        options["krylov_dim"] = 5
+    elif linsolver in ("band", "lapackband"):
+        options["lband"], options["uband"] = system.bandwidths()
+    if jacobian == "compiled" and linsolver != "gmres":
+        matrix = "band" if linsolver in ("band", "lapackband") else linsolver
+        jac = system.jacobian(scale, matrix)
+        options["jacfn"] = jac
+        if matrix == "sparse":
+            options["sparsity"] = jac.sparsity
+    elif linsolver == "sparse":
+        options["sparsity"] = sparse.csc_matrix(system.pattern())
+
+    return options, linsolver, precond
+
+
+@contextlib.contextmanager
+def _small_pages():
+    """Allocate without numpy's transparent-huge-page advice.
+
+    With a ``jacfn``, scikit-sundae allocates a dense (n, n) template for the
+    band solver, of which only the band is ever touched; numpy advises 2 MB
+    pages for large arrays, so writing the band made the kernel clear every
+    2 MB page of it (the whole n^2 array, 460 MB at N = 400, 0.2 s per
+    solver start). With 4 kB pages only the band's own pages are cleared.
+    """
+    core = getattr(np, "_core", None) or getattr(np, "core", None)
+    setter = getattr(getattr(core, "multiarray", None), "_set_madvise_hugepage", None)
+    if setter is None:  # not a numpy that advises huge pages: nothing to undo
+        yield
+        return
+    previous = setter(False)
+    try:
+        yield
+    finally:
+        setter(previous)
+
+
+def _block_solvable(system):
+    """True if the block preconditioner solves this system's structure exactly."""
+    try:
+        check_structure(system.depends)
+    except ValueError:
+        return False
+    return True
