@@ -200,8 +200,7 @@ def test_signal_then_resume_ends_in_the_uninterrupted_state(uninterrupted, tmp_p
     stopped = rodmol.load_result(out)
     assert not stopped.success and 30 <= len(stopped.t) < 201
     assert sig == signal.SIGKILL or "interrupted" in stopped.message
-    if sig == signal.SIGKILL:  # (after SIGINT, tests/cli/test_cli.py checks the views; here they once listed
-        # other frames than result.h5 under load, not reproduced since: see the stop 22 note)
+    if sig == signal.SIGKILL:  # after Ctrl-C the views are checked by tests/cli/test_cli.py
         assert assert_valid_views(out) == pytest.approx(stopped.t)
     resumed = subprocess.run([*SIGNALLED_RUN, "--out", str(out), "--resume"], capture_output=True, text=True,
                              timeout=300)
