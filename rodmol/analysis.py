@@ -35,15 +35,15 @@ def energy(model, result):
     # so this potential balances the gravity work of the semi-discrete system.
     u = result.integrated_positions[:, 1:]
     gravity = -np.einsum("n,n,tni,i->t", lengths, model.net_mass, u, model.gravity)
-    contact = _contact_energy(model, u, lengths)
+    contact = _contact_energy(system.grid_loads, u, lengths)
     return dict(kinetic=kinetic, strain=strain, gravity=gravity, contact=contact,
                 total=kinetic + strain + gravity + contact)
 
 
-def _contact_energy(model, u, lengths):
+def _contact_energy(g, u, lengths):
     """Penalty energy [J] of every frame, at the integrated positions ``u``
-    (n_t, N, 3) of the velocity nodes (those the contact law sees)."""
-    g = model.grid_loads
+    (n_t, N, 3) of the velocity nodes (those the contact law sees); ``g``
+    the system's loads on the grid."""
     out = np.zeros(len(u))
     for e in np.flatnonzero(np.isin(g.kind, (external.PLANE, external.CAPSULE))):
         node, params = int(g.node[e]) - 1, g.params[e]

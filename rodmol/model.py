@@ -15,7 +15,6 @@ from . import _checks
 from . import loads as load_types
 from .base_motion import BaseMotion
 from .cables import Cable
-from .discretise import external
 from .errors import ParameterError
 from .markers import Marker, marker_offsets
 from .parameters import Medium
@@ -106,6 +105,8 @@ class Model:
         duplicate = next((n for n in names if names.count(n) > 1), None)
         if duplicate is not None:
             raise ParameterError(f"two cables are named {duplicate!r}: cable names must be unique")
+        for load in self.loads:
+            load.check_within(rod.length)
         self.markers = _checks.items("markers", markers, Marker, "a rodmol.Marker")
         self.marker_offsets = marker_offsets(self.markers, rod)
         self._sample()
@@ -194,7 +195,6 @@ class Model:
         # the neighbouring nodes.
         anchors = np.array([c.anchor for c in self.cables]).reshape(-1, 1)
         self.cable_weights = np.clip((anchors - s_str[None, :]) / ds, 0.0, 1.0)
-        self.grid_loads = load_types.on_grid(self.loads, self.s_nodes, rod.radius_at(self.s_nodes))
         for name in SAMPLED:
             getattr(self, name).flags.writeable = False
 
@@ -213,20 +213,6 @@ class Model:
     def tensions(self, t, state=None):
         """Cable tensions [N] at time t, shape (n_cables,)."""
         return np.array([c.tension_at(t, state) for c in self.cables])
-
-    def load_scale(self, t=0.0, tensions=None):
-        """A force scale [N] of the applied loads at time t: net weight, cable
-        tensions (``tensions`` [N] if given, else the inputs at t), external
-        forces and external moments divided by L."""
-        net_density = abs(self.rod.material.rho - self.medium.rho)
-        scale = net_density * np.linalg.norm(self.gravity) * self.rod.volume()
-        if self.cables:
-            scale += float(np.sum(self.tensions(t) if tensions is None else tensions))
-        g = self.grid_loads
-        size = np.linalg.norm(g.fill(t, g.initial.copy()), axis=1) * g.weight * self.ds
-        forces = np.isin(g.kind, (external.FOLLOWER_FORCE, external.DEAD_FORCE))
-        moments = np.isin(g.kind, (external.FOLLOWER_MOMENT, external.DEAD_MOMENT))
-        return scale + float(np.sum(size[forces]) + np.sum(size[moments]) / self.rod.length)
 
 
 def _rebuild(cls, rod, n_elements, options):

@@ -15,7 +15,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from . import centreline, external, rotations, stencil
+from . import centreline, external, load_entries, rotations, stencil
 from .layout import StateLayout, merge
 from .physics import compile_signatures
 from .routing import CableRouting
@@ -191,7 +191,7 @@ class SemiDiscrete:
         self._setup_cables(s_cells)
         self._setup_loads()
         self.depends = merge(self.scheme.depends, external.dependency_table(set(self._kinds)))
-        self._inputs_vary = bool(self.global_coupling or self._timed or self._grid_loads.values
+        self._inputs_vary = bool(self.global_coupling or self._timed or self.grid_loads.values
                                  or not self._fixed_base)
         # The kernel's arguments: arrays whose contents update_inputs refreshes in place.
         self._args = (self._params, self._consts, self._offsets, self._weights, self.tension_values,
@@ -230,7 +230,7 @@ class SemiDiscrete:
         self.read_held(0.0)
 
     def _setup_loads(self):
-        entries = self.model.grid_loads
+        entries = load_entries.of_model(self.model)
         self._kinds = np.ascontiguousarray(entries.kind, dtype=np.int64)
         self._nodes = np.ascontiguousarray(entries.node - 1, dtype=np.int64)  # element blocks
         # A point load's share of a node is spread over the node's own length.
@@ -238,7 +238,7 @@ class SemiDiscrete:
         self._entry_weights = np.ascontiguousarray(entries.weight * stretch, dtype=float)
         self._entry_params = np.ascontiguousarray(entries.params, dtype=float).reshape(-1, external.N_PARAMS)
         self.entry_values = np.ascontiguousarray(entries.initial, dtype=float).reshape(-1, 3)
-        self._grid_loads = entries
+        self.grid_loads = entries
 
     @property
     def inputs_vary(self):
@@ -265,7 +265,7 @@ class SemiDiscrete:
                 self.tension_values[j] = cable.tension_at(t)
         if self._friction:
             self._weights[:] = self._path_weights * self.friction_factors(y)[self._active]
-        self._grid_loads.fill(t, self.entry_values)
+        self.grid_loads.fill(t, self.entry_values)
 
     def read_held(self, t):
         """Read the held tensions (time inputs with ``held = True``: a stepping simulator's

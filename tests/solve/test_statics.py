@@ -18,6 +18,7 @@ import pytest
 from scipy.integrate import solve_bvp
 
 import rodmol
+from rodmol.discretise.load_entries import load_scale
 
 # Table I of the paper (the same numbers rodmol.arm.paper_rod() uses; restated
 # here so that the reference does not read them from rodmol).
@@ -175,7 +176,7 @@ def test_equilibrium_is_rest_state(medium):
     assert np.all(lay.field(y, "v") == 0.0) and np.all(lay.field(y, "w") == 0.0)
 
     rate = rodmol.SemiDiscrete(model)(0.0, y)
-    weight = model.load_scale()  # net weight [N] (no cables here)
+    weight = load_scale(model)  # net weight [N] (no cables here)
     # Kinematic rates: zero velocities give zero pose and strain rates (the
     # quaternion rate only sees round-off of |Q| - 1).
     for name in ("u", "Q", "q", "k"):
