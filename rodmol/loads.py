@@ -349,3 +349,20 @@ def SphereContact(centre, radius, stiffness, damping=0.0, friction=0.0, slip_spe
 #: The load types a Model accepts.
 LOAD_TYPES = (PointForce, PointMoment, DistributedForce, DistributedMoment, PlaneContact,
               CapsuleContact)
+
+
+_CONTACT_UNITS = {"stiffness": "N/m^2", "damping": "N s/m^2", "friction": "-", "slip_speed": "m/s",
+                  "smoothing_depth": "m"}
+
+#: The ``[[load]]`` types of a scenario file: type -> (constructor, units of
+#: its keys). The keys are the constructor's arguments, those without a
+#: default required (:mod:`rodmol.scenario.schema` derives them from here).
+SCENARIO_TYPES = {
+    "point_force": (PointForce, {"s": "m", "force": "N"}),
+    "point_moment": (PointMoment, {"s": "m", "moment": "N m"}),
+    "distributed_force": (DistributedForce, {"force": "N/m"}),
+    "distributed_moment": (DistributedMoment, {"moment": "N m/m"}),
+    "plane_contact": (PlaneContact, {"point": "m", "normal": "-", **_CONTACT_UNITS}),
+    "sphere_contact": (SphereContact, {"centre": "m", "radius": "m", **_CONTACT_UNITS}),
+    "capsule_contact": (CapsuleContact, {"start": "m", "end": "m", "radius": "m", **_CONTACT_UNITS}),
+}
