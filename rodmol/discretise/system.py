@@ -19,6 +19,7 @@ from . import centreline, external, load_entries, rotations, stencil
 from .layout import StateLayout, merge
 from .physics import compile_signatures
 from .routing import CableRouting
+from .sampling import Sampled, cell_properties
 from .schemes import DEFAULT_SCHEME, get_scheme
 
 #: Rate [1/s] at which the quaternion norm is pulled back to 1; the exact
@@ -175,11 +176,12 @@ class SemiDiscrete:
         self.global_coupling = model.feedback or self._friction
         m = model
         s_cells = self.scheme.cell_points(m.s_nodes)
-        self.cells = m.cell_properties(s_cells)
+        self.sampled = sampled = Sampled(m)
+        self.cells = cell_properties(m, s_cells)
         self.node_lengths = self.scheme.node_lengths(m.n_elements, m.ds)
         self.lightly_damped = grid_damping_ratio(m) < 1.0
-        self._params = stencil.pack_params(*self.cells, m.mass, m.inertia, m.net_mass,
-                                           m.drag_coefficient, m.added)
+        self._params = stencil.pack_params(*self.cells, sampled.mass, sampled.inertia, sampled.net_mass,
+                                           sampled.drag_coefficient, sampled.added)
         self._consts = np.zeros(stencil.N_CONSTS)
         self._consts[:7] = (m.ds, QUATERNION_RESTORING_RATE, DRAG_SMOOTHING_SPEED**2,
                             1.0 if m.munk_moment else 0.0, *m.gravity)

@@ -184,6 +184,7 @@ class RestEquations:
         # Views and slices made once: the residual runs thousands of times per solve.
         self._sl, self._state_sl = self.static.slices(), self.layout.slices()
         self._y_blocks, self._rate_blocks = self.layout.blocks(self._y), self.layout.blocks(self._rates)
+        self._mass, self._inertia = system.sampled.mass, system.sampled.inertia
         self.scale = load_scale(model, t, tensions, system.grid_loads)
         self.unloaded = self.scale == 0.0 and not model.loads
         self._force_scale = (self.scale or 1.0) / model.rod.length  # contact alone: forces of about 1 N
@@ -192,7 +193,7 @@ class RestEquations:
         """``tol`` raised to the round-off floor of the difference quotients:
         differencing stresses of size EA * strain over ds loses digits as N grows."""
         model = self.system.model
-        return max(tol, 10 * np.finfo(float).eps * np.max(model.kl) / (model.ds * self._force_scale))
+        return max(tol, 10 * np.finfo(float).eps * np.max(self.system.sampled.kl) / (model.ds * self._force_scale))
 
     def unknowns(self, y):
         """The static unknowns z of a state vector ``y``."""
@@ -213,8 +214,8 @@ class RestEquations:
         out = np.empty_like(zb)
         out[:, sl["u"]] = (u - u_prev - centreline.chords(q_prev, q, k, ds)) / ds
         out[:, sl["Q"]] = quat - rotations.multiply(q_prev, rotations.from_rotation_vector(ds * k))
-        out[:, sl["q"]] = self._rate_blocks[:, state_sl["v"]] * model.mass / self._force_scale
-        out[:, sl["k"]] = self._rate_blocks[:, state_sl["w"]] * model.inertia / (self.scale or 1.0)
+        out[:, sl["q"]] = self._rate_blocks[:, state_sl["v"]] * self._mass / self._force_scale
+        out[:, sl["k"]] = self._rate_blocks[:, state_sl["w"]] * self._inertia / (self.scale or 1.0)
         return out.ravel()
 
     def state(self, z):

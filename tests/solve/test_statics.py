@@ -19,6 +19,7 @@ from scipy.integrate import solve_bvp
 
 import rodmol
 from rodmol.discretise.load_entries import load_scale
+from rodmol.discretise.sampling import Sampled
 
 # Table I of the paper (the same numbers rodmol.arm.paper_rod() uses; restated
 # here so that the reference does not read them from rodmol).
@@ -183,8 +184,8 @@ def test_equilibrium_is_rest_state(medium):
         assert np.max(np.abs(lay.field(rate, name))) < 1e-12, name
     assert np.max(np.abs(rate[:7])) < 1e-12
     # Accelerations back to force and torque densities per unit length.
-    force = lay.field(rate, "v") * model.mass
-    torque = lay.field(rate, "w") * model.inertia
+    force = lay.field(rate, "v") * Sampled(model).mass
+    torque = lay.field(rate, "w") * Sampled(model).inertia
     print(f"\n{medium}: max |force| / (W/L) = {np.max(np.abs(force)) * L / weight:.2e}, "
           f"max |torque| / W = {np.max(np.abs(torque)) / weight:.2e}")
     assert np.max(np.abs(force)) < 1e-8 * weight / L
