@@ -7,7 +7,6 @@ linearly (a share that falls on the clamped base goes into the clamp);
 distributed and contact loads act at every node but the base.
 """
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -67,7 +66,10 @@ def _entries(load, s_nodes, radius):
     params = np.zeros((len(nodes), N_PARAMS))
     row = load.params(radius[nodes])
     params[:, :row.shape[1]] = row
-    at: Callable = lambda t: load.values(s, t)  # noqa: E731
+
+    def at(t):
+        return load.values(s, t)
+
     return nodes, weights, params, at
 
 
@@ -117,9 +119,7 @@ def load_scale(model, t=0.0, tensions=None, grid=None):
         scale += float(np.sum(model.tensions(t) if tensions is None else tensions))
     g = of_model(model) if grid is None else grid
     size = np.linalg.norm(g.fill(t, g.initial.copy()), axis=1) * g.weight * model.ds
-    quantity = np.array([KERNELS_BY_CODE[int(k)].quantity for k in g.kind], dtype=object)
+    by_code = {k.code: k.quantity for k in KERNELS.values()}
+    quantity = np.array([by_code[int(k)] for k in g.kind], dtype=object)
     return scale + float(np.sum(size[quantity == "force"]) + np.sum(size[quantity == "moment"])
                          / model.rod.length)
-
-
-KERNELS_BY_CODE = {k.code: k for k in KERNELS.values()}
