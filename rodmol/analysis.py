@@ -25,8 +25,8 @@ def energy(model, result):
     system = SemiDiscrete(model, result.meta.get("scheme", "upwind"))
     lengths, (kl, kth) = system.node_lengths, system.cells[:2]
     v, w = result.velocity[:, 1:], result.angular_velocity[:, 1:]
-    kinetic = 0.5 * (np.einsum("tni,n,ni,tni->t", v, lengths, model.mass, v)
-                     + np.einsum("tni,n,ni,tni->t", w, lengths, model.inertia, w))
+    kinetic = 0.5 * (np.einsum("tni,n,ni,tni->t", v, lengths, system.sampled.mass, v)
+                     + np.einsum("tni,n,ni,tni->t", w, lengths, system.sampled.inertia, w))
     dq = result.linear_strain[:, :-1] - Q_STAR
     k = result.curvature[:, :-1]
     strain = 0.5 * model.ds * (np.einsum("tni,ni,tni->t", dq, kl, dq)
@@ -34,16 +34,16 @@ def energy(model, result):
     # The time-integrated positions, not the rebuilt ones: their rate is exactly R v,
     # so this potential balances the gravity work of the semi-discrete system.
     u = result.integrated_positions[:, 1:]
-    gravity = -np.einsum("n,n,tni,i->t", lengths, model.net_mass, u, model.gravity)
-    contact = _contact_energy(model, u, lengths)
+    gravity = -np.einsum("n,n,tni,i->t", lengths, system.sampled.net_mass, u, model.gravity)
+    contact = _contact_energy(system.grid_loads, u, lengths)
     return dict(kinetic=kinetic, strain=strain, gravity=gravity, contact=contact,
                 total=kinetic + strain + gravity + contact)
 
 
-def _contact_energy(model, u, lengths):
+def _contact_energy(g, u, lengths):
     """Penalty energy [J] of every frame, at the integrated positions ``u``
-    (n_t, N, 3) of the velocity nodes (those the contact law sees)."""
-    g = model.grid_loads
+    (n_t, N, 3) of the velocity nodes (those the contact law sees); ``g``
+    the system's loads on the grid."""
     out = np.zeros(len(u))
     for e in np.flatnonzero(np.isin(g.kind, (external.PLANE, external.CAPSULE))):
         node, params = int(g.node[e]) - 1, g.params[e]

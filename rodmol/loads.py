@@ -20,16 +20,14 @@ around s, linearly (a share that falls on the clamped base goes into the
 clamp); distributed and contact loads act at every node but the base.
 """
 
-from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from . import _checks
-from .discretise import external
 from .errors import ParameterError, RodmolError
-from .inputs import TimeInput, as_time_input
+from .inputs import as_time_input
 
 FRAMES = ("global", "local")
 #: Default contact smoothing depth, as a fraction of the section radius.
@@ -37,32 +35,36 @@ SMOOTHING_FRACTION = 0.01
 
 
 @dataclass(frozen=True)
-class GridLoad:
-    """A load mapped onto the velocity nodes 1..N of a grid (see
-    :mod:`rodmol.discretise.external` for the kinds and parameter rows).
+class Kernel:
+    """One branch of the compiled load kernel (:func:`rodmol.discretise.external.load`).
 
-    ``weight`` is the entry's share of the node's load density [1/m for a
-    point load, 1 for densities], taking every node as standing for a length
-    ds; ``concentrated`` marks point loads, whose density a scheme scales to
-    its own node lengths. ``values(t)`` returns the (n_entries, 3) vectors at
-    time t, or is None when they are constant (``initial`` is then used
-    throughout).
+    ``code`` is its number in the kernel; ``depends`` the state fields of its
+    own element block it reads (the Jacobian's pattern, colouring and
+    preconditioner are derived from them); ``quantity`` is ``"force"``,
+    ``"moment"`` (what the load scale adds up) or ``"contact"``.
     """
 
-    kind: np.ndarray
-    node: np.ndarray
-    weight: np.ndarray
-    params: np.ndarray
-    initial: np.ndarray
-    concentrated: np.ndarray
-    values: Callable | None = None
+    code: int
+    depends: tuple
+    quantity: str
 
-    def fill(self, t, out):
-        """Write the entries' values at time t into ``out`` (n_entries, 3),
-        for a combined load whose ``values`` lists (entry slice, values(t))."""
-        for rows, at in self.values:
-            out[rows] = at(t)
-        return out
+
+#: The kernel's branches, by name; a load names its branch in ``kernel``.
+KERNELS = {
+    "follower_force": Kernel(0, (), "force"),
+    "dead_force": Kernel(1, ("Q",), "force"),
+    "follower_moment": Kernel(2, (), "moment"),
+    "dead_moment": Kernel(3, ("Q",), "moment"),
+    "plane": Kernel(4, ("u", "Q", "v", "w"), "contact"),
+    "capsule": Kernel(5, ("u", "Q", "v", "w"), "contact"),
+}
+
+# The parameter row a load hands its kernel at each node (``params``): the
+# contact kinds' geometry (plane: point, normal; capsule: start, end,
+# radius), then the law, the section radius at the node and the depth over
+# which the penalty is smoothed. Vector loads have none.
+N_PARAMS = 13
+P_STIFFNESS, P_DAMPING, P_FRICTION, P_SLIP, P_RADIUS, P_SMOOTHING = 7, 8, 9, 10, 11, 12
 
 
 def _frame(frame, name):
@@ -72,23 +74,30 @@ def _frame(frame, name):
     return frame
 
 
-def _node_shares(s, s_nodes):
-    """Velocity nodes (1..N) and weights [1/m] sharing a point load at s."""
-    n = len(s_nodes) - 1
-    ds = s_nodes[1] - s_nodes[0]
-    x = min(s / ds, float(n))
-    j = min(int(np.floor(x)), n - 1)
-    f = x - j
-    nodes, weights = [], []
-    for node, share in ((j, 1.0 - f), (j + 1, f)):
-        if node >= 1 and share > 0.0:  # node 0 is the clamped base
-            nodes.append(node)
-            weights.append(share / ds)
-    return np.array(nodes, dtype=int), np.array(weights)
+class _Load:
+    """What every load tells the grid (:mod:`rodmol.discretise.load_entries`):
+    ``kernel``, the name of its branch in :data:`KERNELS`; ``spread``,
+    ``"point"`` (shared between the two nodes around ``s``) or ``"nodes"``
+    (a density at every node but the base); ``values(s, t)``, its (len(s), 3)
+    vectors at arc lengths s [m] and time t, in the frame its kernel reads;
+    ``constant``, True if they do not change with time; ``params(radius)``,
+    the kernel's parameter rows at nodes of section radius ``radius`` [m]."""
+
+    spread = "nodes"
+    constant = True
+
+    def check_within(self, length):
+        """Refuse a load that does not fit a rod of ``length`` [m]."""
+
+    def values(self, s, t):
+        return np.zeros((len(s), 3))
+
+    def params(self, radius):
+        return np.zeros((len(radius), 0))
 
 
-class _PointLoad:
-    _what, _unit, _kinds = "", "", {}
+class _PointLoad(_Load):
+    _what, _unit, _kernels = "", "", {}
 
     def _setup(self, name, value):
         object.__setattr__(self, "s", _checks.non_negative(f"{name} `s`", self.s, " m"))
@@ -96,18 +105,24 @@ class _PointLoad:
         object.__setattr__(self, self._what, as_time_input(f"{self._what}` of `{name}", value, 3,
                                                            self._unit))
 
-    def on_grid(self, s_nodes, radius):
-        length = float(s_nodes[-1])
+    spread = "point"
+
+    @property
+    def kernel(self):
+        return self._kernels[self.frame]
+
+    @property
+    def constant(self):
+        return getattr(self, self._what).constant
+
+    def check_within(self, length):
+        """Refuse an arc length beyond the rod's ``length`` [m]."""
         if self.s > length * (1 + 1e-12):
             raise ParameterError(f"{self.name}: `s` must lie in [0, L = {length!r} m], got {self.s!r}")
-        nodes, weights = _node_shares(self.s, s_nodes)
-        signal: TimeInput = getattr(self, self._what)
-        count = len(nodes)
-        kind = np.full(count, self._kinds[self.frame])
-        initial = np.tile(signal.value(0.0), (count, 1))
-        values = None if signal.constant else (lambda t: np.tile(signal.value(t), (count, 1)))
-        return GridLoad(kind, nodes, weights, np.zeros((count, external.N_PARAMS)), initial,
-                        np.ones(count, dtype=bool), values)
+
+    def values(self, s, t):
+        """The load's vector at time t, repeated for each arc length of ``s``."""
+        return np.tile(getattr(self, self._what).value(t), (len(s), 1))
 
 
 @dataclass(frozen=True)
@@ -123,7 +138,7 @@ class PointForce(_PointLoad):
     frame: str = "global"
     name: str = "point force"
     _what, _unit = "force", "N"
-    _kinds = {"local": external.FOLLOWER_FORCE, "global": external.DEAD_FORCE}
+    _kernels = {"local": "follower_force", "global": "dead_force"}
 
     def __post_init__(self):
         self._setup(self.name, self.force)
@@ -138,14 +153,14 @@ class PointMoment(_PointLoad):
     frame: str = "global"
     name: str = "point moment"
     _what, _unit = "moment", "N m"
-    _kinds = {"local": external.FOLLOWER_MOMENT, "global": external.DEAD_MOMENT}
+    _kernels = {"local": "follower_moment", "global": "dead_moment"}
 
     def __post_init__(self):
         self._setup(self.name, self.moment)
 
 
-class _DistributedLoad:
-    _what, _kinds = "", {}
+class _DistributedLoad(_Load):
+    _what, _kernels = "", {}
 
     def _setup(self):
         object.__setattr__(self, "frame", _frame(self.frame, self.name))
@@ -172,14 +187,17 @@ class _DistributedLoad:
             raise _checks.bad_return(what, raw, t, "its values must be finite")
         return arr
 
-    def on_grid(self, s_nodes, radius):
-        s = s_nodes[1:]
-        count = len(s)
-        kind = np.full(count, self._kinds[self.frame])
-        values = (lambda t: self._sample(s, t)) if callable(getattr(self, self._what)) else None
-        return GridLoad(kind, np.arange(1, count + 1), np.ones(count),
-                        np.zeros((count, external.N_PARAMS)), self._sample(s, 0.0),
-                        np.zeros(count, dtype=bool), values)
+    @property
+    def kernel(self):
+        return self._kernels[self.frame]
+
+    @property
+    def constant(self):
+        return not callable(getattr(self, self._what))
+
+    def values(self, s, t):
+        """The load's density at arc lengths ``s`` [m] and time t, (len(s), 3)."""
+        return self._sample(s, t)
 
 
 @dataclass(frozen=True)
@@ -193,7 +211,7 @@ class DistributedForce(_DistributedLoad):
     frame: str = "global"
     name: str = "distributed force"
     _what = "force"
-    _kinds = {"local": external.FOLLOWER_FORCE, "global": external.DEAD_FORCE}
+    _kernels = {"local": "follower_force", "global": "dead_force"}
 
     def __post_init__(self):
         self._setup()
@@ -207,13 +225,13 @@ class DistributedMoment(_DistributedLoad):
     frame: str = "global"
     name: str = "distributed moment"
     _what = "moment"
-    _kinds = {"local": external.FOLLOWER_MOMENT, "global": external.DEAD_MOMENT}
+    _kernels = {"local": "follower_moment", "global": "dead_moment"}
 
     def __post_init__(self):
         self._setup()
 
 
-class _Contact:
+class _Contact(_Load):
     """Penalty contact of the tube's surface with a fixed obstacle.
 
     Where the surface penetrates the obstacle by a depth d > 0, the rod gets a
@@ -244,16 +262,15 @@ class _Contact:
     def _law(self):
         return [self.stiffness, self.damping, self.friction, self.slip_speed]
 
-    def on_grid(self, s_nodes, radius):
-        count = len(s_nodes) - 1
-        params = np.zeros((count, external.N_PARAMS))
+    def params(self, radius):
+        """The kernel's parameter rows at nodes of section radius ``radius`` [m]."""
+        rows = np.zeros((len(radius), N_PARAMS))
         row = np.array(self._geometry() + self._law())
-        params[:, :len(row)] = row
-        params[:, external.P_RADIUS] = radius[1:]
-        params[:, external.P_SMOOTHING] = (SMOOTHING_FRACTION * radius[1:] if self.smoothing_depth is None
-                                           else self.smoothing_depth)
-        return GridLoad(np.full(count, self._kind), np.arange(1, count + 1), np.ones(count), params,
-                        np.zeros((count, 3)), np.zeros(count, dtype=bool))
+        rows[:, :len(row)] = row
+        rows[:, P_RADIUS] = radius
+        rows[:, P_SMOOTHING] = (SMOOTHING_FRACTION * radius if self.smoothing_depth is None
+                                else self.smoothing_depth)
+        return rows
 
 
 @dataclass(frozen=True)
@@ -281,7 +298,7 @@ class PlaneContact(_Contact):
     slip_speed: float = 1e-4
     smoothing_depth: float | None = None
     name: str = "plane contact"
-    _kind = external.PLANE
+    kernel = "plane"
 
     def __post_init__(self):
         object.__setattr__(self, "point", _checks.vector3(f"{self.name} point", self.point))
@@ -309,7 +326,7 @@ class CapsuleContact(_Contact):
     slip_speed: float = 1e-4
     smoothing_depth: float | None = None
     name: str = "capsule contact"
-    _kind = external.CAPSULE
+    kernel = "capsule"
 
     def __post_init__(self):
         object.__setattr__(self, "start", _checks.vector3(f"{self.name} start", self.start))
@@ -334,20 +351,18 @@ LOAD_TYPES = (PointForce, PointMoment, DistributedForce, DistributedMoment, Plan
               CapsuleContact)
 
 
-def on_grid(loads, s_nodes, radius):
-    """All ``loads`` as one :class:`GridLoad` whose ``values`` is a list of
-    (entry slice, values(t)) for the time-dependent ones."""
-    parts = [load.on_grid(s_nodes, radius) for load in loads]
-    timed, start = [], 0
-    for part in parts:
-        if part.values is not None:
-            timed.append((slice(start, start + len(part.kind)), part.values))
-        start += len(part.kind)
+_CONTACT_UNITS = {"stiffness": "N/m^2", "damping": "N s/m^2", "friction": "-", "slip_speed": "m/s",
+                  "smoothing_depth": "m"}
 
-    def cat(name, shape):
-        arrays = [getattr(p, name) for p in parts]
-        return np.concatenate(arrays) if arrays else np.zeros(shape)
-
-    return GridLoad(cat("kind", 0).astype(np.int64), cat("node", 0).astype(np.int64),
-                    cat("weight", 0), cat("params", (0, external.N_PARAMS)), cat("initial", (0, 3)),
-                    cat("concentrated", 0).astype(bool), timed)
+#: The ``[[load]]`` types of a scenario file: type -> (constructor, units of
+#: its keys). The keys are the constructor's arguments, those without a
+#: default required (:mod:`rodmol.scenario.schema` derives them from here).
+SCENARIO_TYPES = {
+    "point_force": (PointForce, {"s": "m", "force": "N"}),
+    "point_moment": (PointMoment, {"s": "m", "moment": "N m"}),
+    "distributed_force": (DistributedForce, {"force": "N/m"}),
+    "distributed_moment": (DistributedMoment, {"moment": "N m/m"}),
+    "plane_contact": (PlaneContact, {"point": "m", "normal": "-", **_CONTACT_UNITS}),
+    "sphere_contact": (SphereContact, {"centre": "m", "radius": "m", **_CONTACT_UNITS}),
+    "capsule_contact": (CapsuleContact, {"start": "m", "end": "m", "radius": "m", **_CONTACT_UNITS}),
+}

@@ -1,5 +1,6 @@
-"""The model: a rod, its grid, the medium, the cables and the base, with every
-sectional quantity sampled once on the staggered grid.
+"""The model: a rod, its grid, the medium, the cables, the loads and the
+base; the system samples its sectional quantities on the staggered grid
+(:mod:`rodmol.discretise.sampling`).
 
 Grid (section IV-C of the paper): N elements, ds = L/N, nodes s_i = i ds.
 Strains q, k and the stresses live on the *strain nodes* i = 0..N-1; pose u, R
@@ -15,7 +16,6 @@ from . import _checks
 from . import loads as load_types
 from .base_motion import BaseMotion
 from .cables import Cable
-from .discretise import external
 from .errors import ParameterError
 from .markers import Marker, marker_offsets
 from .parameters import Medium
@@ -27,11 +27,6 @@ Q_STAR.flags.writeable = False
 #: Most elements a Model accepts (memory, not accuracy, is the limit: a run at
 #: N = 1e4 already takes minutes per simulated second).
 MAX_ELEMENTS = 100_000
-#: The sampled arrays of a Model (read-only once built).
-SAMPLED = ("s_nodes", "kl", "kth", "vl", "vth", "added", "mass", "inertia", "net_mass",
-           "drag_coefficient", "cable_weights")
-
-
 class Model:
     """A semi-discretised Cosserat rod with its loads.
 
@@ -69,14 +64,9 @@ class Model:
         C [kg/m^2] of the componentwise law, local frame (axial, y, z); force
         per unit length.
 
-    The sampled sectional arrays (``kl``, ``kth``, ``vl``, ``vth``, ``mass``,
-    ``inertia``, ``net_mass``, ``drag_coefficient``, ``added``,
-    ``cable_weights``, ``s_nodes``) are read-only: the
-    compiled system copies them once, so they must not change afterwards.
-    Build a new Model to change a parameter. ``kl`` ... ``vth`` are sampled at
-    the strain nodes s_0..s_N-1, as the paper's upwind scheme reads them; a
-    scheme may sample the cells elsewhere (:meth:`cell_properties`,
-    ``SemiDiscrete.cells``: the centred scheme at the cells' midpoints).
+    ``s_nodes`` (N + 1,) [m] are the grid's nodes (read-only); the sectional
+    quantities are sampled on them once, by the system
+    (``SemiDiscrete.sampled``, :mod:`rodmol.discretise.sampling`).
     """
 
     def __init__(self, rod, n_elements, *, gravity=(0.0, -9.81, 0.0), medium=None,
@@ -106,9 +96,11 @@ class Model:
         duplicate = next((n for n in names if names.count(n) > 1), None)
         if duplicate is not None:
             raise ParameterError(f"two cables are named {duplicate!r}: cable names must be unique")
+        for load in self.loads:
+            load.check_within(rod.length)
         self.markers = _checks.items("markers", markers, Marker, "a rodmol.Marker")
         self.marker_offsets = marker_offsets(self.markers, rod)
-        self._sample()
+        self._grid()
 
     def options(self):
         """The keyword arguments this model was built with (after checking)."""
@@ -125,8 +117,7 @@ class Model:
                           **{**self.options(), **changes})
 
     def __reduce__(self):
-        # Rebuilt from its arguments on unpickling: the sampled arrays follow
-        # from them, and the grid loads' time functions are closures.
+        # Rebuilt from its arguments on unpickling: the grid follows from them.
         _check_no_inline_functions(self)
         return (_rebuild, (type(self), self.rod, self.n_elements, self.options()))
 
@@ -167,66 +158,15 @@ class Model:
                     f"lies outside the body at s = {s[i]:.6g} m where the radius is "
                     f"{r[i]:.6g} m (a cable on spacer disks: Cable(..., outside_body=True))")
 
-    def _sample(self):
-        """Sample every sectional quantity on the grid (done once)."""
-        n, ds, rod, med = self.n_elements, self.ds, self.rod, self.medium
-        rho = rod.material.rho
-        self.s_nodes = np.linspace(0.0, rod.length, n + 1)
-        s_str, s_vel = self.s_nodes[:-1], self.s_nodes[1:]
-
-        self.kl, self.kth, self.vl, self.vth = self.cell_properties(s_str)
-
-        a, r = rod.area(s_vel), rod.radius_at(s_vel)
-        coeff = np.array([0.0, med.By, med.Bz]) if self.added_mass else np.zeros(3)
-        self.added = med.rho * a[:, None] * coeff
-        self.mass = rho * a[:, None] + self.added
-        self.inertia = rho * rod.second_moments(s_vel)
-        self.net_mass = (rho - med.rho) * a
-        if not self.drag:
-            self.drag_coefficient = np.zeros((n, 3))
-        elif self.drag_law == "componentwise":
-            self.drag_coefficient = np.tile(self.drag_coefficients, (n, 1))
-        else:
-            self.drag_coefficient = med.rho * r[:, None] * np.array([0.5 * np.pi * med.Cx, med.Cy, med.Cz])
-
-        # Fraction of each strain node's cell on the cable path: moving the
-        # anchor inside a cell shifts its concentrated load smoothly between
-        # the neighbouring nodes.
-        anchors = np.array([c.anchor for c in self.cables]).reshape(-1, 1)
-        self.cable_weights = np.clip((anchors - s_str[None, :]) / ds, 0.0, 1.0)
-        self.grid_loads = load_types.on_grid(self.loads, self.s_nodes, rod.radius_at(self.s_nodes))
-        for name in SAMPLED:
-            getattr(self, name).flags.writeable = False
-
-    def cell_properties(self, s):
-        """Sectional stiffness and viscosity diagonals at arc lengths ``s`` [m]:
-        (Kl, Kth, Vl, Vth), each (len(s), 3) [N, N m^2, N s, N m^2 s], with
-        ``viscosity=False`` honoured. The model's own ``kl`` ... ``vth`` are
-        these at the strain nodes; a scheme may sample them elsewhere."""
-        s = np.asarray(s, dtype=float)
-        kl, kth = self.rod.stiffness(s)
-        vl, vth = self.rod.viscosity(s)
-        if not self.viscosity:
-            vl, vth = np.zeros_like(vl), np.zeros_like(vth)
-        return kl, kth, vl, vth
+    def _grid(self):
+        """The grid's nodes s_0..s_N [m] (the sectional quantities are sampled
+        on them by the system, :mod:`rodmol.discretise.sampling`)."""
+        self.s_nodes = np.linspace(0.0, self.rod.length, self.n_elements + 1)
+        self.s_nodes.flags.writeable = False
 
     def tensions(self, t, state=None):
         """Cable tensions [N] at time t, shape (n_cables,)."""
         return np.array([c.tension_at(t, state) for c in self.cables])
-
-    def load_scale(self, t=0.0, tensions=None):
-        """A force scale [N] of the applied loads at time t: net weight, cable
-        tensions (``tensions`` [N] if given, else the inputs at t), external
-        forces and external moments divided by L."""
-        net_density = abs(self.rod.material.rho - self.medium.rho)
-        scale = net_density * np.linalg.norm(self.gravity) * self.rod.volume()
-        if self.cables:
-            scale += float(np.sum(self.tensions(t) if tensions is None else tensions))
-        g = self.grid_loads
-        size = np.linalg.norm(g.fill(t, g.initial.copy()), axis=1) * g.weight * self.ds
-        forces = np.isin(g.kind, (external.FOLLOWER_FORCE, external.DEAD_FORCE))
-        moments = np.isin(g.kind, (external.FOLLOWER_MOMENT, external.DEAD_MOMENT))
-        return scale + float(np.sum(size[forces]) + np.sum(size[moments]) / self.rod.length)
 
 
 def _rebuild(cls, rod, n_elements, options):

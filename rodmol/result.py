@@ -209,7 +209,7 @@ def _loads(system, result):
     tip_length = system.node_lengths[-1]
     n_tip, m_tip = loads[:, -1, :3] * tip_length, loads[:, -1, 3:] * tip_length
     for c in range(len(model.cables)):
-        if model.cable_weights[c, -1] != 1.0:
+        if system.routing.weights[c, -1] != 1.0:
             continue
         p, dp = tuple(system.routing.geometry[c, -1, :3]), tuple(system.routing.geometry[c, -1, 3:])
         for i in range(n_t):

@@ -39,6 +39,7 @@ import os
 import numpy as np
 from scipy.integrate import solve_bvp
 
+from rodmol.discretise.load_entries import load_scale
 from rodmol.errors import ParameterError
 
 SCRIPT = "continuum.py"
@@ -148,7 +149,7 @@ class _Problem:
         self.segments = len(self.joints) - 1
         net = (rod.material.rho - model.medium.rho)
         self.weight = lambda s: net * rod.area(s)[:, None] * model.gravity  # global [N/m]
-        self.force = max(model.load_scale(t), 1e-300)
+        self.force = max(load_scale(model, t), 1e-300)
         self.u0 = np.asarray(model.base.position, dtype=float)
         self.quat0 = matrix_quaternion(model.base.rotation)
 

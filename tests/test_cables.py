@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 import rodmol
+from rodmol.discretise.sampling import Sampled
 
 #: The paper's silicone (Table I).
 SILICONE = rodmol.Material(E=110e3, nu=0.5, mu=300.0, rho=1080.0)
@@ -242,8 +243,8 @@ def test_base_reaction_equals_net_weight_in_water():
     for n_el in (40, 80):
         model = rodmol.Model(rod, n_el, medium="water")
         pos, q, k = static_fields(model, rodmol.equilibrium(model))
-        base_force[n_el] = model.kl[0] * (q[0] - [1, 0, 0])  # base frame = global (R0 = I)
-        base_moment[n_el] = model.kth[0] * k[0]
+        base_force[n_el] = Sampled(model).kl[0] * (q[0] - [1, 0, 0])  # base frame = global (R0 = I)
+        base_moment[n_el] = Sampled(model).kth[0] * k[0]
         # Moment of the net weight about the base, trapezoid rule on the nodes.
         density = (SILICONE.rho - RHO_WATER) * math.pi * rod.radius_at(model.s_nodes) ** 2
         arm[n_el] = np.trapezoid(density[:, None] * np.cross(pos, [0.0, -9.81, 0.0]),
@@ -434,7 +435,7 @@ def test_reaching_pull_compresses_the_arm_by_tension_over_ea():
     q = rodmol.StateLayout(N_D).field(y, "q")
     tensions = model.tensions(t)
     assert tensions.sum() > 4.0
-    pulled = model.cable_weights[tensions > 0.0].min(axis=0) == 1.0
+    pulled = Sampled(model).cable_weights[tensions > 0.0].min(axis=0) == 1.0
     s = rodmol.SCHEMES["centred"].cell_points(model.s_nodes)[pulled]  # where q lives
     ea = model.rod.material.E * model.rod.area(s)
     np.testing.assert_allclose(q[pulled, 0] - 1.0, -tensions.sum() / ea, rtol=0.03)

@@ -73,6 +73,7 @@ def test_model_arrays_are_read_only():
     """The compiled system copies the sampled coefficients once: changing them
     afterwards would make it stale, so they cannot be changed."""
     model = rodmol.paper_arm(6)
-    for name in ("kth", "kl", "mass", "cable_weights"):
+    sampled = rodmol.SemiDiscrete(model).sampled
+    for array in (sampled.kth, sampled.kl, sampled.mass, sampled.cable_weights, model.s_nodes):
         with pytest.raises(ValueError, match="read-only"):
-            getattr(model, name)[:] *= 2.0
+            array[:] *= 2.0

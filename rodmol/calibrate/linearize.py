@@ -9,7 +9,7 @@ discretisation for model-predictive control.
 
 import numpy as np
 
-from ..discretise import stencil
+from ..discretise import load_entries, stencil
 from ..discretise.schemes import DEFAULT_SCHEME
 from ..discretise.system import SemiDiscrete, tensions_by_hand
 from ..errors import ParameterError
@@ -154,14 +154,13 @@ def _field_rows(layout, name):
 def _point_loads(model, system, t, y, tensions):
     """(name, d f / d component) of the point forces and moments: the kernel's
     load values moved by one unit, central (the right-hand side is affine in them)."""
-    radius = model.rod.radius_at(model.s_nodes)
     out, start = [], 0
     system.update_inputs(t, y, tensions)
     values = system.entry_values
     held = values.copy()
     rates = np.empty((2, system.size))
     for load in model.loads:
-        count = len(load.on_grid(model.s_nodes, radius).kind)
+        count = load_entries.count(load, model.s_nodes)
         rows = slice(start, start + count)
         start += count
         if not isinstance(load, (PointForce, PointMoment)):

@@ -5,34 +5,36 @@ A model's external loads (:mod:`rodmol.loads`) become *entries*: (kind,
 velocity node, weight, parameter row, value). Every entry adds ``weight`` times
 its force and moment densities to its node's balance laws, in the local frame.
 
-To add a kind: give it a code, its parameter columns and its dependencies in
-:data:`DEPENDS` (the Jacobian's pattern, colouring and preconditioner are
-derived from them), and a branch in :func:`load`. The Jacobian test covers
-every code in :data:`DEPENDS`.
+To add a kind: give it a record in :data:`rodmol.loads.KERNELS` (its code,
+the state fields it reads and what it adds up as) and a branch in
+:func:`load`; its loads tell the grid how they spread and what parameter row
+they hand the kernel (:mod:`rodmol.discretise.load_entries`). The Jacobian's
+pattern, colouring and preconditioner are derived from the records, and the
+Jacobian test covers every code in :data:`DEPENDS`.
 """
 
 import numpy as np
 
+from ..loads import (
+    KERNELS,
+    N_PARAMS,  # noqa: F401 (the row width, read here by the system)
+    P_DAMPING,
+    P_FRICTION,
+    P_RADIUS,
+    P_SLIP,
+    P_SMOOTHING,
+    P_STIFFNESS,
+)
 from .physics import add, cross, dot, jit, rotation, scale, sub, to_local
 
-FOLLOWER_FORCE, DEAD_FORCE, FOLLOWER_MOMENT, DEAD_MOMENT, PLANE, CAPSULE = range(6)
+# The codes as module constants: the compiled branches read them as such.
+FOLLOWER_FORCE, DEAD_FORCE = KERNELS["follower_force"].code, KERNELS["dead_force"].code
+FOLLOWER_MOMENT, DEAD_MOMENT = KERNELS["follower_moment"].code, KERNELS["dead_moment"].code
+PLANE, CAPSULE = KERNELS["plane"].code, KERNELS["capsule"].code
 
 #: Which fields of its own element block each kind reads (force rows "v" and
 #: moment rows "w" of that block are the ones written).
-DEPENDS = {
-    FOLLOWER_FORCE: (),
-    DEAD_FORCE: ("Q",),
-    FOLLOWER_MOMENT: (),
-    DEAD_MOMENT: ("Q",),
-    PLANE: ("u", "Q", "v", "w"),
-    CAPSULE: ("u", "Q", "v", "w"),
-}
-
-# Parameter row of the contact kinds: geometry (plane: point, normal; capsule:
-# start, end, radius), then the law, the section radius at the node and the
-# depth over which the penalty is smoothed.
-N_PARAMS = 13
-P_STIFFNESS, P_DAMPING, P_FRICTION, P_SLIP, P_RADIUS, P_SMOOTHING = 7, 8, 9, 10, 11, 12
+DEPENDS = {k.code: k.depends for k in KERNELS.values()}
 
 
 def dependency_table(kinds):

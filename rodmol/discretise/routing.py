@@ -17,6 +17,7 @@ import numpy as np
 from ..cable_routing import cell_geometry
 from . import physics
 from .physics import jit
+from .sampling import cable_weights
 from .stencil import CENTRED, compatibility
 
 
@@ -34,7 +35,7 @@ class CableRouting:
         self.ds, self.n = model.ds, n
         self.geometry = np.array([cell_geometry(c.offset, model.s_nodes, s_cells, c.name)
                                   for c in cables]).reshape(len(cables), n, 6)
-        self.weights = np.array(model.cable_weights, dtype=float).reshape(len(cables), n)
+        self.weights = np.array(cable_weights(model), dtype=float).reshape(len(cables), n)
         self.friction = np.array([c.friction for c in cables])
         self.slip_speed = np.array([c.slip_speed for c in cables])
         self.index = {c.name: i for i, c in enumerate(cables)}

@@ -15,10 +15,11 @@ from dataclasses import replace
 
 import numpy as np
 
-from . import centreline, external, rotations, stencil
+from . import centreline, external, load_entries, rotations, stencil
 from .layout import StateLayout, merge
 from .physics import compile_signatures
 from .routing import CableRouting
+from .sampling import Sampled, cell_properties
 from .schemes import DEFAULT_SCHEME, get_scheme
 
 #: Rate [1/s] at which the quaternion norm is pulled back to 1; the exact
@@ -175,11 +176,12 @@ class SemiDiscrete:
         self.global_coupling = model.feedback or self._friction
         m = model
         s_cells = self.scheme.cell_points(m.s_nodes)
-        self.cells = m.cell_properties(s_cells)
+        self.sampled = sampled = Sampled(m)
+        self.cells = cell_properties(m, s_cells)
         self.node_lengths = self.scheme.node_lengths(m.n_elements, m.ds)
         self.lightly_damped = grid_damping_ratio(m) < 1.0
-        self._params = stencil.pack_params(*self.cells, m.mass, m.inertia, m.net_mass,
-                                           m.drag_coefficient, m.added)
+        self._params = stencil.pack_params(*self.cells, sampled.mass, sampled.inertia, sampled.net_mass,
+                                           sampled.drag_coefficient, sampled.added)
         self._consts = np.zeros(stencil.N_CONSTS)
         self._consts[:7] = (m.ds, QUATERNION_RESTORING_RATE, DRAG_SMOOTHING_SPEED**2,
                             1.0 if m.munk_moment else 0.0, *m.gravity)
@@ -191,7 +193,7 @@ class SemiDiscrete:
         self._setup_cables(s_cells)
         self._setup_loads()
         self.depends = merge(self.scheme.depends, external.dependency_table(set(self._kinds)))
-        self._inputs_vary = bool(self.global_coupling or self._timed or self._grid_loads.values
+        self._inputs_vary = bool(self.global_coupling or self._timed or self.grid_loads.values
                                  or not self._fixed_base)
         # The kernel's arguments: arrays whose contents update_inputs refreshes in place.
         self._args = (self._params, self._consts, self._offsets, self._weights, self.tension_values,
@@ -230,7 +232,7 @@ class SemiDiscrete:
         self.read_held(0.0)
 
     def _setup_loads(self):
-        entries = self.model.grid_loads
+        entries = load_entries.of_model(self.model)
         self._kinds = np.ascontiguousarray(entries.kind, dtype=np.int64)
         self._nodes = np.ascontiguousarray(entries.node - 1, dtype=np.int64)  # element blocks
         # A point load's share of a node is spread over the node's own length.
@@ -238,7 +240,7 @@ class SemiDiscrete:
         self._entry_weights = np.ascontiguousarray(entries.weight * stretch, dtype=float)
         self._entry_params = np.ascontiguousarray(entries.params, dtype=float).reshape(-1, external.N_PARAMS)
         self.entry_values = np.ascontiguousarray(entries.initial, dtype=float).reshape(-1, 3)
-        self._grid_loads = entries
+        self.grid_loads = entries
 
     @property
     def inputs_vary(self):
@@ -265,7 +267,7 @@ class SemiDiscrete:
                 self.tension_values[j] = cable.tension_at(t)
         if self._friction:
             self._weights[:] = self._path_weights * self.friction_factors(y)[self._active]
-        self._grid_loads.fill(t, self.entry_values)
+        self.grid_loads.fill(t, self.entry_values)
 
     def read_held(self, t):
         """Read the held tensions (time inputs with ``held = True``: a stepping simulator's

@@ -12,22 +12,12 @@ from .. import loads as rodmol_loads
 from . import readers as read
 from .arm import entries
 from .problems import FAILED, failed
-from .schema import DISTRIBUTED_UNITS, FRAMES, LOAD_UNITS, LOADS, POINT_UNITS
-
-_CLASSES = {
-    "point_force": rodmol_loads.PointForce,
-    "point_moment": rodmol_loads.PointMoment,
-    "distributed_force": rodmol_loads.DistributedForce,
-    "distributed_moment": rodmol_loads.DistributedMoment,
-    "plane_contact": rodmol_loads.PlaneContact,
-    "sphere_contact": rodmol_loads.SphereContact,
-    "capsule_contact": rodmol_loads.CapsuleContact,
-}
+from .schema import LOAD_UNITS, LOADS
 
 #: Readers of the keys every type shares the meaning of.
 _READERS = {
     "s": read.number("non-negative", "m"),
-    "frame": read.choice(FRAMES),
+    "frame": read.choice(rodmol_loads.FRAMES),
     "name": read.string,
     "point": read.vector(3, "m"),
     "normal": read.vector(3, "-"),
@@ -69,9 +59,9 @@ def _load(ctx, path, entry):
     if kind is FAILED:
         return FAILED  # its keys depend on the type: they cannot be checked
     keys, required = LOADS[kind]
+    build, units = rodmol_loads.SCENARIO_TYPES[kind][0], LOAD_UNITS[kind]
     what = "moment" if "moment" in keys else "force"
-    point = kind.startswith("point_")
-    units = {**LOAD_UNITS, what: (POINT_UNITS if point else DISTRIBUTED_UNITS)[what]}
+    point = getattr(build, "spread", None) == "point"
     table = ctx.table(entry, path, ("type",) + keys, required=required, units=units,
                       hint=f" (for `type = {kind!r}`)")
     readers = dict(_READERS)
@@ -82,4 +72,4 @@ def _load(ctx, path, entry):
     values = {key: ctx.read(table, path, key, readers[key]) for key in keys if key in table}
     if failed(*values.values()) or any(key not in table for key in required):
         return FAILED
-    return ctx.construct(path, table, partial(_CLASSES[kind], **values))
+    return ctx.construct(path, table, partial(build, **values))

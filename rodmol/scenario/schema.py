@@ -6,6 +6,18 @@ Documented in ``docs/scenario-reference.md``; the checks live in
 :mod:`rodmol.scenario.build`).
 """
 
+import inspect
+
+from ..loads import SCENARIO_TYPES
+
+
+def _arguments(build):
+    """(argument names, those without a default) of a load's constructor."""
+    params = [p for p in inspect.signature(build).parameters.values() if not p.name.startswith("_")]
+    return (tuple(p.name for p in params),
+            tuple(p.name for p in params if p.default is inspect.Parameter.empty))
+
+
 TOP = ("name", "description", "arm", "scenario", "gravity", "rod", "material", "medium",
        "cable", "marker", "load", "base", "discretization", "solver", "output")
 ROD = ("length", "radius")
@@ -33,25 +45,8 @@ UNITS = {"length": "m", "radius": "m", "E": "Pa", "G": "Pa", "mu": "Pa s", "rho"
 
 # --------------------------------------------------------------------------- [[load]]
 
-FRAMES = ("global", "local")
-CONTACT_LAW = ("stiffness", "damping", "friction", "slip_speed", "smoothing_depth")
-
-#: [[load]] types: type -> (keys besides `type`, required keys). The keys are
-#: the arguments of the Python classes of :mod:`rodmol.loads`.
-LOADS = {
-    "point_force": (("s", "force", "frame", "name"), ("s", "force")),
-    "point_moment": (("s", "moment", "frame", "name"), ("s", "moment")),
-    "distributed_force": (("force", "frame", "name"), ("force",)),
-    "distributed_moment": (("moment", "frame", "name"), ("moment",)),
-    "plane_contact": (("point", "normal") + CONTACT_LAW + ("name",), ("point", "normal", "stiffness")),
-    "sphere_contact": (("centre", "radius") + CONTACT_LAW + ("name",), ("centre", "radius", "stiffness")),
-    "capsule_contact": (("start", "end", "radius") + CONTACT_LAW + ("name",),
-                        ("start", "end", "radius", "stiffness")),
-}
-
-#: Units of the [[load]] keys; ``force`` and ``moment`` depend on the type.
-LOAD_UNITS = {"s": "m", "point": "m", "normal": "-", "centre": "m", "start": "m", "end": "m",
-              "radius": "m", "stiffness": "N/m^2", "damping": "N s/m^2", "friction": "-",
-              "slip_speed": "m/s", "smoothing_depth": "m"}
-POINT_UNITS = {"force": "N", "moment": "N m"}
-DISTRIBUTED_UNITS = {"force": "N/m", "moment": "N m/m"}
+#: [[load]] types: type -> (keys besides `type`, required keys), the
+#: arguments of the constructors in :data:`rodmol.loads.SCENARIO_TYPES`.
+LOADS = {kind: _arguments(build) for kind, (build, _) in SCENARIO_TYPES.items()}
+#: Units of the [[load]] keys, by type.
+LOAD_UNITS = {kind: units for kind, (_, units) in SCENARIO_TYPES.items()}

@@ -19,6 +19,7 @@ from scipy.linalg import solve_banded
 from ..discretise import centreline, rotations
 from ..discretise.jacobian import BandedDifferences
 from ..discretise.layout import BlockLayout
+from ..discretise.load_entries import load_scale
 from ..discretise.schemes import DEFAULT_SCHEME
 from ..discretise.system import SemiDiscrete, straight_state
 from ..errors import EquilibriumError, ParameterError
@@ -59,8 +60,9 @@ def equilibrium(model, t=0.0, *, scheme=DEFAULT_SCHEME, tol=1e-10, max_iter=40, 
         state at rest for one scheme is not at rest for the other.
     tol : float
         Required max-norm of the force and torque residuals, relative to the
-        load scale (``Model.load_scale``); raised to the round-off floor of
-        the difference quotients on very fine grids.
+        load scale (:func:`rodmol.discretise.load_entries.load_scale`);
+        raised to the round-off floor of the difference quotients on very
+        fine grids.
     system : SemiDiscrete, optional
         The model's system, if one is built already (``simulate`` passes its
         own); it overrides ``scheme``.
@@ -108,7 +110,7 @@ def _closed_loop(system, t, tol, max_iter, max_rounds=30):
     # A displacement-controlled cable's law on the straight rod can ask for far
     # more than the arm carries (the rigid-rod tension); start it slack.
     tensions[[c.actuated for c in model.cables]] = 0.0
-    scale = max(model.load_scale(t, tensions), 1e-12)
+    scale = max(load_scale(model, t, tensions, system.grid_loads), 1e-12)
     warm = None
     # One feedback cable: F(T) decreases with T for a tendon (more pull, a
     # shorter path, less stretch), so a bracket [low, high] of its root
@@ -182,7 +184,8 @@ class RestEquations:
         # Views and slices made once: the residual runs thousands of times per solve.
         self._sl, self._state_sl = self.static.slices(), self.layout.slices()
         self._y_blocks, self._rate_blocks = self.layout.blocks(self._y), self.layout.blocks(self._rates)
-        self.scale = model.load_scale(t, tensions)
+        self._mass, self._inertia = system.sampled.mass, system.sampled.inertia
+        self.scale = load_scale(model, t, tensions, system.grid_loads)
         self.unloaded = self.scale == 0.0 and not model.loads
         self._force_scale = (self.scale or 1.0) / model.rod.length  # contact alone: forces of about 1 N
 
@@ -190,7 +193,7 @@ class RestEquations:
         """``tol`` raised to the round-off floor of the difference quotients:
         differencing stresses of size EA * strain over ds loses digits as N grows."""
         model = self.system.model
-        return max(tol, 10 * np.finfo(float).eps * np.max(model.kl) / (model.ds * self._force_scale))
+        return max(tol, 10 * np.finfo(float).eps * np.max(self.system.sampled.kl) / (model.ds * self._force_scale))
 
     def unknowns(self, y):
         """The static unknowns z of a state vector ``y``."""
@@ -211,8 +214,8 @@ class RestEquations:
         out = np.empty_like(zb)
         out[:, sl["u"]] = (u - u_prev - centreline.chords(q_prev, q, k, ds)) / ds
         out[:, sl["Q"]] = quat - rotations.multiply(q_prev, rotations.from_rotation_vector(ds * k))
-        out[:, sl["q"]] = self._rate_blocks[:, state_sl["v"]] * model.mass / self._force_scale
-        out[:, sl["k"]] = self._rate_blocks[:, state_sl["w"]] * model.inertia / (self.scale or 1.0)
+        out[:, sl["q"]] = self._rate_blocks[:, state_sl["v"]] * self._mass / self._force_scale
+        out[:, sl["k"]] = self._rate_blocks[:, state_sl["w"]] * self._inertia / (self.scale or 1.0)
         return out.ravel()
 
     def state(self, z):

@@ -137,7 +137,7 @@ class Watch:
         # 1 - T / EA turns negative) though no element of the state does.
         model = system.model
         self.system = system
-        self.tip_cables = np.flatnonzero(model.cable_weights[:, -1] == 1.0)  # anchored at the tip
+        self.tip_cables = np.flatnonzero(system.routing.weights[:, -1] == 1.0)  # anchored at the tip
         self.tip_stiffness = float(model.rod.stiffness(model.rod.length)[0][0])
 
     def state(self, t, h, y):

@@ -8,6 +8,7 @@ import pytest
 import rodmol
 from rodmol import ParameterError
 from rodmol.calibrate.variants import apply, current, spec_of
+from rodmol.discretise.sampling import Sampled
 
 
 def base():
@@ -20,9 +21,9 @@ def test_material_medium_switches_and_solver():
                           "solver.rtol": 1e-7})
     m = spec.model
     assert m.rod.material.E == 90e3 and m.rod.material.nu == 0.5 and m.rod.material.G == 30e3
-    assert np.all(m.vl == 0.0)
+    assert np.all(Sampled(m).vl == 0.0)
     assert (m.medium.Cy, m.medium.Cz, m.medium.By) == (3.0, 3.0, 1.5)
-    assert not m.drag and np.all(m.drag_coefficient == 0.0)
+    assert not m.drag and np.all(Sampled(m).drag_coefficient == 0.0)
     assert m.n_elements == 12 and spec.t_end == 2.0 and spec.solver["rtol"] == 1e-7
     assert spec.solver["output_dt"] == 0.1
     assert [mk.name for mk in m.markers] == ["L1", "L2", "L3", "L"]

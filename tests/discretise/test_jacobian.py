@@ -14,7 +14,7 @@ import scipy.linalg
 
 import rodmol
 from rodmol.arm import paper_rod
-from rodmol.discretise import external, preconditioner
+from rodmol.discretise import external, load_entries, preconditioner
 from rodmol.discretise.layout import FIELDS, HEADER, merge
 from rodmol.discretise.schemes import SCHEMES
 from rodmol.discretise.system import SemiDiscrete
@@ -103,7 +103,7 @@ def _state(name):
 def test_every_load_kind_is_covered():
     kinds = set()
     for name in CASES:
-        kinds |= set(int(k) for k in _model(name).grid_loads.kind)
+        kinds |= set(int(k) for k in load_entries.of_model(_model(name)).kind)
     assert kinds == set(external.DEPENDS)
 
 

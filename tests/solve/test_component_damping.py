@@ -7,6 +7,7 @@ import pytest
 from vibration import measure_free_vibration
 
 import rodmol
+from rodmol.discretise.sampling import Sampled
 from rodmol.discretise.system import SemiDiscrete, grid_damping_ratio
 
 L, RADIUS, E, RHO = 0.3, 0.01, 1e5, 1000.0  # m, m, Pa, kg/m^3
@@ -25,12 +26,12 @@ BSE_ZERO = dict(shear_extension=(0.0, 0.0, 0.0), bending_torsion=(ETA_BENDING,) 
 def test_per_component_viscosity_reaches_the_sections():
     model = _model(BSE_ZERO)
     area, inertia = np.pi * RADIUS**2, np.pi * RADIUS**4 / 4
-    assert np.all(model.vl == 0.0)
-    np.testing.assert_allclose(model.vth, np.tile(ETA_BENDING * inertia * np.array([2.0, 1.0, 1.0]), (N, 1)))
+    assert np.all(Sampled(model).vl == 0.0)
+    np.testing.assert_allclose(Sampled(model).vth, np.tile(ETA_BENDING * inertia * np.array([2.0, 1.0, 1.0]), (N, 1)))
     # A key left out keeps the paper's ratios from mu.
     paper, partial = _model(None, mu=50.0), _model(dict(bending_torsion=(1.0, 2.0, 3.0)), mu=50.0)
-    np.testing.assert_allclose(partial.vl, paper.vl, rtol=1e-15)
-    np.testing.assert_allclose(partial.vl[0], 50.0 * area * np.array([3.0, 1.0, 1.0]))
+    np.testing.assert_allclose(Sampled(partial).vl, Sampled(paper).vl, rtol=1e-15)
+    np.testing.assert_allclose(Sampled(partial).vl[0], 50.0 * area * np.array([3.0, 1.0, 1.0]))
     # Bse = 0 leaves the axial and shear waves undamped: lightly damped (BDF order <= 2).
     assert grid_damping_ratio(model) == 0.0
     assert SemiDiscrete(model).lightly_damped

@@ -18,6 +18,8 @@ import pytest
 from scipy.integrate import solve_bvp
 
 import rodmol
+from rodmol.discretise.load_entries import load_scale
+from rodmol.discretise.sampling import Sampled
 
 # Table I of the paper (the same numbers rodmol.arm.paper_rod() uses; restated
 # here so that the reference does not read them from rodmol).
@@ -175,15 +177,15 @@ def test_equilibrium_is_rest_state(medium):
     assert np.all(lay.field(y, "v") == 0.0) and np.all(lay.field(y, "w") == 0.0)
 
     rate = rodmol.SemiDiscrete(model)(0.0, y)
-    weight = model.load_scale()  # net weight [N] (no cables here)
+    weight = load_scale(model)  # net weight [N] (no cables here)
     # Kinematic rates: zero velocities give zero pose and strain rates (the
     # quaternion rate only sees round-off of |Q| - 1).
     for name in ("u", "Q", "q", "k"):
         assert np.max(np.abs(lay.field(rate, name))) < 1e-12, name
     assert np.max(np.abs(rate[:7])) < 1e-12
     # Accelerations back to force and torque densities per unit length.
-    force = lay.field(rate, "v") * model.mass
-    torque = lay.field(rate, "w") * model.inertia
+    force = lay.field(rate, "v") * Sampled(model).mass
+    torque = lay.field(rate, "w") * Sampled(model).inertia
     print(f"\n{medium}: max |force| / (W/L) = {np.max(np.abs(force)) * L / weight:.2e}, "
           f"max |torque| / W = {np.max(np.abs(torque)) / weight:.2e}")
     assert np.max(np.abs(force)) < 1e-8 * weight / L

@@ -1,0 +1,125 @@
+"""External loads on the grid: each load of a model (:mod:`rodmol.loads`)
+becomes *entries* at the velocity nodes 1..N, the rows the compiled kernel
+(:func:`rodmol.discretise.external.load`) reads.
+
+A point load at arc length s is shared between the two nodes around s,
+linearly (a share that falls on the clamped base goes into the clamp);
+distributed and contact loads act at every node but the base.
+"""
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..loads import KERNELS, N_PARAMS
+
+
+@dataclass(frozen=True)
+class GridLoad:
+    """Loads mapped onto the velocity nodes 1..N of a grid.
+
+    ``weight`` is the entry's share of the node's load density [1/m for a
+    point load, 1 for densities], taking every node as standing for a length
+    ds; ``concentrated`` marks point loads, whose density a scheme scales to
+    its own node lengths. ``initial`` (n_entries, 3) are the values at t = 0;
+    ``values`` lists (entry slice, values(t)) for the time-dependent loads.
+    """
+
+    kind: np.ndarray
+    node: np.ndarray
+    weight: np.ndarray
+    params: np.ndarray
+    initial: np.ndarray
+    concentrated: np.ndarray
+    values: list
+
+    def fill(self, t, out):
+        """Write the entries' values at time t into ``out`` (n_entries, 3)."""
+        for rows, at in self.values:
+            out[rows] = at(t)
+        return out
+
+
+def node_shares(s, s_nodes):
+    """Velocity nodes (1..N) and weights [1/m] sharing a point load at s [m]."""
+    n = len(s_nodes) - 1
+    ds = s_nodes[1] - s_nodes[0]
+    x = min(s / ds, float(n))
+    j = min(int(np.floor(x)), n - 1)
+    f = x - j
+    nodes, weights = [], []
+    for node, share in ((j, 1.0 - f), (j + 1, f)):
+        if node >= 1 and share > 0.0:  # node 0 is the clamped base
+            nodes.append(node)
+            weights.append(share / ds)
+    return np.array(nodes, dtype=int), np.array(weights)
+
+
+def _entries(load, s_nodes, radius):
+    """(nodes, weights, params, values(t) at those nodes, time-dependent) of one load."""
+    if load.spread == "point":
+        nodes, weights = node_shares(load.s, s_nodes)
+    else:
+        nodes = np.arange(1, len(s_nodes))
+        weights = np.ones(len(nodes))
+    s = s_nodes[nodes]
+    params = np.zeros((len(nodes), N_PARAMS))
+    row = load.params(radius[nodes])
+    params[:, :row.shape[1]] = row
+
+    def at(t):
+        return load.values(s, t)
+
+    return nodes, weights, params, at
+
+
+def count(load, s_nodes):
+    """How many entries ``load`` has on the grid of nodes ``s_nodes`` [m]."""
+    return len(node_shares(load.s, s_nodes)[0]) if load.spread == "point" else len(s_nodes) - 1
+
+
+def on_grid(loads, s_nodes, radius):
+    """All ``loads`` as one :class:`GridLoad`; ``radius`` [m] at ``s_nodes``."""
+    kind, node, weight, params, initial, concentrated, timed = [], [], [], [], [], [], []
+    start = 0
+    for load in loads:
+        nodes, weights, rows, at = _entries(load, s_nodes, radius)
+        n = len(nodes)
+        kind.append(np.full(n, KERNELS[load.kernel].code))
+        node.append(nodes)
+        weight.append(weights)
+        params.append(rows)
+        initial.append(np.asarray(at(0.0), dtype=float).reshape(n, 3))
+        concentrated.append(np.full(n, load.spread == "point"))
+        if not load.constant:
+            timed.append((slice(start, start + n), at))
+        start += n
+
+    def cat(arrays, shape):
+        return np.concatenate(arrays) if arrays else np.zeros(shape)
+
+    return GridLoad(cat(kind, 0).astype(np.int64), cat(node, 0).astype(np.int64), cat(weight, 0),
+                    cat(params, (0, N_PARAMS)), cat(initial, (0, 3)), cat(concentrated, 0).astype(bool),
+                    timed)
+
+
+def of_model(model):
+    """The model's loads on its grid."""
+    return on_grid(model.loads, model.s_nodes, model.rod.radius_at(model.s_nodes))
+
+
+def load_scale(model, t=0.0, tensions=None, grid=None):
+    """A force scale [N] of the applied loads at time t: net weight, cable
+    tensions (``tensions`` [N] if given, else the inputs at t), external
+    forces and external moments divided by L, as the grid sees them
+    (``grid``: the model's :class:`GridLoad`, built here if None)."""
+    net_density = abs(model.rod.material.rho - model.medium.rho)
+    scale = net_density * np.linalg.norm(model.gravity) * model.rod.volume()
+    if model.cables:
+        scale += float(np.sum(model.tensions(t) if tensions is None else tensions))
+    g = of_model(model) if grid is None else grid
+    size = np.linalg.norm(g.fill(t, g.initial.copy()), axis=1) * g.weight * model.ds
+    by_code = {k.code: k.quantity for k in KERNELS.values()}
+    quantity = np.array([by_code[int(k)] for k in g.kind], dtype=object)
+    return scale + float(np.sum(size[quantity == "force"]) + np.sum(size[quantity == "moment"])
+                         / model.rod.length)
