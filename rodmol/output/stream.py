@@ -157,10 +157,14 @@ class RunWriter:
             try:
                 job.result()
             except BaseException:
-                del self.t[len(self.t) - self.chunks.pop(name):]
-                self.record.drop([name])
+                self._unlist(name)
                 if report:
                     raise
+
+    def _unlist(self, name):
+        """Forget the chunk ``name`` (the last listed), which is not on disk."""
+        del self.t[len(self.t) - self.chunks.pop(name):]
+        self.record.drop([name])
 
     def end(self, success, message, stats):
         """Finish: the final index; returns the Result (read lazily)."""
@@ -191,26 +195,30 @@ class RunWriter:
         self.chunks[name] = n
         self.record.stored(name)
         self.t.extend(np.asarray(chunk.t, dtype=float).tolist())
-        # The chunk that ends the planned run leaves the index to end() (a kill before it: resumed there).
-        final = self.t_out is not None and len(self.t) == len(self.t_out)
-        index = None if final else self._index(dict(success=True, message="running", complete=False))
-        # The thread writes each batch of arrays while this one computes the next, then the views' text.
-        posed, moving = self._view_batches(shown) if self.views else ([], [])
-        batches = [*posed, lambda: {key: getattr(chunk, key) for key in LOADS}, *moving]
-        fragment = [partial(self._fragment, shown.t, name)] if self.views else []
-        handed = [Future() for _ in batches + fragment]
-        made = [future.result for future in handed]
-        at_hand = {key: getattr(chunk, key) for key in STORED if key not in LOADS}
-        self._write_behind(name, partial(self._write, name, [at_hand, *made[:len(batches)]],
-                                         made[-1] if fragment else None, list(self.chunks), index))
-        try:
+        handed = []
+        try:  # from here on, an interrupt (or a failed write before) drops the chunk: it is listed above
+            # The chunk that ends the planned run leaves the index to end() (a kill before it: resumed there).
+            final = self.t_out is not None and len(self.t) == len(self.t_out)
+            index = None if final else self._index(dict(success=True, message="running", complete=False))
+            # The thread writes each batch of arrays while this one computes the next, then the views' text.
+            posed, moving = self._view_batches(shown) if self.views else ([], [])
+            batches = [*posed, lambda: {key: getattr(chunk, key) for key in LOADS}, *moving]
+            fragment = [partial(self._fragment, shown.t, name)] if self.views else []
+            handed = [Future() for _ in batches + fragment]
+            made = [future.result for future in handed]
+            at_hand = {key: getattr(chunk, key) for key in STORED if key not in LOADS}
+            self._write_behind(name, partial(self._write, name, [at_hand, *made[:len(batches)]],
+                                             made[-1] if fragment else None, list(self.chunks), index))
             for future, make in zip(handed, batches + fragment):
                 future.set_result(make())
-        except BaseException as exc:  # an interrupt, say: the chunk is dropped
+        except BaseException as exc:
             for future in handed:
                 if not future.done():
                     future.set_exception(exc)
-            self._settle(False)
+            if self._pending is not None and self._pending[1] == name:
+                self._settle(False)  # handed to the writer's thread: it stops at the missing batch
+            else:
+                self._unlist(name)
             raise
 
     @contextmanager

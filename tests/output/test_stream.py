@@ -122,3 +122,25 @@ def test_resume_refuses_another_end_time_and_an_empty_directory(model, tmp_path,
         rodmol.simulate(model, 0.3, out=tmp_path / "empty", resume=True)
 
 
+
+
+@pytest.mark.parametrize("where", ["_view_batches", "_fragment"])
+def test_ctrl_c_while_a_chunk_is_stored_leaves_the_chunks_before(tmp_path, monkeypatch, where):
+    # Ctrl-C lands while the third chunk is stored: before it is handed to the writer's thread
+    # (its views being made) or after (its XDMF text being made); either way it is dropped.
+    calls, original = [], getattr(RunWriter, where)
+
+    def interrupted(self, *args):
+        calls.append(1)
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        return original(self, *args)
+
+    monkeypatch.setattr(RunWriter, where, interrupted)
+    model = rodmol.scenarios.get("bending").model(6)
+    with pytest.warns(RuntimeWarning, match="interrupted"):
+        rodmol.simulate(model, 0.3, out=RunWriter(tmp_path, chunk_frames=5))
+    stopped = rodmol.load_result(tmp_path)
+    assert not stopped.success and len(stopped.t) == 11  # the first two chunks: frames 0-10
+    assert len(stopped.states) == len(stopped.t)
+    assert assert_valid_views(tmp_path) == pytest.approx(list(stopped.t))
