@@ -58,16 +58,16 @@ class BaseMotion:
         function = getattr(self, name)
         if function is None:
             return _ZERO
-        what = f"the base motion's `{name}` function"
         try:
             value = function(t)
         except RodmolError:
             raise
         except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
-            raise _checks.user_error(what, exc, t) from exc
+            raise _checks.user_error(f"the base motion's `{name}` function", exc, t) from exc
         arr = _checks.floats(value)
         if arr is None or arr.shape != (3,) or not np.all(np.isfinite(arr)):
-            raise _checks.bad_return(what, value, t, "it must return three finite numbers")
+            raise _checks.bad_return(f"the base motion's `{name}` function", value, t,
+                                     "it must return three finite numbers")
         return arr
 
     @classmethod

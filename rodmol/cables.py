@@ -46,6 +46,7 @@ class Tension:
     def __init__(self, signal: TimeInput):
         self.signal = signal
         self.constant = signal.value(0.0) if signal.constant else None
+        self.held = signal.held
 
     def __call__(self, t, state=None):
         return self.signal.value(t)
@@ -61,6 +62,7 @@ class FeedbackTension(Tension):
     function: Callable
     feedback = True
     constant = None
+    held = False
     label = "feedback law T(t, state)"
 
     def __call__(self, t, state=None):
@@ -113,6 +115,7 @@ class ActuatorTension(Tension):
 
     feedback = True
     constant = None
+    held = False
     label = "displacement-controlled tension"
 
     def __init__(self, name, position, compliance, base_to_actuator, rest_length, straight_length):
@@ -271,18 +274,21 @@ class Cable:
     def tension_at(self, t, state=None):
         """Tension [N] at time t; an exception or a value that is not a finite
         tension >= 0 is a :class:`UserFunctionError` naming the cable, its input and t."""
-        what = f"cable {self.name!r}: the {self.tension.label}"
         try:
             value = self.tension(t, state)
         except RodmolError:
             raise
         except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
-            raise _checks.user_error(what, exc, t) from exc
+            raise _checks.user_error(self._input_name(), exc, t) from exc
         if not isinstance(value, float):
             number = _checks.floats(value)
             if number is None or number.size != 1:
-                raise _checks.bad_return(what, value, t, "a tension is one number [N]")
+                raise _checks.bad_return(self._input_name(), value, t, "a tension is one number [N]")
             value = float(number.reshape(()))
         if not 0.0 <= value < math.inf:  # also catches NaN
-            raise _checks.bad_return(what, value, t, "a tension must be finite and >= 0 N")
+            raise _checks.bad_return(self._input_name(), value, t, "a tension must be finite and >= 0 N")
         return value
+
+    def _input_name(self):
+        """The tension input, as failure messages name it (built only then: tension_at is hot)."""
+        return f"cable {self.name!r}: the {self.tension.label}"

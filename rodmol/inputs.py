@@ -28,11 +28,14 @@ class TimeInput:
     """A value of ``width`` components as a function of time t [s].
 
     ``value(t)`` returns a float if ``width == 1``, else a (width,) array.
-    ``constant`` is True if the value never changes (it is then read once).
+    ``constant`` is True if the value never changes (it is then read once);
+    ``held`` if it changes only between a stepping simulator's steps (it is
+    then read when it changes, ``SemiDiscrete.read_held``).
     """
 
     width = 1
     constant = False
+    held = False
     source = "function"
 
     def value(self, t):

@@ -177,15 +177,19 @@ class _DistributedLoad(_Load):
         except RodmolError:
             raise
         except Exception as exc:  # noqa: BLE001 (the user's function: chained, never lost)
-            raise _checks.user_error(f"{self.name}: the {self._what}(s, t) function", exc, t) from exc
-        what = f"{self.name}: the {self._what}(s, t) function"
+            raise _checks.user_error(self._function_name(), exc, t) from exc
         try:
             arr = np.broadcast_to(np.asarray(raw, dtype=float), (len(s), 3))
         except (TypeError, ValueError, OverflowError):
-            raise _checks.bad_return(what, raw, t, "it must return (len(s), 3) values for an array s") from None
+            raise _checks.bad_return(self._function_name(), raw, t,
+                                     "it must return (len(s), 3) values for an array s") from None
         if not np.all(np.isfinite(arr)):
-            raise _checks.bad_return(what, raw, t, "its values must be finite")
+            raise _checks.bad_return(self._function_name(), raw, t, "its values must be finite")
         return arr
+
+    def _function_name(self):
+        """The load's function, as failure messages name it (built only then: sampled per evaluation)."""
+        return f"{self.name}: the {self._what}(s, t) function"
 
     @property
     def kernel(self):

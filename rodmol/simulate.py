@@ -130,9 +130,10 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
     if not (resume is True or resume is False or (isinstance(resume, str) and resume in RESUME)):
         raise ParameterError(f"`resume` must be False, True or 'force', got {_checks.short(resume)}")
-    sink, first, plan, recorded = _sink(out, resume, overwrite), 0, None, None
+    sink, first, plan, recorded = None, 0, None, None
     asked_plan = (t0, output_dt, output_times)
-    if resume:
+    if resume:  # the run's directory first: its settings fill in what the call leaves out
+        sink = _sink(out, resume, overwrite)
         plan, first, kept = sink.resume_point()
         recorded = getattr(sink, "settings", None) or {}
         _settings.check_grid(recorded, model.n_elements, _where(sink))
@@ -161,6 +162,8 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
             raise ParameterError(f"`t_end` = {t_end!r} s: the run being resumed ends at {float(plan[-1])!r} s")
         _check_plan(plan, asked_plan, t_end, size, sink)
         t_out = plan
+    if not resume:  # after every check: with `overwrite`, making the sink clears the earlier run
+        sink = _sink(out, resume, overwrite)
     settings = _settings.record(model, scheme=run_args.scheme.name, backend=backend, rtol=rtol,
                                 atol=atol, backend_options=backend_options,  # None: the default
                                 initial=(recorded.get("initial") or "unknown") if resume and initial is None

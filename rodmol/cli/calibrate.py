@@ -84,9 +84,9 @@ def _progress(args, label):
 
 def _out(args, spec, kind):
     out = args.out or Path("out") / f"{spec.name}-{kind}"
-    from .options import make_output_directory
+    from .._files import output_directory
 
-    make_output_directory(out)
+    output_directory(out, "--out")
     return out
 
 

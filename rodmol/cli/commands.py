@@ -25,13 +25,15 @@ import warnings
 from dataclasses import replace
 from pathlib import Path
 
+from .._files import output_directory
 from .._progress import Progress
 from .._version import __version__
 from ..errors import ParameterError
+from ..output import h5result
 from ..output.formats import FORMATS, get_format
 from ..output.lock import OutputLock
 from ..output.run_files import cannot_write
-from .options import EXAMPLES, add_run_options, load_spec, make_output_directory
+from .options import EXAMPLES, add_run_options, load_spec
 
 EXIT_FAILED, EXIT_USAGE, EXIT_OUTPUT, EXIT_INTERRUPTED = 1, 2, 3, 130
 #: Exit code of a run stopped by each signal (128 + the signal's number, as a shell reports it).
@@ -99,7 +101,7 @@ class _Parser(argparse.ArgumentParser):
 def _run(args):
     spec = load_spec(args)
     out = args.out or spec.output.directory or Path("out") / spec.name
-    make_output_directory(out)  # before the run, so a directory that cannot be made does not waste it
+    output_directory(out, "--out")  # before the run, so a directory that cannot be made does not waste it
     with OutputLock(out):  # one run per output directory
         return _run_locked(args, spec, out)
 
@@ -147,7 +149,7 @@ def _run_locked(args, spec, out):
     except OSError as exc:  # the streamed index could not be replaced: the previous one is valid
         if writer is None:
             raise
-        print(f"rodmol: {cannot_write(out / 'result.h5', exc)}", file=sys.stderr)
+        print(f"rodmol: {cannot_write(out / h5result.INDEX, exc)}", file=sys.stderr)
         return EXIT_OUTPUT
     except KeyboardInterrupt:
         print("\nrodmol: interrupted before the first frame; nothing written", file=sys.stderr)
@@ -201,10 +203,10 @@ def _stream_writer(args, spec, out):
 def _streamed(writer, result):
     # Absolute: given a bare file name, ParaView 5.11 looks for the included files in the wrong place.
     views = [(writer.directory / f"{v}.xdmf").resolve() for v in writer.view_names()] if writer.views else []
-    written = dict(result=writer.directory / "result.h5", views=views, seconds=writer.seconds,
+    written = dict(result=writer.directory / h5result.INDEX, views=views, seconds=writer.seconds,
                    frames=len(result.t))
     if isinstance(result.error, OSError):
-        written["error"] = cannot_write(writer.directory / "frames", result.error)
+        written["error"] = cannot_write(writer.directory / h5result.FRAMES, result.error)
     return written
 
 

@@ -54,12 +54,3 @@ def load_spec(args):
     if not args.scenario:
         raise ParameterError("give a scenario file (rodmol run FILE.toml) or `--example NAME`")
     return load_scenario(args.scenario, overrides=overrides)
-
-
-def make_output_directory(out):
-    """Create the output directory ``out``; a ParameterError names it and says why not."""
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except (OSError, ValueError) as exc:  # ValueError: a NUL in the path
-        reason = getattr(exc, "strerror", None) or str(exc)
-        raise ParameterError(f"cannot create the output directory {str(out)!r}: {reason}") from None

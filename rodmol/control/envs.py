@@ -107,7 +107,7 @@ class ReachEnv(gymnasium.Env):
         else:
             self.sim.reset(self._start)
         self._steps = 0
-        return self._observation(), {"target": self.target.copy()}
+        return self._observation(self.sim.state), {"target": self.target.copy()}
 
     def step(self, action):
         tensions = np.clip(np.asarray(action, dtype=float), 0.0, self.max_tension)
@@ -117,19 +117,19 @@ class ReachEnv(gymnasium.Env):
             self.sim.step(self.period, tensions)
         except IntegrationError as exc:
             terminated, info["failure"] = True, str(exc)
-        distance = float(np.linalg.norm(self.sim.state.tip - self.target))
+        state = self.sim.state  # one view: its positions are rebuilt once
+        distance = float(np.linalg.norm(state.tip - self.target))
         reward = -distance - self.effort_weight * float(tensions @ tensions)
         info["distance"] = distance
         truncated = self._steps >= self.episode_steps and not terminated
-        return self._observation(), reward, terminated, truncated, info
+        return self._observation(state), reward, terminated, truncated, info
 
     def close(self):
         self.sim.close()
 
     # ----------------------------------------------------------------- internals
 
-    def _observation(self):
-        state = self.sim.state
+    def _observation(self, state):
         tip_velocity = state.rotations[-1] @ state.v[-1]  # local to global
         return np.concatenate([state.tip, tip_velocity, state.markers[:3].ravel(), self.target,
                                self.target - state.tip]).astype(np.float32)

@@ -177,7 +177,6 @@ class Simulator:
         self._wall += time.perf_counter() - started
         if failed:
             self._hold(self._row)
-            self._restart = True  # the stepper was re-initialised at the last good state
             reason, error = failed
             raise IntegrationError(f"the step from t = {t_start:.6g} s to {t_end:.6g} s failed "
                                    f"(the simulator stays at t = {t_start:.6g} s): {reason}") from error

@@ -109,9 +109,9 @@ class StateView:
     and ``markers`` (n_markers, 3) [m] global, as ``Result.markers``.
     """
 
-    def __init__(self, layout, t, y, ds, routing=None, markers=None):
+    def __init__(self, layout, t, y, ds, routing=None, model=None):
         self.t, self._layout, self._y, self._ds, self._routing = t, layout, y, ds, routing
-        self._markers = markers  # the model, whose markers are tracked
+        self._model = model  # whose markers are tracked
 
     def cable_length(self, name):
         """Path length [m] of the cable called ``name`` from the base to its anchor."""
@@ -136,10 +136,10 @@ class StateView:
                                         self._layout.quaternions(self._y), self.q, self.k, self._ds)
         if name == "tip":
             return self.positions[-1]
-        if name == "markers" and self._markers is not None:
-            m = self._markers
+        if name == "markers" and self._model is not None:
+            m = self._model
             return centreline.track([mk.s for mk in m.markers], m.marker_offsets[:, 1:], m.s_nodes,
-                         self.positions[None], self.rotations[None])[0]
+                                    self.positions[None], self.rotations[None])[0]
         raise AttributeError(name)
 
 
@@ -225,10 +225,9 @@ class SemiDiscrete:
         self._weights = self._path_weights.copy()  # times the friction factors, refreshed
         self.tension_values = np.array([constant[i] or 0.0 for i in active])
         timed = [(j, m.cables[i]) for j, i in enumerate(active) if constant[i] is None]
-        # Inputs held over a step (rodmol.control.Simulator) are read by read_held, not per call.
-        held = [getattr(getattr(cable.tension, "signal", None), "held", False) for _, cable in timed]
-        self._held = [entry for entry, h in zip(timed, held) if h]
-        self._timed = [entry for entry, h in zip(timed, held) if not h]
+        # Tensions held over a step (rodmol.control.Simulator) are read by read_held, not per call.
+        self._held = [(j, cable) for j, cable in timed if cable.tension.held]
+        self._timed = [(j, cable) for j, cable in timed if not cable.tension.held]
         self.read_held(0.0)
 
     def _setup_loads(self):

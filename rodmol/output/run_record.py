@@ -18,7 +18,7 @@ began that a later resume redid.
 from contextlib import contextmanager
 
 from ..errors import ParameterError
-from ..solve.chunked import merge_stats
+from ..solve.outputs import merge_stats
 
 #: The statistics of a session (its entry of ``stats["sessions"]``).
 SESSION_KEYS = ("steps", "rhs_evals", "jac_evals", "wall_time_s", "prepare_s", "equilibrium_s")

@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 
-from .outputs import keep_before_failure, merge_stats  # noqa: F401 (merge_stats: stream.py's)
+from .outputs import keep_before_failure, merge_stats
 
 
 def run_chunked(run, system, y0, t_out, sink, first=0, *, progress=None, max_wall_time=None, **options):
