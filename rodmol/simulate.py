@@ -137,7 +137,7 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         plan, first, kept = sink.resume_point()
         recorded = getattr(sink, "settings", None) or {}
         _settings.check_grid(recorded, model.n_elements, _where(sink))
-        t0, output_times = float(plan[first]), plan[first:]
+        t0 = float(plan[first])
         scheme = recorded.get("scheme") if scheme is None else scheme
         backend = recorded.get("backend") if backend is None else backend
         rtol = recorded.get("rtol") if rtol is None else rtol
@@ -156,8 +156,9 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         raise ParameterError(f"`t_end` must be after the start t0 = {t0!r} s, got {t_end!r} s")
     output_dt = _checks.positive("output_dt", OUTPUT_DT if output_dt is None else output_dt, " s")
     size = run_args.layout.size
-    t_out = options.output_times(t0, t_end, output_dt, output_times, size)
-    if plan is not None:
+    if plan is None:
+        t_out = options.output_times(t0, t_end, output_dt, output_times, size)
+    else:  # the run's own output times, from where it stopped
         if t_end != plan[-1]:
             raise ParameterError(f"`t_end` = {t_end!r} s: the run being resumed ends at {float(plan[-1])!r} s")
         _check_plan(plan, asked_plan, t_end, size, sink)
