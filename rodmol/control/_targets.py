@@ -4,6 +4,7 @@ weighted functions of a rest state, with their derivatives in the state."""
 import numpy as np
 
 from .. import _checks
+from .._differences import central_columns
 from ..discretise import centreline, rotations
 from ..errors import ParameterError
 
@@ -80,13 +81,7 @@ class Targets:
     def rows(self, y):
         """d values / d y[entries], (size, len(entries))."""
         h = _STEP * np.maximum(np.abs(y[self.entries]), 0.1)
-        out = np.empty((self.size, self.entries.size))
-        for j, (i, step) in enumerate(zip(self.entries, h)):
-            up, down = y.copy(), y.copy()
-            up[i] += step
-            down[i] -= step
-            out[:, j] = (self.values(up) - self.values(down)) / (2 * step)
-        return out
+        return central_columns(self.values, y, self.entries, h)
 
     def errors(self, y, aim):
         """(tip error [m] or None, tangent angle [rad] or None, {marker: error [m]})."""
