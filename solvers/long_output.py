@@ -45,7 +45,7 @@ CHILD = textwrap.dedent("""
     rodmol.simulate(spec.model, 0.02)  # compile or load the kernels: not part of the run
     started = time.perf_counter()
     if fmt == "xdmf":
-        writer = RunWriter(out)
+        writer = RunWriter(out, overwrite=True)
         result = spec.simulate(out=writer)
         writing = writer.seconds
     elif fmt == "none":

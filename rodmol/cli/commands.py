@@ -197,7 +197,8 @@ def _stream_writer(args, spec, out):
         return None
     chunk_frames = options.chunk_frames if args.chunk_frames is None else args.chunk_frames
     return fmt.sink(out, views=options.vtk, every=options.every, chunk_frames=chunk_frames,
-                    resume=bool(args.resume), meta=dict(scenario=spec.source, name=spec.name))
+                    resume=bool(args.resume), overwrite=bool(args.overwrite),
+                    meta=dict(scenario=spec.source, name=spec.name))
 
 
 def _streamed(writer, result):

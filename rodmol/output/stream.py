@@ -64,13 +64,13 @@ class RunWriter:
     overwrite : bool
         Without ``resume``: replace an earlier run in ``directory`` (all of its
         files, :mod:`rodmol.output.run_files`); False refuses with a ParameterError
-        if there is one (``simulate(..., out=DIR)`` passes its ``overwrite``).
+        if there is one (the default; ``simulate(..., out=DIR)`` passes its ``overwrite``).
     meta : dict, optional
         Added to the Result's ``meta`` (e.g. the scenario's name).
     """
 
     def __init__(self, directory, *, views=True, every=None, chunk_frames=CHUNK_FRAMES, resume=False,
-                 overwrite=True, meta=None):
+                 overwrite=False, meta=None):
         if (every is not None and int(every) < 1) or int(chunk_frames) < 1:
             raise ParameterError(f"`every` and `chunk_frames` must be >= 1, got {every!r}, {chunk_frames!r}")
         self.directory = output_directory(directory, "out")
@@ -383,8 +383,8 @@ def _load_once():
 
 def write_xdmf(result, directory, every=None):
     """The ``"xdmf"`` format of :func:`rodmol.write_series`: ``result.h5`` and the XDMF
-    views of a finished Result; returns the path of ``rod.xdmf``."""
-    return RunWriter(directory, every=every).write_result(result)
+    views of a finished Result, replacing an earlier run there; returns the path of ``rod.xdmf``."""
+    return RunWriter(directory, every=every, overwrite=True).write_result(result)
 
 
 run_sinks.register_directory(RunWriter)  # simulate(out=DIR) streams into a RunWriter

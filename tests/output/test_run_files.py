@@ -58,6 +58,8 @@ def test_a_finished_run_is_kept_unless_overwrite(tmp_path, capsys):
         rodmol.simulate(model, 0.05, out=out)
     with pytest.raises(rodmol.ParameterError, match="rtol"):  # bad input: refused before the old run goes
         rodmol.simulate(model, 0.02, out=out, overwrite=True, rtol=-1.0)
+    with pytest.raises(rodmol.ParameterError, match="holds a finished run"):  # a writer made by hand too
+        rodmol.output.stream.RunWriter(out)
     assert {name: (out / name).read_bytes() for name in listing(out)} == before
     assert rodmol.simulate(model, 0.02, out=out, overwrite=True).success
     with pytest.raises(rodmol.ParameterError, match="either `resume` or `overwrite=True`"):
