@@ -61,9 +61,9 @@ from .result import Result
 from .rod import Rod
 from .scenario.file import ScenarioError, load_scenario
 from .simulate import default_atol, simulate, straight_state
-from .systems import Joint, System
 from .solve.backends import BACKENDS
 from .solve.equilibrium import equilibrium
+from .systems import Joint, System
 
 __all__ = [
     "BACKENDS", "Base", "BaseMotion", "Cable", "CapsuleContact", "DistributedForce",
