@@ -1,0 +1,272 @@
+"""The semi-discrete system of a :class:`rodmol.System`: rods and rigid
+bodies in one state vector, dy/dt = f(t, y).
+
+The state is the rods' states (each a :class:`SemiDiscrete`'s, in ``rods``
+order) followed by the bodies' blocks (in ``bodies`` order). A body's block
+(:data:`BODY_FIELDS`) holds the position x [m] of its origin (global), its
+quaternion Q (body to global) and, for a free body only, the velocity v
+[m/s] of its origin and its angular velocity w [rad/s], both in the body
+frame, as the rods' nodes. A fixed or driven body's velocities are not
+state: they are zero or its BaseMotion's, and its pose integrates them.
+
+Coupling (tree joints, the constraint eliminated): a rod clamped at point p
+with rotation Rj (base to body frame) of a body moving with (v, w) has the
+base velocities v0 = Rj^T (v + w x p), w0 = Rj^T w. A body feels, from each
+rod clamped to it, the total stress of the rod's cell 0 (with the cables)
+plus the base node's share of that cell's products (``Scheme.base_share``),
+the same force and moment that node 1 feels with the opposite sign: the pair
+is then the same as between any two nodes of a rod. The rod's header (u0,
+Q0) integrates v0, w0 as for a single rod: it is not tied to the body's pose
+but drifts from it by the integration error only (``pose_drift``).
+
+Newton-Euler of a body about its origin, body frame, with the momentum
+P = m (v + w x c) and H = I_o w + m c x v of its own mass:
+M [v_t, w_t] = [F - w x P, T - w x H - v x P], where the 6x6 mass matrix M
+adds the added mass (its gyroscopic terms are left out), F, T the rods'
+wrenches, weight minus buoyancy at the centre of mass and quadratic drag.
+"""
+
+import numpy as np
+from scipy import sparse
+
+from .layout import BlockLayout
+from .physics import quaternion_rate
+from .rotations import from_matrix, matrices
+from .stencil import WORK_TOTAL
+from .system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE, SemiDiscrete, field_scales
+
+#: Fields of a free body's block; a fixed or driven body holds the pose only.
+BODY_FIELDS = {"x": 3, "Q": 4, "v": 3, "w": 3}
+POSE_FIELDS = {"x": 3, "Q": 4}
+
+
+class BodyPart:
+    """One rigid body's place in the state and its constant data."""
+
+    def __init__(self, name, body, start):
+        self.name, self.body = name, body
+        self.layout = BlockLayout(1, dict(BODY_FIELDS if body.free else POSE_FIELDS))
+        self.slice = slice(start, start + self.layout.size)
+        self.fields = {f: slice(start + s.start, start + s.stop) for f, s in self.layout.slices().items()}
+        self.inverse_mass = np.linalg.inv(body.mass_matrix)
+        self.rigid_mass = body.mass_matrix - body.added_mass  # its own, for the momentum
+        self.rods = []  # (name, SemiDiscrete, point, rotation) of the rods clamped to it
+
+
+class Assembly:
+    """The method-of-lines system of a :class:`rodmol.System`.
+
+    Parameters
+    ----------
+    system : System
+    scheme : str or Scheme
+        The spatial scheme of every rod (``rodmol.SCHEMES``).
+
+    Attributes
+    ----------
+    rods : dict of str to SemiDiscrete
+        Each rod's system; a rod on a driven body or the world moves by its
+        own ``base`` (the body's motion carried to its clamp).
+    parts : dict of str to slice
+        Where each rod's and body's entries sit in the state.
+    size : int
+    """
+
+    def __init__(self, system, scheme=None):
+        self.system = system
+        self.rods, self.parts, self.bodies = {}, {}, {}
+        start = 0
+        for name in system.rods:
+            sd = SemiDiscrete(system.rods[name].replace(base=self._rod_base(name)),
+                              *(() if scheme is None else (scheme,)))
+            self.rods[name] = sd
+            self.parts[name] = slice(start, start + sd.size)
+            start += sd.size
+        self.scheme = next(iter(self.rods.values())).scheme
+        for name, body in system.bodies.items():
+            part = BodyPart(name, body, start)
+            for rod in system.rods_on(name):
+                _, point, rotation = system.clamps[rod]
+                part.rods.append((rod, self.rods[rod], np.asarray(point, dtype=float), np.asarray(rotation, dtype=float)))
+            self.bodies[name] = part
+            self.parts[name] = part.slice
+            start = part.slice.stop
+        self.size = start
+        self.free = [p for p in self.bodies.values() if p.body.free]
+        self.driven = [p for p in self.bodies.values() if p.body.driven]
+        self.lightly_damped = any(sd.lightly_damped for sd in self.rods.values())
+        self._gravity = system.gravity
+        self._fluid = system.medium.rho
+
+    def _rod_base(self, name):
+        """The Model ``base`` of rod ``name``: its clamp's pose, moving with a driven body."""
+        system = self.system
+        base = system.base_motion(name)
+        body = system.clamps.get(name, (None,))[0]
+        if body is None or not system.bodies[body].driven:
+            return base
+        _, point, rj = system.clamps[name]
+        motion = system.bodies[body].motion
+
+        def velocity(t):
+            v, w = motion.velocities(t)
+            return rj.T @ (v + np.cross(w, point))
+
+        def angular_velocity(t):
+            return rj.T @ motion.velocities(t)[1]
+
+        return type(base)(velocity, angular_velocity, base.position, base.rotation)
+
+    # ------------------------------------------------------------------ state
+
+    def initial_state(self):
+        """Every rod straight at rest at its base, every body at rest at its initial pose."""
+        y = np.zeros(self.size)
+        for name, sd in self.rods.items():
+            m = sd.model
+            y[self.parts[name]] = sd.layout.straight(m.s_nodes, np.asarray(m.base.position, dtype=float),
+                                                     np.asarray(m.base.rotation, dtype=float),
+                                                     from_matrix(np.asarray(m.base.rotation, dtype=float)))
+        for part in self.bodies.values():
+            y[part.fields["x"]] = part.body.position
+            y[part.fields["Q"]] = from_matrix(part.body.rotation)
+        return y
+
+    def body_velocities(self, part, t, y):
+        """(v, w) of a body's origin at (t, y) [m/s, rad/s], body frame."""
+        if part.body.free:
+            return y[part.fields["v"]], y[part.fields["w"]]
+        if part.body.driven:
+            return part.body.motion.velocities(t)
+        return np.zeros(3), np.zeros(3)
+
+    def project_quaternions(self, y):
+        """Scale every quaternion of the states ``y`` (..., size) to unit norm, in place."""
+        y = y.reshape(-1, self.size)
+        for name, sd in self.rods.items():
+            rod = np.ascontiguousarray(y[:, self.parts[name]])
+            sd.layout.project_quaternions(rod)
+            y[:, self.parts[name]] = rod
+        for part in self.bodies.values():
+            q = y[:, part.fields["Q"]]
+            y[:, part.fields["Q"]] = q / np.linalg.norm(q, axis=-1, keepdims=True)
+
+    # ------------------------------------------------------------------ evaluation
+
+    def __call__(self, t, y, out=None):
+        """dy/dt at (t, y); writes into ``out`` if given (CVODE's ``yp``)."""
+        if out is None:
+            out = np.empty(self.size)
+        for part in self.free:  # the rods' base velocities first
+            v, w = y[part.fields["v"]], y[part.fields["w"]]
+            for _, sd, point, rj in part.rods:
+                sd.base_velocities[:3] = rj.T @ (v + np.cross(w, point))
+                sd.base_velocities[3:] = rj.T @ w
+        for name, sd in self.rods.items():
+            sl = self.parts[name]
+            sd(t, y[sl], out[sl])
+        for part in self.bodies.values():
+            self._body_rates(part, t, y, out)
+        return out
+
+    def _body_rates(self, part, t, y, out):
+        quat = y[part.fields["Q"]]
+        r = matrices(quat)
+        v, w = self.body_velocities(part, t, y)
+        out[part.fields["x"]] = r @ v
+        out[part.fields["Q"]] = quaternion_rate(tuple(quat), tuple(w), QUATERNION_RESTORING_RATE)
+        if not part.body.free:
+            return
+        force, torque = self.body_wrench(part, y, r)
+        momentum = part.rigid_mass @ np.concatenate([v, w])
+        force -= np.cross(w, momentum[:3])
+        torque -= np.cross(w, momentum[3:]) + np.cross(v, momentum[:3])
+        rates = part.inverse_mass @ np.concatenate([force, torque])
+        out[part.fields["v"]], out[part.fields["w"]] = rates[:3], rates[3:]
+
+    def rod_wrench(self, sd, y_rod):
+        """Force and moment [N, N m] that rod ``sd`` puts on what holds its base,
+        local frame of the base, after a call of ``sd`` on the state ``y_rod``:
+        cell 0's total stress and the base node's share of its products."""
+        stress = sd._work[0, WORK_TOTAL:WORK_TOTAL + 6]
+        n, m = stress[:3], stress[3:]
+        first = sd.layout.blocks(y_rod)[0]
+        sl = sd.layout.slices()
+        q, k = first[sl["q"]], first[sl["k"]]
+        share = self.scheme.base_share * sd.model.ds
+        return n + share * np.cross(k, n), m + share * (np.cross(k, m) + np.cross(q, n))
+
+    def body_wrench(self, part, y, r):
+        """Total force and moment about the origin [N, N m] on a body, body frame
+        (``r``: its rotation matrix), after the rods' rates at ``y``."""
+        body = part.body
+        c = body.centre_of_mass
+        weight = (body.mass - self._fluid * body.volume) * (r.T @ self._gravity)
+        v, w = y[part.fields["v"]], y[part.fields["w"]]
+        v_c = v + np.cross(w, c)
+        drag = -body.drag[:3] * v_c * np.sqrt(v_c * v_c + DRAG_SMOOTHING_SPEED**2)
+        force = weight + drag
+        torque = np.cross(c, force) - body.drag[3:] * w * np.sqrt(w * w + DRAG_SMOOTHING_SPEED**2)
+        for name, sd, point, rj in part.rods:
+            n, m = self.rod_wrench(sd, y[self.parts[name]])
+            f = rj @ n
+            force += f
+            torque += rj @ m + np.cross(point, f)
+        return force, torque
+
+    # ------------------------------------------------------------------ structure
+
+    def pattern(self):
+        """Structural Jacobian pattern (scipy CSC, size x size): each rod's
+        pattern on the diagonal, each body's block, and for each rod clamped
+        to a free body its header and first element against the body's
+        velocities, and the body's velocity rows against that element."""
+        blocks = [sparse.csr_matrix(sd.pattern()) for sd in self.rods.values()]
+        blocks += [sparse.csr_matrix(np.ones((p.layout.size, p.layout.size), dtype=bool))
+                   for p in self.bodies.values()]
+        pat = sparse.block_diag(blocks, format="lil", dtype=bool)
+        for part in self.free:
+            velocity = np.r_[part.fields["v"], part.fields["w"]]
+            for name, sd, _, _ in part.rods:
+                start = self.parts[name].start
+                first = np.arange(start, start + sd.layout.header + sd.layout.block)
+                pat[np.ix_(first, velocity)] = True
+                pat[np.ix_(velocity, first)] = True
+        return pat.tocsc()
+
+    def atol_scale(self):
+        """Typical magnitude of each entry: the rods' own
+        (:meth:`SemiDiscrete.atol_scale`); a body's position the longest rod,
+        its velocity the slowest rod's speed scale, its angular velocity that
+        speed over the longest rod (:func:`field_scales`)."""
+        scales = [sd.atol_scale() for sd in self.rods.values()]
+        rods = [field_scales(sd.model) for sd in self.rods.values()]
+        length, speed = max(f["u"] for f in rods), min(f["v"] for f in rods)
+        per_field = {"x": length, "Q": 1.0, "v": speed, "w": speed / length}
+        for part in self.bodies.values():
+            scales.append(np.concatenate([np.full(n, per_field[f]) for f, n in part.layout.fields.items()]))
+        return np.concatenate(scales)
+
+    # ------------------------------------------------------------------ checks
+
+    def momentum(self, y):
+        """Total linear momentum [kg m/s] and angular momentum about the
+        global origin [kg m^2/s] of the bodies and rods, global, at the state
+        ``y``: the nodes' as their mass per length times the length each
+        stands for, at their integrated positions."""
+        linear, angular = np.zeros(3), np.zeros(3)
+        for name, sd in self.rods.items():
+            y_rod, lay = y[self.parts[name]], sd.layout
+            rot = matrices(lay.field(y_rod, "Q"))
+            lengths = sd.node_lengths[:, None]
+            p = np.einsum("nij,nj->ni", rot, sd.sampled.mass * lay.field(y_rod, "v") * lengths)
+            h = np.einsum("nij,nj->ni", rot, sd.sampled.inertia * lay.field(y_rod, "w") * lengths)
+            linear += p.sum(axis=0)
+            angular += (np.cross(lay.field(y_rod, "u"), p) + h).sum(axis=0)
+        for part in self.free:
+            r = matrices(y[part.fields["Q"]])
+            v, w = y[part.fields["v"]], y[part.fields["w"]]
+            momentum = part.rigid_mass @ np.concatenate([v, w])
+            linear += r @ momentum[:3]
+            angular += np.cross(y[part.fields["x"]], r @ momentum[:3]) + r @ momentum[3:]
+        return linear, angular
