@@ -218,12 +218,11 @@ class Assembly:
 
     def pattern(self):
         """Structural Jacobian pattern (scipy CSC, size x size): each rod's
-        pattern on the diagonal, each body's block, and for each rod clamped
+        pattern on the diagonal, each body's block (:func:`_body_pattern`), and for each rod clamped
         to a free body its header and first element against the body's
         velocities, and the body's velocity rows against that element."""
         blocks = [sparse.csr_matrix(sd.pattern()) for sd in self.rods.values()]
-        blocks += [sparse.csr_matrix(np.ones((p.layout.size, p.layout.size), dtype=bool))
-                   for p in self.bodies.values()]
+        blocks += [sparse.csr_matrix(_body_pattern(p)) for p in self.bodies.values()]
         pat = sparse.block_diag(blocks, format="lil", dtype=bool)
         for part in self.free:
             velocity = np.r_[part.fields["v"], part.fields["w"]]
@@ -270,3 +269,19 @@ class Assembly:
             linear += r @ momentum[:3]
             angular += np.cross(y[part.fields["x"]], r @ momentum[:3]) + r @ momentum[3:]
         return linear, angular
+
+
+def _body_pattern(part):
+    """A body block's own coupling: its quaternion rates read Q (the restoring
+    term), its position rates Q unless it is fixed, and a free body's pose
+    rates its velocities; its velocity rates read everything (gravity's
+    direction, gyroscopic terms)."""
+    sl, size = part.layout.slices(), part.layout.size
+    pat = np.zeros((size, size), dtype=bool)
+    pat[sl["Q"], sl["Q"]] = True
+    if part.body.motion != "fixed":
+        pat[sl["x"], sl["Q"]] = True
+    if "v" in sl:
+        pat[sl["x"], sl["v"]] = pat[sl["Q"], sl["w"]] = True
+        pat[sl["v"].start:, :] = True
+    return pat
