@@ -70,7 +70,7 @@ class SystemResult:
     def _rod(self, name):
         assembly = self.assembly
         sd, y_rod = assembly.rods[name], self.states[:, assembly.parts[name]]
-        held = next((part for part in assembly.free if any(r[0] == name for r in part.rods)), None)
+        held = next((part for part in assembly.free if name in part.rods), None)
         if held is not None:  # the same rod, its base moving as its body did at the frames
             sd = SemiDiscrete(sd.model.replace(base=self._recorded_base(name, held, sd.model.base)), sd.scheme)
         return from_states(sd, self.t, y_rod, self.success, self.message, dict(self.stats))
@@ -78,9 +78,10 @@ class SystemResult:
     def _recorded_base(self, name, part, base):
         """A BaseMotion replaying the base velocities of rod ``name`` on the free body
         ``part`` (exact at the frames, linear between them), local frame of the base."""
-        _, _, point, rj = next(r for r in part.rods if r[0] == name)
+        i = part.rods.index(name)
         v, w = self.states[:, part.fields["v"]], self.states[:, part.fields["w"]]
-        v0, w0 = (v + np.cross(w, point)) @ rj, w @ rj  # rows times Rj: Rj^T x per frame
+        moving = np.array([part.base_velocities(vk, wk)[i] for vk, wk in zip(v, w)]).reshape(-1, 6)
+        v0, w0 = moving[:, :3], moving[:, 3:]
         t = self.t
 
         def replay(values):

@@ -1,0 +1,98 @@
+"""What does an octopus cost? Eight of the paper's arms on a free head in
+water against one arm alone, at the same N and settings.
+
+The head is a sphere (radius 5 cm, 10% heavier than the water it displaces,
+with the added mass and drag of a sphere); the arms leave it radially in the
+horizontal plane, tilted 30 degrees down, and each pulls one cable with a
+0.2 s ramp to 1 N (alternately cable 1 and cable 3). The single arm is
+``paper_arm`` under the same cable input, clamped to the world, run as a
+Model (CVODE's own choice of linear solver) and as a one-rod System (the
+systems' sparse solver), all from the straight rest state. Reported: wall
+time, simulated seconds per wall second, right-hand side evaluations, and
+the ratio of the octopus's wall time to one arm's.
+
+    python solvers/octopus.py [--quick | --smoke] [--out DIR]
+"""
+
+import time
+
+import _common as C
+from _common import np, rodmol
+
+SCRIPT = "octopus.py"
+HEAD_RADIUS = 0.05  # m
+ARMS = 8
+
+
+def ramp(t):
+    return min(t / 0.2, 1.0)
+
+
+def arm(n, cable):
+    return rodmol.paper_arm(n, tensions={cable: ramp}, markers=())
+
+
+def head():
+    water = rodmol.MEDIA["water"].rho
+    volume = 4.0 / 3.0 * np.pi * HEAD_RADIUS**3
+    mass = 1.1 * water * volume
+    inertia = 0.4 * mass * HEAD_RADIUS**2
+    added = 0.5 * water * volume  # a sphere's added mass
+    drag = 0.5 * water * 0.47 * np.pi * HEAD_RADIUS**2  # C_d = 0.47
+    return rodmol.RigidBody(mass, (inertia,) * 3, volume=volume, added_mass=(added,) * 3 + (0.0,) * 3,
+                            drag=(drag,) * 3 + (1e-4,) * 3)
+
+
+def octopus(n):
+    rods, joints = {}, []
+    tilt = np.radians(30.0)
+    for i in range(ARMS):
+        angle = 2.0 * np.pi * i / ARMS
+        out = np.array([np.cos(angle) * np.cos(tilt), np.sin(angle) * np.cos(tilt), -np.sin(tilt)])
+        side = np.array([-np.sin(angle), np.cos(angle), 0.0])
+        frame = np.column_stack([out, side, np.cross(out, side)])  # the arm's base frame in the head's
+        rods[f"arm{i + 1}"] = arm(n, 1 if i % 2 == 0 else 3)
+        joints.append(rodmol.Joint(("head", HEAD_RADIUS * out, frame), (f"arm{i + 1}", "base")))
+    return rodmol.System(rods, {"head": head()}, joints, medium="water", gravity=(0.0, 0.0, -9.81))
+
+
+def timed(case, thing, t_end, **options):
+    start = time.perf_counter()
+    result = rodmol.simulate(thing, t_end, **options)
+    wall = time.perf_counter() - start
+    size = result.states.shape[1]
+    return dict(case=case, state_size=size, t_end_s=t_end, wall_s=wall, sim_s_per_wall_s=t_end / wall,
+                rhs_evals=result.stats["rhs_evals"], success=result.success), result
+
+
+def main(argv=None):
+    args = C.parse_args(__doc__.splitlines()[0], argv)
+    header = C.header_lines(args, SCRIPT)
+    n = C.pick(args, 30, 30, 8)
+    t_end = C.pick(args, 1.0, 0.3, 0.05)
+    single = arm(n, 1).replace(gravity=(0.0, 0.0, -9.81))
+    # Warm: the kernels compile on first use; every case below runs warm.
+    rodmol.simulate(rodmol.System({"a": arm(n, 1)}, medium="water", gravity=(0.0, 0.0, -9.81)), 0.01)
+    rodmol.simulate(single, 0.01, initial="straight")
+    rows = []
+    row, _ = timed("one arm, Model", single, t_end, initial="straight")
+    rows.append(row)
+    row, _ = timed("one arm, System", rodmol.System({"a": arm(n, 1)}, medium="water", gravity=(0.0, 0.0, -9.81)),
+                   t_end)
+    rows.append(row)
+    row, result = timed(f"octopus, {ARMS} arms + head", octopus(n), t_end)
+    rows.append(row)
+    for r in rows:
+        r["N"] = n
+        r["wall_vs_one_arm_model"] = r["wall_s"] / rows[0]["wall_s"]
+        print(r, flush=True)
+    drift = max(float(np.max(result.pose_drift(name)[0])) for name in result.assembly.rods)
+    notes = (f"Head at t_end: position {np.round(result['head'].position[-1], 4).tolist()} m, "
+             f"largest header-to-clamp drift of the arms {drift:.2e} m.\n")
+    fmt = {"wall_s": ".3g", "sim_s_per_wall_s": ".3g", "wall_vs_one_arm_model": ".2f", "t_end_s": ".3g"}
+    C.write_results(args, "octopus", "Octopus: eight arms on a free head against one arm", header, rows,
+                    [("Results", C.markdown_table(rows, None, fmt)), ("Notes", notes)])
+
+
+if __name__ == "__main__":
+    main()
