@@ -10,7 +10,7 @@ Model (CVODE's own choice of linear solver) and as a one-rod System; the
 octopus with both linear solvers of systems (the preconditioned GMRES, the
 default, and the sparse LU); all from the straight rest state. Reported: wall
 time, simulated seconds per wall second, right-hand side evaluations, and
-the ratio of the octopus's wall time to one arm's.
+the ratio of the octopus's wall time to one arm's (medians of --reps runs).
 
     python solvers/octopus.py [--quick | --smoke] [--out DIR]
 """
@@ -57,10 +57,14 @@ def octopus(n):
     return rodmol.System(rods, {"head": head()}, joints, medium="water", gravity=(0.0, 0.0, -9.81))
 
 
-def timed(case, thing, t_end, **options):
-    start = time.perf_counter()
-    result = rodmol.simulate(thing, t_end, **options)
-    wall = time.perf_counter() - start
+def timed(case, thing, t_end, reps, **options):
+    """Median wall time [s] of ``reps`` runs, and the last run."""
+    walls = []
+    for _ in range(reps):
+        start = time.perf_counter()
+        result = rodmol.simulate(thing, t_end, **options)
+        walls.append(time.perf_counter() - start)
+    wall = float(np.median(walls))
     size = result.states.shape[1]
     return dict(case=case, state_size=size, t_end_s=t_end, wall_s=wall, sim_s_per_wall_s=t_end / wall,
                 rhs_evals=result.stats["rhs_evals"], success=result.success), result
@@ -76,14 +80,14 @@ def main(argv=None):
     rodmol.simulate(rodmol.System({"a": arm(n, 1)}, medium="water", gravity=(0.0, 0.0, -9.81)), 0.01)
     rodmol.simulate(single, 0.01, initial="straight")
     rows = []
-    row, _ = timed("one arm, Model", single, t_end, initial="straight")
+    row, _ = timed("one arm, Model", single, t_end, args.reps, initial="straight")
     rows.append(row)
     row, _ = timed("one arm, System", rodmol.System({"a": arm(n, 1)}, medium="water", gravity=(0.0, 0.0, -9.81)),
-                   t_end)
+                   t_end, args.reps)
     rows.append(row)
-    row, _ = timed(f"octopus, {ARMS} arms + head, sparse LU", octopus(n), t_end, linsolver="sparse")
+    row, _ = timed(f"octopus, {ARMS} arms + head, sparse LU", octopus(n), t_end, args.reps, linsolver="sparse")
     rows.append(row)
-    row, result = timed(f"octopus, {ARMS} arms + head, GMRES", octopus(n), t_end)
+    row, result = timed(f"octopus, {ARMS} arms + head, GMRES", octopus(n), t_end, args.reps)
     rows.append(row)
     for r in rows:
         r["N"] = n

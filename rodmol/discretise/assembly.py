@@ -31,6 +31,7 @@ from scipy import sparse
 
 from .layout import BlockLayout
 from .physics import quaternion_rate
+from .rigid import clamp_wrench, free_body_rates, pack_body
 from .rotations import from_matrix, matrices
 from .stencil import WORK_TOTAL
 from .system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE, SemiDiscrete, field_scales
@@ -52,8 +53,9 @@ class BodyPart:
     clamps stacked for the coupling (points (n, 3) [m] and rotations (n, 3, 3),
     base to body frame)."""
 
-    def __init__(self, name, body, start):
+    def __init__(self, name, body, start, fluid_density):
         self.name, self.body = name, body
+        self.params = pack_body(body, fluid_density)
         self.layout = BlockLayout(1, dict(BODY_FIELDS if body.free else POSE_FIELDS))
         self.slice = slice(start, start + self.layout.size)
         self.fields = {f: slice(start + s.start, start + s.stop) for f, s in self.layout.slices().items()}
@@ -61,14 +63,17 @@ class BodyPart:
         self.rigid_mass = body.mass_matrix - body.added_mass  # its own, for the momentum
         self.rods, self.systems = [], []
         self.points, self.turns = np.zeros((0, 3)), np.zeros((0, 3, 3))
+        self.shares = np.zeros(0)  # the base node's share of cell 0 [m] (Scheme.base_share ds)
         self.strains = np.zeros((0, 6), dtype=np.int64)  # state indices of (q, k) of each rod's cell 0
 
     def clamp(self, name, sd, start, point, turn):
         """Hold the base of rod ``name`` (its system ``sd``, its state from ``start``)."""
+        self.shares = np.append(self.shares, sd.scheme.base_share * sd.model.ds)
         self.rods.append(name)
         self.systems.append(sd)
         self.points = np.vstack([self.points, point])
         self.turns = np.concatenate([self.turns, np.asarray(turn, dtype=float)[None]])
+        self.flat_turns = np.ascontiguousarray(self.turns.reshape(-1, 9))  # row-major, for the kernel
         sl, first = sd.layout.slices(), start + sd.layout.header
         index = np.r_[first + sl["q"].start:first + sl["q"].stop, first + sl["k"].start:first + sl["k"].stop]
         self.strains = np.vstack([self.strains, index])
@@ -112,7 +117,7 @@ class Assembly:
             start += sd.size
         self.scheme = next(iter(self.rods.values())).scheme
         for name, body in system.bodies.items():
-            part = BodyPart(name, body, start)
+            part = BodyPart(name, body, start, system.medium.rho)
             for rod in system.rods_on(name):
                 _, point, rotation = system.clamps[rod]
                 part.clamp(rod, self.rods[rod], self.parts[rod].start, point, rotation)
@@ -123,8 +128,7 @@ class Assembly:
         self.free = [p for p in self.bodies.values() if p.body.free]
         self.driven = [p for p in self.bodies.values() if p.body.driven]
         self.lightly_damped = any(sd.lightly_damped for sd in self.rods.values())
-        self._gravity = system.gravity
-        self._fluid = system.medium.rho
+        self._gravity = np.ascontiguousarray(system.gravity, dtype=float)
 
     def _rod_base(self, name):
         """The Model ``base`` of rod ``name``: its clamp's pose, moving with a driven body."""
@@ -196,49 +200,22 @@ class Assembly:
         return out
 
     def _body_rates(self, part, t, y, out):
-        quat = y[part.fields["Q"]]
-        r = matrices(quat)
-        v, w = self.body_velocities(part, t, y)
-        out[part.fields["x"]] = r @ v
-        out[part.fields["Q"]] = quaternion_rate(tuple(quat), tuple(w), QUATERNION_RESTORING_RATE)
-        if not part.body.free:
+        if part.body.free:
+            force, torque = self.body_wrench(part, y) if part.rods else ((0.0,) * 3, (0.0,) * 3)
+            free_body_rates(y[part.slice], part.params, part.rigid_mass, part.inverse_mass, self._gravity,
+                            force, torque, DRAG_SMOOTHING_SPEED**2, QUATERNION_RESTORING_RATE, out[part.slice])
             return
-        force, torque = self.body_wrench(part, y, r)
-        momentum = part.rigid_mass @ np.concatenate([v, w])
-        force -= _cross(w, momentum[:3])
-        torque -= _cross(w, momentum[3:]) + _cross(v, momentum[:3])
-        rates = part.inverse_mass @ np.concatenate([force, torque])
-        out[part.fields["v"]], out[part.fields["w"]] = rates[:3], rates[3:]
+        quat = y[part.fields["Q"]]
+        v, w = self.body_velocities(part, t, y)
+        out[part.fields["x"]] = matrices(quat) @ v
+        out[part.fields["Q"]] = quaternion_rate(tuple(quat), tuple(w), QUATERNION_RESTORING_RATE)
 
-    def rod_wrenches(self, part, y):
-        """(n, 3), (n, 3): force and moment [N, N m] that each rod clamped to
-        ``part`` puts on the body, local frame of its base, after the rods'
-        rates at ``y``: cell 0's total stress and the base node's share of its
-        products (``Scheme.base_share``)."""
+    def body_wrench(self, part, y):
+        """Force and moment about the origin [N, N m] of the rods clamped to
+        ``part``, body frame, after the rods' rates at ``y``
+        (:func:`rodmol.discretise.rigid.clamp_wrench`)."""
         stress = np.array([sd._work[0, WORK_TOTAL:WORK_TOTAL + 6] for sd in part.systems]).reshape(-1, 6)
-        n, m = stress[:, :3], stress[:, 3:]
-        strains = y[part.strains]
-        q, k = strains[:, :3], strains[:, 3:]
-        share = self.scheme.base_share * np.array([sd.model.ds for sd in part.systems])[:, None]
-        return n + share * _cross(k, n), m + share * (_cross(k, m) + _cross(q, n))
-
-    def body_wrench(self, part, y, r):
-        """Total force and moment about the origin [N, N m] on a body, body frame
-        (``r``: its rotation matrix), after the rods' rates at ``y``."""
-        body = part.body
-        c = body.centre_of_mass
-        weight = (body.mass - self._fluid * body.volume) * (r.T @ self._gravity)
-        v, w = y[part.fields["v"]], y[part.fields["w"]]
-        v_c = v + _cross(w, c)
-        drag = -body.drag[:3] * v_c * np.sqrt(v_c * v_c + DRAG_SMOOTHING_SPEED**2)
-        force = weight + drag
-        torque = _cross(c, force) - body.drag[3:] * w * np.sqrt(w * w + DRAG_SMOOTHING_SPEED**2)
-        if part.rods:
-            n, m = self.rod_wrenches(part, y)
-            f = np.einsum("rij,rj->ri", part.turns, n)
-            force = force + f.sum(axis=0)
-            torque = torque + (np.einsum("rij,rj->ri", part.turns, m) + _cross(part.points, f)).sum(axis=0)
-        return force, torque
+        return clamp_wrench(stress, np.ascontiguousarray(y[part.strains]), part.shares, part.flat_turns, part.points)
 
     # ------------------------------------------------------------------ structure
 
