@@ -130,3 +130,26 @@ def test_mirrored_pair_of_arms_leaves_the_head_unrotated():
 def test_what_systems_do_not_do_yet_is_refused_before_any_work(kwargs, match):
     with pytest.raises(rodmol.ParameterError, match=match):
         rodmol.simulate(rodmol.System({"arm": _arm()}), 0.1, **kwargs)
+
+
+def test_sinking_body_starts_at_its_net_weight_over_its_mass_and_ends_at_its_terminal_speed():
+    # A stiff rod (its axial waves cross it in 0.1 ms) of the fluid's density hanging straight
+    # down (no net weight, drag or added mass) rides along: the body starts at
+    # a = (m - rho V) g / (m + m_added + m_rod) and ends where its drag d v^2 balances its net
+    # weight. The rod's mass is 0.55% of the total: the first check sees it.
+    fluid = rodmol.Medium(rho=1000.0)
+    rod = rodmol.Rod(0.1, radius=0.005, material=rodmol.Material(E=1e9, nu=0.5, mu=1e4, rho=1000.0))
+    mass, volume, added, drag, g = 1.0, 5e-4, 0.3, 10.0, 9.81
+    body = rodmol.RigidBody(mass, (1e-3, 1e-3, 1e-3), volume=volume, added_mass=(added,) * 3 + (0.0,) * 3,
+                            drag=(drag,) * 3 + (0.0,) * 3)
+    down = np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]])  # the rod's x along -z
+    system = rodmol.System({"tail": rodmol.Model(rod, 6)}, {"body": body},
+                           [rodmol.Joint(("body", (0.0, 0.0, 0.0), down), ("tail", "base"))],
+                           medium=fluid, gravity=(0.0, 0.0, -g))
+    run = rodmol.simulate(system, 1.0, rtol=1e-7, output_times=[0.002])
+    weight = (mass - 1000.0 * volume) * g
+    rod_mass = 1000.0 * np.pi * 0.005**2 * 0.1 * (1 - 0.5 / 6)  # the nodes' (half a cell at the base is not)
+    speed = -run["body"].velocity[:, 2]
+    assert speed[1] / 0.002 == pytest.approx(weight / (mass + added + rod_mass), rel=2e-3)
+    assert speed[-1] == pytest.approx(np.sqrt(weight / drag), rel=1e-4)
+    np.testing.assert_allclose(run["body"].position[-1, :2], 0.0, atol=1e-9)
