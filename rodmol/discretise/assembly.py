@@ -62,6 +62,7 @@ class BodyPart:
         self.inverse_mass = np.linalg.inv(body.mass_matrix)
         self.rigid_mass = body.mass_matrix - body.added_mass  # its own, for the momentum
         self.rods, self.systems = [], []
+        self.works = []  # each rod kernel's scratch: cell 0's total stress after a call (stencil.rhs)
         self.points, self.turns = np.zeros((0, 3)), np.zeros((0, 3, 3))
         self.shares = np.zeros(0)  # the base node's share of cell 0 [m] (Scheme.base_share ds)
         self.strains = np.zeros((0, 6), dtype=np.int64)  # state indices of (q, k) of each rod's cell 0
@@ -71,6 +72,7 @@ class BodyPart:
         self.shares = np.append(self.shares, sd.scheme.base_share * sd.model.ds)
         self.rods.append(name)
         self.systems.append(sd)
+        self.works.append(sd.kernel_arguments()[-1])
         self.points = np.vstack([self.points, point])
         self.turns = np.concatenate([self.turns, np.asarray(turn, dtype=float)[None]])
         self.flat_turns = np.ascontiguousarray(self.turns.reshape(-1, 9))  # row-major, for the kernel
@@ -214,7 +216,7 @@ class Assembly:
         """Force and moment about the origin [N, N m] of the rods clamped to
         ``part``, body frame, after the rods' rates at ``y``
         (:func:`rodmol.discretise.rigid.clamp_wrench`)."""
-        stress = np.array([sd._work[0, WORK_TOTAL:WORK_TOTAL + 6] for sd in part.systems]).reshape(-1, 6)
+        stress = np.array([work[0, WORK_TOTAL:WORK_TOTAL + 6] for work in part.works]).reshape(-1, 6)
         return clamp_wrench(stress, np.ascontiguousarray(y[part.strains]), part.shares, part.flat_turns, part.points)
 
     # ------------------------------------------------------------------ structure
