@@ -48,6 +48,14 @@ def _cross(a, b):
                      a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
 
 
+def clamp_velocities(points, turns, v, w):
+    """(n, 6) base velocities (v0, w0) = (Rj^T (v + w x p), Rj^T w) of rods
+    clamped at ``points`` (n, 3) [m] with ``turns`` (n, 3, 3) (base to body
+    frame) to a body moving with (v, w) (body frame): local frames of the bases."""
+    return np.concatenate([np.einsum("rji,rj->ri", turns, v + _cross(w, points)),
+                           np.einsum("rji,j->ri", turns, np.broadcast_to(w, 3))], axis=1)
+
+
 class BodyPart:
     """One rigid body's place in the state, its constant data and its rods'
     clamps stacked for the coupling (points (n, 3) [m] and rotations (n, 3, 3),
@@ -81,11 +89,8 @@ class BodyPart:
         self.strains = np.vstack([self.strains, index])
 
     def base_velocities(self, v, w):
-        """(n, 6) base velocities (v0, w0) of the rods, local frames of their bases,
-        for the body velocities (v, w) (body frame)."""
-        turns = self.turns
-        return np.concatenate([np.einsum("rji,rj->ri", turns, v + _cross(w, self.points)),
-                               np.einsum("rji,j->ri", turns, np.broadcast_to(w, 3))], axis=1)
+        """(n, 6) base velocities of the rods for the body velocities (v, w) (:func:`clamp_velocities`)."""
+        return clamp_velocities(self.points, self.turns, v, w)
 
 
 class Assembly:
@@ -128,7 +133,6 @@ class Assembly:
             start = part.slice.stop
         self.size = start
         self.free = [p for p in self.bodies.values() if p.body.free]
-        self.driven = [p for p in self.bodies.values() if p.body.driven]
         self.lightly_damped = any(sd.lightly_damped for sd in self.rods.values())
         self._gravity = np.ascontiguousarray(system.gravity, dtype=float)
 
@@ -142,14 +146,10 @@ class Assembly:
         _, point, rj = system.clamps[name]
         motion = system.bodies[body].motion
 
-        def velocity(t):
-            v, w = motion.velocities(t)
-            return rj.T @ (v + _cross(w, point))
+        def velocities(t):
+            return clamp_velocities(point[None], rj[None], *motion.velocities(t))[0]
 
-        def angular_velocity(t):
-            return rj.T @ motion.velocities(t)[1]
-
-        return type(base)(velocity, angular_velocity, base.position, base.rotation)
+        return type(base)(lambda t: velocities(t)[:3], lambda t: velocities(t)[3:], base.position, base.rotation)
 
     # ------------------------------------------------------------------ state
 
