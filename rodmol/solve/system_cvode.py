@@ -36,8 +36,9 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, linsolver="gmres", max_step
     damped (``SemiDiscrete.lightly_damped``), else 5, as for one rod.
 
     Returns (t (n,), states (n, size), success, message, stats, error): the
-    frames reached; on failure ``message`` says where and why and ``error``
-    holds the exception that stopped it (a user function's), if any.
+    output frames reached; on failure (CVODE's, a user function's exception,
+    Ctrl-C) ``message`` says after which output time and why, and ``error``
+    holds the exception that stopped it, if any.
     """
     from sksundae.cvode import CVODE, CVODEPrecond
 
@@ -60,23 +61,29 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, linsolver="gmres", max_step
         precond = SystemPreconditioner(assembly, np.broadcast_to(atol, (assembly.size,)) / rtol)
         options.update(precond=CVODEPrecond(precond.setup, precond.solve, "left"), krylov_dim=KRYLOV_DIM)
     t_out = np.asarray(t_out, dtype=float)
-    # Two times: CVODE would return its internal steps; a midpoint keeps the frames ours.
-    span = t_out if len(t_out) > 2 else np.array([t_out[0], 0.5 * (t_out[0] + t_out[1]), t_out[1]])
     start = time.perf_counter()
-    error = None
-    try:
-        solution = CVODE(rhs, **options).solve(span, np.array(y0, dtype=float))
-    except Exception as exc:  # noqa: BLE001 (a user function's: reported with the frames before)
-        return (t_out[:1], np.array(y0, dtype=float)[None], False,
-                f"CVODE stopped: {cause(exc, float(t_out[0]))}", dict(rhs_evals=evals[0]), exc)
-    t, y = np.asarray(solution.t), np.array(solution.y)
-    if len(t_out) == 2:
-        keep = np.isin(t, t_out)
-        t, y = t[keep], y[keep]
+    frames, message, error, jac_evals = [np.array(y0, dtype=float)], "", None, 0
+    solver = CVODE(rhs, **options)
+    solver.init_step(float(t_out[0]), frames[0])
+    for t_k in t_out[1:]:
+        reached = float(t_out[len(frames) - 1])
+        try:
+            r = solver.step(float(t_k))
+        except KeyboardInterrupt:
+            message = f"CVODE interrupted after t = {reached:.6g} s"
+            break
+        except Exception as exc:  # noqa: BLE001 (a user function's: reported with the frames before)
+            message, error = f"CVODE stopped after t = {reached:.6g} s: {cause(exc)}", exc
+            break
+        if not r.success:
+            message = f"CVODE stopped after t = {reached:.6g} s: {r.message}"
+            break
+        frames.append(np.array(r.y))
+        jac_evals = int(r.njev)
+    t, y = t_out[:len(frames)], np.array(frames)
     assembly.project_quaternions(y)
-    success = bool(solution.success) and len(t) == len(t_out)
-    message = "" if success else f"CVODE stopped at t = {t[-1]:.6g} s: {solution.message}"
-    stats = dict(rhs_evals=evals[0], jac_evals=int(solution.njev), linear_solver=linsolver,
+    success = len(t) == len(t_out)
+    stats = dict(rhs_evals=evals[0], jac_evals=jac_evals, linear_solver=linsolver,
                  wall_time_s=time.perf_counter() - start)
     if precond is not None:
         stats.update(jac_evals=precond.jac_evals, prec_setups=precond.setups, prec_solves=precond.solves)
