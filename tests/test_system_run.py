@@ -111,6 +111,9 @@ def test_mirrored_pair_of_arms_leaves_the_head_unrotated():
     assert np.abs(run["right"].angular_velocity).max() > 1.0
     assert np.abs(head.angular_velocity).max() < 1e-4
     np.testing.assert_allclose(run["left"].tip[:, 0], -run["right"].tip[:, 0], atol=1e-6)
+    # The rod's Result on a free body: its base moves with the head's clamp (v + w x p, Rj = I).
+    clamp = head.velocity + np.cross(head.angular_velocity, [0.02, 0.0, 0.0])
+    np.testing.assert_allclose(run["right"].velocity[:, 0], clamp, atol=1e-12)
     distance, angle = run.pose_drift("right")
     assert distance.max() < 1e-5 * 0.2 and angle.max() < 1e-4
     # The sparse direct solver of the whole Newton matrix agrees with the preconditioned GMRES.
