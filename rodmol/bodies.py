@@ -14,7 +14,7 @@ MOTIONS = ("free", "fixed")
 _IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # compared by identity: its fields are arrays
 class RigidBody:
     """A rigid body: a head, a platform, a payload.
 
@@ -107,6 +107,7 @@ class RigidBody:
 
     @property
     def free(self):
+        """True if the body moves freely in 6 DOF."""
         return isinstance(self.motion, str) and self.motion == "free"
 
     @classmethod

@@ -154,7 +154,8 @@ class System:
                                          "`base` moves: drop the joint or the motion")
                 clamps[rod] = (None, np.array(base.position, dtype=float), np.array(base.rotation, dtype=float))
                 continue
-            if base != BaseMotion():
+            if not base.fixed or np.any(np.asarray(base.position, dtype=float) != 0.0) or not np.array_equal(
+                    np.asarray(base.rotation, dtype=float), np.eye(3)):
                 raise ParameterError(f"rod {rod!r} is clamped to body {other[1]!r}, so its Model's `base` "
                                      f"must be the default (the body gives its pose and motion), got {base!r}")
             clamps[rod] = (other[1], other[2], other[3])
