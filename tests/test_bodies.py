@@ -14,6 +14,7 @@ _CUBE = np.array([[0, 2, 3], [0, 3, 1], [4, 5, 7], [4, 7, 6], [0, 1, 5], [0, 5, 
 _CORNERS = np.array([[(i >> 2) & 1, (i >> 1) & 1, i & 1] for i in range(8)], dtype=float)
 
 
+@pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")  # meshio's binary-STL size probe
 def test_box_from_an_stl_file_has_the_analytic_mass_properties(tmp_path):
     size, corner, density = np.array([0.3, 0.2, 0.1]), np.array([1.0, -2.0, 0.5]), 700.0
     path = tmp_path / "box.stl"
