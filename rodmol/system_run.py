@@ -2,8 +2,8 @@
 :func:`rodmol.simulate`: in memory, from rest, with CVODE.
 
 Not yet for systems (each raises :class:`rodmol.errors.NotSupportedYet`):
-the equilibrium start, streamed output (``out``), ``resume``, the other
-backends, ``progress`` and ``max_wall_time``.
+the equilibrium start, streamed output (``out``), ``resume``, ``overwrite``
+and the other backends. ``progress`` is reported at the output times only.
 """
 
 import warnings
@@ -28,8 +28,7 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
     straight at its base, every body at rest at its pose) or from a state
     vector (``SystemResult.states[k]``); the other arguments as for
     :func:`rodmol.simulate`. Returns a :class:`rodmol.system_result.SystemResult`."""
-    for name, value, unset in (("out", out, None), ("resume", resume, False), ("overwrite", overwrite, False),
-                               ("progress", progress, None), ("max_wall_time", max_wall_time, None)):
+    for name, value, unset in (("out", out, None), ("resume", resume, False), ("overwrite", overwrite, False)):
         if value is not unset:
             raise NotSupportedYet(f"`{name}` is not supported yet for systems (in-memory runs only)")
     if isinstance(initial, str) and initial == "equilibrium":
@@ -37,6 +36,7 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
     if backend not in (None, "cvode"):
         raise NotSupportedYet(f"`backend` {backend!r} is not supported yet for systems: use 'cvode'")
     checked = options.backend_options("cvode", cvode_system, backend_options)
+    progress, max_wall_time = options.progress(progress), options.max_wall_time(max_wall_time)
     scheme = get_scheme(DEFAULT_SCHEME if scheme is None else scheme)
     rtol = options.rtol(scheme.default_rtol if rtol is None else rtol)
     t0 = 0.0 if t0 is None else _checks.non_negative("t0", t0, " s")
@@ -55,7 +55,18 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
     atol = rtol * assembly.atol_scale() if atol is None else _sized("atol", atol, assembly.size)
     if np.any(atol <= 0):
         raise ParameterError("`atol` must be > 0")
-    t, y, success, message, stats, error = cvode_system(assembly, y0, t_out, rtol=rtol, atol=atol, **checked)
+    owned = progress is True
+    if owned:
+        from ._progress import Progress
+
+        progress = Progress()
+    try:
+        t, y, success, message, stats, error = cvode_system(assembly, y0, t_out, rtol=rtol, atol=atol,
+                                                            progress=progress, max_wall_time=max_wall_time,
+                                                            **checked)
+    finally:
+        if owned:
+            progress.close()
     if not success:
         warnings.warn(message, RuntimeWarning, stacklevel=3)
     return SystemResult(assembly, t, y, success, message, stats, error)

@@ -139,6 +139,16 @@ def test_a_failing_input_ends_the_run_with_the_frames_before_it():
     assert run["arm"].positions.shape[0] == len(run.t) and np.all(np.isfinite(run.states))
 
 
+def test_progress_sees_every_output_and_the_wall_time_budget_stops_the_run():
+    seen = []
+    run = rodmol.simulate(rodmol.System({"arm": _arm()}), 0.05, output_dt=0.01,
+                          progress=lambda t, t_end: seen.append((t, t_end)))
+    assert run.success and [t for t, _ in seen] == pytest.approx(list(run.t)) and {e for _, e in seen} == {0.05}
+    with pytest.warns(RuntimeWarning, match="wall-time budget"):
+        stopped = rodmol.simulate(rodmol.System({"arm": _arm()}), 10.0, max_wall_time=1e-9)
+    assert not stopped.success and len(stopped.t) == 1
+
+
 @pytest.mark.parametrize("kwargs, match", [
     (dict(out="somewhere"), "`out` is not supported yet"),
     (dict(initial="equilibrium"), "equilibrium"),

@@ -28,9 +28,17 @@ SYSTEM_LINEAR_SOLVERS = ("sparse", "gmres", "dense")
 KRYLOV_DIM = 5
 
 
-def cvode_system(assembly, y0, t_out, *, rtol, atol, linsolver="gmres", max_step=0.0, max_order="auto"):
+class _OutOfTime(Exception):
+    """Raised inside the right-hand side when the wall-time budget is used up."""
+
+
+def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, linsolver="gmres",
+                 max_step=0.0, max_order="auto"):
     """Integrate ``assembly`` from ``y0`` at ``t_out[0]`` through the output
     times ``t_out`` [s].
+
+    ``progress(t, t_end)`` is called at each output time; ``max_wall_time``
+    [s] is checked at every right-hand side, and ends the run when used up.
 
     ``max_order`` caps the BDF order; ``"auto"`` is 2 when a rod is lightly
     damped (``SemiDiscrete.lightly_damped``), else 5, as for one rod.
@@ -50,6 +58,8 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, linsolver="gmres", max_step
 
     def rhs(t, y, yp):
         evals[0] += 1
+        if max_wall_time is not None and time.perf_counter() - start > max_wall_time:
+            raise _OutOfTime
         assembly(t, y, yp)
 
     options = dict(method="BDF", rtol=rtol, atol=atol, linsolver=linsolver, max_num_steps=1_000_000,
@@ -62,6 +72,8 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, linsolver="gmres", max_step
         options.update(precond=CVODEPrecond(precond.setup, precond.solve, "left"), krylov_dim=KRYLOV_DIM)
     t_out = np.asarray(t_out, dtype=float)
     start = time.perf_counter()
+    if progress is not None:
+        progress(float(t_out[0]), float(t_out[-1]))
     frames, message, error, jac_evals = [np.array(y0, dtype=float)], "", None, 0
     solver = CVODE(rhs, **options)
     solver.init_step(float(t_out[0]), frames[0])
@@ -72,6 +84,9 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, linsolver="gmres", max_step
         except KeyboardInterrupt:
             message = f"CVODE interrupted after t = {reached:.6g} s"
             break
+        except _OutOfTime:
+            message = f"CVODE stopped after t = {reached:.6g} s: the wall-time budget max_wall_time = {max_wall_time:g} s is used up"
+            break
         except Exception as exc:  # noqa: BLE001 (a user function's: reported with the frames before)
             message, error = f"CVODE stopped after t = {reached:.6g} s: {cause(exc)}", exc
             break
@@ -80,6 +95,12 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, linsolver="gmres", max_step
             break
         frames.append(np.array(r.y))
         jac_evals = int(r.njev)
+        if progress is not None:
+            try:
+                progress(float(t_k), float(t_out[-1]))
+            except Exception as exc:  # noqa: BLE001 (the user's callable, guarded: a UserFunctionError)
+                message, error = f"CVODE stopped at t = {float(t_k):.6g} s: {cause(exc)}", exc
+                break
     t, y = t_out[:len(frames)], np.array(frames)
     assembly.project_quaternions(y)
     success = len(t) == len(t_out)
