@@ -3,9 +3,12 @@ water against one arm alone, at the same N and settings.
 
 The head is a sphere (radius 5 cm, 10% heavier than the water it displaces,
 with the added mass and drag of a sphere); the arms leave it radially in the
-horizontal plane, tilted 30 degrees down, and each pulls one cable with a
-0.2 s ramp to 1 N (alternately cable 1 and cable 3). The single arm is
-``paper_arm`` under the same cable input, clamped to the world, run as a
+horizontal plane, tilted 30 degrees down, and each pulls one cable
+(alternately cable 1 and cable 3) with one of two patterns: ``ramp``, a 0.2
+s ramp to 1 N then held (the arms come to rest while the head sinks), and
+``pulsing``, 1 N (1 - cos(2 pi f t + phase)) / 2 at f = 2 Hz with the arms'
+phases spread over a period (every arm keeps moving). The single arm is
+``paper_arm`` under the same cable input (phase 0), clamped to the world, run as a
 Model (CVODE's own choice of linear solver) and as a one-rod System; the
 octopus with both linear solvers of systems (the preconditioned GMRES, the
 default, and the sparse LU); all from the straight rest state. Reported: wall
@@ -25,12 +28,22 @@ HEAD_RADIUS = 0.05  # m
 ARMS = 8
 
 
-def ramp(t):
-    return min(t / 0.2, 1.0)
+PULSE_HZ = 2.0
 
 
-def arm(n, cable):
-    return rodmol.paper_arm(n, tensions={cable: ramp}, markers=())
+def ramp(phase):
+    return lambda t: min(t / 0.2, 1.0)
+
+
+def pulsing(phase):
+    return lambda t: 0.5 * (1.0 - np.cos(2.0 * np.pi * PULSE_HZ * t + phase))
+
+
+PATTERNS = {"ramp": ramp, "pulsing": pulsing}
+
+
+def arm(n, cable, tension):
+    return rodmol.paper_arm(n, tensions={cable: tension}, markers=())
 
 
 def head():
@@ -44,7 +57,7 @@ def head():
                             drag=(drag,) * 3 + (1e-4,) * 3)
 
 
-def octopus(n):
+def octopus(n, pattern):
     rods, joints = {}, []
     tilt = np.radians(30.0)
     for i in range(ARMS):
@@ -52,7 +65,7 @@ def octopus(n):
         out = np.array([np.cos(angle) * np.cos(tilt), np.sin(angle) * np.cos(tilt), -np.sin(tilt)])
         side = np.array([-np.sin(angle), np.cos(angle), 0.0])
         frame = np.column_stack([out, side, np.cross(out, side)])  # the arm's base frame in the head's
-        rods[f"arm{i + 1}"] = arm(n, 1 if i % 2 == 0 else 3)
+        rods[f"arm{i + 1}"] = arm(n, 1 if i % 2 == 0 else 3, pattern(2.0 * np.pi * i / ARMS))
         joints.append(rodmol.Joint(("head", HEAD_RADIUS * out, frame), (f"arm{i + 1}", "base")))
     return rodmol.System(rods, {"head": head()}, joints, medium="water", gravity=(0.0, 0.0, -9.81))
 
@@ -75,27 +88,27 @@ def main(argv=None):
     header = C.header_lines(args, SCRIPT)
     n = C.pick(args, 30, 30, 8)
     t_end = C.pick(args, 1.0, 0.3, 0.05)
-    single = arm(n, 1).replace(gravity=(0.0, 0.0, -9.81))
+    water = dict(medium="water", gravity=(0.0, 0.0, -9.81))
     # Warm: the kernels compile on first use; every case below runs warm.
-    rodmol.simulate(rodmol.System({"a": arm(n, 1)}, medium="water", gravity=(0.0, 0.0, -9.81)), 0.01)
-    rodmol.simulate(single, 0.01, initial="straight")
-    rows = []
-    row, _ = timed("one arm, Model", single, t_end, args.reps, initial="straight")
-    rows.append(row)
-    row, _ = timed("one arm, System", rodmol.System({"a": arm(n, 1)}, medium="water", gravity=(0.0, 0.0, -9.81)),
-                   t_end, args.reps)
-    rows.append(row)
-    row, _ = timed(f"octopus, {ARMS} arms + head, sparse LU", octopus(n), t_end, args.reps, linsolver="sparse")
-    rows.append(row)
-    row, result = timed(f"octopus, {ARMS} arms + head, GMRES", octopus(n), t_end, args.reps)
-    rows.append(row)
-    for r in rows:
-        r["N"] = n
-        r["wall_vs_one_arm_model"] = r["wall_s"] / rows[0]["wall_s"]
-        print(r, flush=True)
-    drift = max(float(np.max(result.pose_drift(name)[0])) for name in result.assembly.rods)
-    notes = (f"Head at t_end: position {np.round(result['head'].position[-1], 4).tolist()} m, "
-             f"largest header-to-clamp drift of the arms {drift:.2e} m.\n")
+    rodmol.simulate(rodmol.System({"a": arm(n, 1, ramp(0.0))}, **water), 0.01)
+    rodmol.simulate(arm(n, 1, ramp(0.0)), 0.01, initial="straight")
+    rows, notes = [], ""
+    for name, pattern in PATTERNS.items():
+        single = arm(n, 1, pattern(0.0)).replace(gravity=water["gravity"])
+        cases = [("one arm, Model", single, dict(initial="straight")),
+                 ("one arm, System", rodmol.System({"a": arm(n, 1, pattern(0.0))}, **water), {}),
+                 (f"octopus, {ARMS} arms + head, sparse LU", octopus(n, pattern), dict(linsolver="sparse")),
+                 (f"octopus, {ARMS} arms + head, GMRES", octopus(n, pattern), {})]
+        first = len(rows)
+        for case, thing, options in cases:
+            row, result = timed(case, thing, t_end, args.reps, **options)
+            row = dict(pattern=name, **row, N=n)
+            row["wall_vs_one_arm_model"] = row["wall_s"] / (rows[first]["wall_s"] if rows[first:] else row["wall_s"])
+            rows.append(row)
+            print(row, flush=True)
+        drift = max(float(np.max(result.pose_drift(rod)[0])) for rod in result.assembly.rods)
+        notes += (f"- {name}: head at t_end {np.round(result['head'].position[-1], 4).tolist()} m, "
+                  f"largest header-to-clamp drift of the arms {drift:.2e} m.\n")
     fmt = {"wall_s": ".3g", "sim_s_per_wall_s": ".3g", "wall_vs_one_arm_model": ".2f", "t_end_s": ".3g"}
     C.write_results(args, "octopus", "Octopus: eight arms on a free head against one arm", header, rows,
                     [("Results", C.markdown_table(rows, None, fmt)), ("Notes", notes)])
