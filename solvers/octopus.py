@@ -13,7 +13,8 @@ Model (CVODE's own choice of linear solver) and as a one-rod System; the
 octopus with both linear solvers of systems (the preconditioned GMRES, the
 default, and the sparse LU); all from the straight rest state. Reported: wall
 time, simulated seconds per wall second, right-hand side evaluations, and
-the ratio of the octopus's wall time to one arm's (medians of --reps runs).
+the ratio of the octopus's wall time to one arm's (medians of --reps rounds,
+each round running every case once).
 
     python solvers/octopus.py [--quick | --smoke] [--out DIR]
 """
@@ -70,17 +71,25 @@ def octopus(n, pattern):
     return rodmol.System(rods, {"head": head()}, joints, medium="water", gravity=(0.0, 0.0, -9.81))
 
 
-def timed(case, thing, t_end, reps, **options):
-    """Median wall time [s] of ``reps`` runs, and the last run."""
-    walls = []
+def timed(cases, t_end, reps):
+    """Rows of the ``cases`` (label, model or system, simulate options): median
+    wall times [s] of ``reps`` rounds, each round running every case once (so
+    that a change of the shared machine's load falls on all of them); and the
+    last case's last result."""
+    walls = {label: [] for label, _, _ in cases}
     for _ in range(reps):
-        start = time.perf_counter()
-        result = rodmol.simulate(thing, t_end, **options)
-        walls.append(time.perf_counter() - start)
-    wall = float(np.median(walls))
-    size = result.states.shape[1]
-    return dict(case=case, state_size=size, t_end_s=t_end, wall_s=wall, sim_s_per_wall_s=t_end / wall,
-                rhs_evals=result.stats["rhs_evals"], success=result.success), result
+        for label, thing, options in cases:
+            start = time.perf_counter()
+            rodmol.simulate(thing, t_end, **options)
+            walls[label].append(time.perf_counter() - start)
+    rows = []
+    for label, thing, options in cases:
+        result = rodmol.simulate(thing, t_end, **options)  # for its statistics
+        wall = float(np.median(walls[label]))
+        rows.append(dict(case=label, state_size=result.states.shape[1], t_end_s=t_end, wall_s=wall,
+                         sim_s_per_wall_s=t_end / wall, rhs_evals=result.stats["rhs_evals"],
+                         success=result.success))
+    return rows, result
 
 
 def main(argv=None):
@@ -99,11 +108,9 @@ def main(argv=None):
                  ("one arm, System", rodmol.System({"a": arm(n, 1, pattern(0.0))}, **water), {}),
                  (f"octopus, {ARMS} arms + head, sparse LU", octopus(n, pattern), dict(linsolver="sparse")),
                  (f"octopus, {ARMS} arms + head, GMRES", octopus(n, pattern), {})]
-        first = len(rows)
-        for case, thing, options in cases:
-            row, result = timed(case, thing, t_end, args.reps, **options)
-            row = dict(pattern=name, **row, N=n)
-            row["wall_vs_one_arm_model"] = row["wall_s"] / (rows[first]["wall_s"] if rows[first:] else row["wall_s"])
+        timed_rows, result = timed(cases, t_end, args.reps)
+        for row in timed_rows:
+            row = dict(pattern=name, **row, N=n, wall_vs_one_arm_model=row["wall_s"] / timed_rows[0]["wall_s"])
             rows.append(row)
             print(row, flush=True)
         drift = max(float(np.max(result.pose_drift(rod)[0])) for rod in result.assembly.rods)

@@ -198,10 +198,12 @@ class Assembly:
             sl = self.parts[name]
             sd(t, y[sl], out[sl])
         for part in self.bodies.values():
-            self._body_rates(part, t, y, out)
+            self.body_rates(part, t, y, out)
         return out
 
-    def _body_rates(self, part, t, y, out):
+    def body_rates(self, part, t, y, out):
+        """The rates of body ``part``'s block at (t, y) into ``out`` (the whole
+        state's rates), after the rods' rates at y (their cell 0's stress)."""
         if part.body.free:
             force, torque = self.body_wrench(part, y) if part.rods else ((0.0,) * 3, (0.0,) * 3)
             free_body_rates(y[part.slice], part.params, part.rigid_mass, part.inverse_mass, self._gravity,

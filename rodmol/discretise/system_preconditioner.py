@@ -4,8 +4,9 @@ rods and rigid bodies (:class:`rodmol.discretise.assembly.Assembly`).
 Each rod gets its own exact block preconditioner
 (:class:`rodmol.discretise.preconditioner.BlockPreconditioner`), its base
 velocities held at the state's; each body its block (I - gamma J_bb),
-J_bb by differences of the full right-hand side in the body's own entries,
-inverted directly. The joints' coupling blocks are left out: GMRES's
+inverted directly, J_bb by differences in the body's own entries: of the
+full right-hand side in its velocities (they move the rods' bases), of its
+own rates in its rotation, none in its position (no rate reads it). The joints' coupling blocks are left out: GMRES's
 products J v are differences of the full right-hand side, so it sees them,
 only converging in more iterations.
 """
@@ -27,6 +28,7 @@ class SystemPreconditioner:
         self._steps = {p.name: BODY_STEP * np.maximum(scale[p.slice], 1e-300) for p in self.bodies}
         self._jac = {p.name: np.zeros((p.layout.size, p.layout.size)) for p in self.bodies}
         self._inverse = {p.name: np.eye(p.layout.size) for p in self.bodies}
+        self._field_of = {p.name: [f for f, n in p.layout.fields.items() for _ in range(n)] for p in self.bodies}
         self._out = np.empty(assembly.size)
         self.jac_evals = self.setups = self.solves = 0
 
@@ -41,10 +43,17 @@ class SystemPreconditioner:
                 prec.jacobian.evaluate(t, y[parts[name]], fy[parts[name]])
             z = np.array(y)
             for part in self.bodies:
+                assembly(t, y, self._out)  # the rods' stress at y (their Jacobians and other bodies moved it)
                 jac, steps = self._jac[part.name], self._steps[part.name]
                 for j, index in enumerate(range(part.slice.start, part.slice.stop)):
+                    field = self._field_of[part.name][j]
+                    if field == "x":  # no rate reads a body's position
+                        continue
                     z[index] = y[index] + steps[j]
-                    assembly(t, z, self._out)
+                    if field == "Q":  # only the body's own rates read its rotation
+                        assembly.body_rates(part, t, z, self._out)
+                    else:  # its velocities move the rods' bases
+                        assembly(t, z, self._out)
                     jac[:, j] = (self._out[part.slice] - fy[part.slice]) / steps[j]
                     z[index] = y[index]
             assembly(t, y, self._out)  # leave the rods as at y

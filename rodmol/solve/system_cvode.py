@@ -5,8 +5,8 @@ The Newton systems are solved (``linsolver``) by
 
 * ``"gmres"`` (default): GMRES preconditioned by the rods' exact block
   preconditioners and the bodies' own blocks
-  (:mod:`rodmol.discretise.system_preconditioner`); 2.6x faster than
-  ``"sparse"`` on the octopus (``solvers/octopus.py``);
+  (:mod:`rodmol.discretise.system_preconditioner`); about 2x faster than
+  ``"sparse"`` on the octopus (``solvers/octopus.py``, docs/performance.md);
 * ``"sparse"``: SuperLU_MT (scikit-sundae) on the assembly's Jacobian
   pattern, the rods' banded patterns on the diagonal and the joints'
   coupling blocks; scikit-sundae fills the Jacobian by its own coloured
