@@ -25,9 +25,11 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
                     output_dt=None, output_times=None, t0=None, progress=None, max_wall_time=None,
                     out=None, resume=False, overwrite=False, **backend_options):
     """Integrate ``system`` from rest (``initial="straight"``: every rod
-    straight at its base, every body at rest at its pose) or from a state
-    vector (``SystemResult.states[k]``); the other arguments as for
-    :func:`rodmol.simulate`. Returns a :class:`rodmol.system_result.SystemResult`."""
+    straight at its base, every body at rest at its pose), from a state
+    vector (``SystemResult.states[k]``) or from the last frame of an earlier
+    SystemResult (at its last time unless ``t0`` is given); the other
+    arguments as for :func:`rodmol.simulate`. Returns a
+    :class:`rodmol.system_result.SystemResult`."""
     for name, value, unset in (("out", out, None), ("resume", resume, False), ("overwrite", overwrite, False)):
         if value is not unset:
             raise NotSupportedYet(f"`{name}` is not supported yet for systems (in-memory runs only)")
@@ -37,6 +39,9 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
         raise NotSupportedYet(f"`backend` {backend!r} is not supported yet for systems: use 'cvode'")
     checked = options.backend_options("cvode", cvode_system, backend_options)
     progress, max_wall_time = options.progress(progress), options.max_wall_time(max_wall_time)
+    if isinstance(initial, SystemResult):
+        t0 = float(initial.t[-1]) if t0 is None else t0
+        initial = initial.states[-1]
     scheme = get_scheme(DEFAULT_SCHEME if scheme is None else scheme)
     rtol = options.rtol(scheme.default_rtol if rtol is None else rtol)
     t0 = 0.0 if t0 is None else _checks.non_negative("t0", t0, " s")

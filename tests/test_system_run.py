@@ -114,6 +114,11 @@ def test_mirrored_pair_of_arms_leaves_the_head_unrotated():
     # The rod's Result on a free body: its base moves with the head's clamp (v + w x p, Rj = I).
     clamp = head.velocity + np.cross(head.angular_velocity, [0.02, 0.0, 0.0])
     np.testing.assert_allclose(run["right"].velocity[:, 0], clamp, atol=1e-12)
+    # A run continued from the middle frame ends where the whole run did.
+    half = rodmol.simulate(run.assembly.system, 0.07, rtol=1e-6, output_dt=0.01)
+    rest = rodmol.simulate(half.assembly.system, 0.15, rtol=1e-6, output_dt=0.01, initial=half)
+    assert rest.t[0] == pytest.approx(0.07)
+    np.testing.assert_allclose(rest["right"].tip[-1], run["right"].tip[-1], atol=2e-6 * 0.2)
     distance, angle = run.pose_drift("right")
     assert distance.max() < 1e-5 * 0.2 and angle.max() < 1e-4
     # The sparse direct solver of the whole Newton matrix agrees with the preconditioned GMRES.
