@@ -20,6 +20,7 @@ from ._version import __version__ as __version__
 from .analysis import energy, marker_errors, oscillation_period
 from .arm import paper_arm
 from .base_motion import Base, BaseMotion
+from .bodies import RigidBody
 from .cables import Cable, read_tension_csv
 from .calibrate import (
     LinearModel,
@@ -35,7 +36,14 @@ from .control import Simulator, StaticFit, inverse_statics, inverse_statics_path
 from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
 from .discretise.system import SemiDiscrete, StateView
-from .errors import EquilibriumError, IntegrationError, ParameterError, RodmolError, UserFunctionError
+from .errors import (
+    EquilibriumError,
+    IntegrationError,
+    NotSupportedYet,
+    ParameterError,
+    RodmolError,
+    UserFunctionError,
+)
 from .loads import (
     CapsuleContact,
     DistributedForce,
@@ -55,11 +63,12 @@ from .scenario.file import ScenarioError, load_scenario
 from .simulate import default_atol, simulate, straight_state
 from .solve.backends import BACKENDS
 from .solve.equilibrium import equilibrium
+from .systems import Joint, System
 
 __all__ = [
     "BACKENDS", "Base", "BaseMotion", "Cable", "CapsuleContact", "DistributedForce",
     "DistributedMoment", "PlaneContact", "PointForce", "PointMoment", "SphereContact", "EquilibriumError", "IntegrationError", "MEDIA",
-    "Marker", "Material", "Medium", "Model", "ParameterError", "Result", "Rod", "RodmolError",
+    "Joint", "Marker", "Material", "Medium", "Model", "NotSupportedYet", "RigidBody", "System", "ParameterError", "Result", "Rod", "RodmolError",
     "SCHEMES", "ScenarioError", "SemiDiscrete", "Simulator", "StateLayout", "StateView", "UserFunctionError",
     "default_atol", "energy",
     "equilibrium", "load_result", "load_scenario", "marker_errors", "oscillation_period", "paper_arm",

@@ -45,3 +45,8 @@ class IntegrationError(RodmolError, RuntimeError):
 
 class EquilibriumError(RodmolError, RuntimeError):
     """The static equilibrium could not be found."""
+
+
+class NotSupportedYet(ParameterError):
+    """A valid request that rodmol does not handle yet (a joint at a rod's tip,
+    a closed loop, streamed output of a system); the message says what."""

@@ -21,6 +21,8 @@ from .solve.equilibrium import equilibrium
 from .solve.outputs import keep_before_failure
 from .solve.scales import check_scales
 from .solve.watch import state_problem
+from .system_run import simulate_system
+from .systems import System
 
 INITIAL = ("equilibrium", "straight")
 #: Values of ``resume``: "force" continues even with settings other than the run's.
@@ -46,7 +48,9 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
 
     Parameters
     ----------
-    model : Model
+    model : Model or System
+        A System (several rods and rigid bodies) runs in memory from rest
+        and returns a ``SystemResult`` (:mod:`rodmol.system_run`, ``docs/systems.md``).
     t_end : float
         End time [s], absolute (> ``t0``).
     initial : "equilibrium", "straight", Result or array
@@ -126,8 +130,13 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         the exception that ended it (e.g. a user function's, with its
         traceback) and a warning is issued.
     """
+    if isinstance(model, System):  # several rods and bodies: their own run (rodmol.system_run)
+        return simulate_system(model, t_end, initial=initial, scheme=scheme, backend=backend, rtol=rtol,
+                               atol=atol, output_dt=output_dt, output_times=output_times, t0=t0,
+                               progress=progress, max_wall_time=max_wall_time, out=out, resume=resume,
+                               overwrite=overwrite, **backend_options)
     if not isinstance(model, Model):
-        raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
+        raise ParameterError(f"`model` must be a rodmol.Model or rodmol.System, got {model!r}")
     if not (resume is True or resume is False or (isinstance(resume, str) and resume in RESUME)):
         raise ParameterError(f"`resume` must be False, True or 'force', got {_checks.short(resume)}")
     sink, first, plan, recorded = None, 0, None, None

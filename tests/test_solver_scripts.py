@@ -166,6 +166,13 @@ def _quaternion_norm(out):
         assert row["tip_difference_m"] < 1e-6 and row["steps_with"] == row["steps_without"], row
 
 
+def _octopus(out):
+    table = rows(out / "octopus.csv")
+    assert all(row["success"] is True for row in table), table
+    one, octopus = table[0]["state_size"], table[-1]["state_size"]
+    assert octopus == 8 * one + 13  # eight arms and a free head's block
+
+
 SCRIPTS = {
     "scaling.py": (["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"], _scaling),
     "temporal.py": (["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv", "temporal_options.csv"],
@@ -187,6 +194,7 @@ SCRIPTS = {
     "inverse_statics.py": (["inverse_statics.csv", "inverse_statics.md"], _inverse_statics),
     "linear_mpc.py": (["linear_mpc.csv", "linear_mpc.md"], _linear_mpc),
     "quaternion_norm.py": (["quaternion_norm.csv", "quaternion_norm.md"], _quaternion_norm),
+    "octopus.py": (["octopus.csv", "octopus.md"], _octopus),
 }
 
 

@@ -63,7 +63,12 @@ class Scheme:
 
     ``kernel`` is the stencil's branch; ``cell_point`` the fraction of a cell
     (from its base-side node) where its properties are sampled; ``tip_share``
-    the fraction of a cell the tip node stands for (the other nodes: one cell).
+    the fraction of a cell the tip node stands for (the other nodes: one cell);
+    ``base_share`` the fraction of cell 0's non-derivative products (k x N,
+    k x M + q x N) that the base node's balance would take (node 1 takes the
+    rest): a body clamped to the base feels them with cell 0's stress, so
+    that the pair of forces on body and node 1 is the same as between any two
+    nodes (:mod:`rodmol.discretise.assembly`).
     """
 
     name: str
@@ -77,6 +82,7 @@ class Scheme:
     #: spatial error at N = 100 on the paper's tests (docs/model.md,
     #: docs/performance.md).
     default_rtol: float
+    base_share: float
 
     def cell_points(self, s_nodes):
         """Arc lengths [m] where the properties of cells 0..N-1 are sampled."""
@@ -96,11 +102,11 @@ SCHEMES = {
     "centred": Scheme(
         "centred",
         "second order: cell properties at cell midpoints, centred non-derivative "
-        "terms, half a cell at the tip", 2, Kernel.CENTRED, 0.5, 0.5, _CENTRED, 3e-5),
+        "terms, half a cell at the tip", 2, Kernel.CENTRED, 0.5, 0.5, _CENTRED, 3e-5, 0.5),
     "upwind": Scheme(
         "upwind",
         "the paper's scheme (section IV-C): one-sided non-derivative terms, first order",
-        1, Kernel.UPWIND, 0.0, 1.0, _UPWIND, 1e-4),
+        1, Kernel.UPWIND, 0.0, 1.0, _UPWIND, 1e-4, 1.0),
 }
 DEFAULT_SCHEME = "centred"
 

@@ -1,0 +1,188 @@
+"""Rigid bodies of a system: mass properties, fluid loads, motion and their
+mass properties from a closed triangulated surface (a mesh file)."""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import _checks
+from .base_motion import BaseMotion
+from .errors import ParameterError
+
+#: Motions of a body besides a prescribed :class:`BaseMotion`.
+MOTIONS = ("free", "fixed")
+_IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
+@dataclass(frozen=True, eq=False)  # compared by identity: its fields are arrays
+class RigidBody:
+    """A rigid body: a head, a platform, a payload.
+
+    Its *body frame* has its origin at ``position`` and axes ``rotation``
+    (body to global) at t = 0; every vector below is in the body frame.
+
+    Parameters
+    ----------
+    mass : float
+        Mass [kg].
+    inertia : (3,) or (3, 3) float
+        Inertia tensor [kg m^2] about the centre of mass, body frame: three
+        principal values along the body axes or a symmetric positive definite tensor.
+    volume : float
+        Displaced volume [m^3]: buoyancy ``-rho_fluid volume gravity`` acts at
+        the centre of mass (a body of uniform density).
+    centre_of_mass : (3,) float
+        Centre of mass [m], body frame.
+    added_mass : (6,) or (6, 6) float, optional
+        Added-mass matrix of the surrounding fluid, about the body origin,
+        body frame, ordered (translation [kg], rotation [kg m^2]); it adds to
+        the body's mass matrix (its gyroscopic terms are left out, as the
+        rods' Munk moment by default).
+    drag : (6,) float, optional
+        Quadratic drag coefficients: force ``-d_i v_i |v_i|`` [N] along the
+        body axes (d [kg/m]) from the velocity of the centre of mass, and
+        torque ``-d_i w_i |w_i|`` [N m] about them (d [kg m^2]).
+    mesh : str or path, optional
+        The surface the body was built from (:meth:`from_mesh`), for views.
+    motion : "free", "fixed" or BaseMotion
+        Free in 6 DOF (default), fixed where it is, or driven: a
+        :class:`BaseMotion`, whose velocities are the body frame's (origin
+        velocity and angular velocity, body frame) and whose position and
+        rotation are the body's initial pose.
+    position : (3,) float, optional
+        Initial position [m] of the body origin, global (default: the origin,
+        or the BaseMotion's).
+    rotation : (3, 3) float, optional
+        Initial rotation, body to global (default: identity, or the BaseMotion's).
+    """
+
+    mass: float
+    inertia: tuple
+    volume: float = 0.0
+    centre_of_mass: tuple = (0.0, 0.0, 0.0)
+    added_mass: tuple | None = None
+    drag: tuple | None = None
+    mesh: object = None
+    motion: object = "free"
+    position: tuple | None = None
+    rotation: tuple | None = None
+    #: The 6x6 mass matrix about the body origin, body frame (with the added mass).
+    mass_matrix: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        put = object.__setattr__
+        put(self, "mass", _checks.positive("mass", self.mass, " kg"))
+        put(self, "inertia", _inertia(self.inertia))
+        put(self, "volume", _checks.non_negative("volume", self.volume, " m^3"))
+        put(self, "centre_of_mass", _checks.vector3("centre_of_mass", self.centre_of_mass))
+        added = _six("added_mass", self.added_mass, square=True)
+        if np.any(np.linalg.eigvalsh(0.5 * (added + added.T)) < 0.0):
+            raise ParameterError(f"`added_mass` must be positive semi-definite, got {_checks.short(self.added_mass)}")
+        put(self, "added_mass", added)
+        drag = np.diag(_six("drag", self.drag, square=False)).copy()
+        if np.any(drag < 0.0):
+            raise ParameterError(f"`drag` must be >= 0, got {_checks.short(self.drag)}")
+        put(self, "drag", drag)
+        motion = self.motion
+        if not isinstance(motion, BaseMotion):
+            _checks.choice("motion", motion, MOTIONS)
+        elif self.position is not None or self.rotation is not None:
+            raise ParameterError("a driven body (`motion` a BaseMotion) starts at the BaseMotion's "
+                                 "position and rotation: leave `position` and `rotation` out")
+        pose = BaseMotion(position=self.position if self.position is not None else (0.0, 0.0, 0.0),
+                          rotation=self.rotation if self.rotation is not None else _IDENTITY)
+        start = motion if isinstance(motion, BaseMotion) else pose
+        put(self, "position", np.array(start.position, dtype=float))
+        put(self, "rotation", np.array(start.rotation, dtype=float))
+        c, m = self.centre_of_mass, self.mass
+        about_origin = self.inertia + m * (np.dot(c, c) * np.eye(3) - np.outer(c, c))
+        cross_c = np.array([[0.0, -c[2], c[1]], [c[2], 0.0, -c[0]], [-c[1], c[0], 0.0]])
+        matrix = np.block([[m * np.eye(3), -m * cross_c], [m * cross_c, about_origin]])
+        put(self, "mass_matrix", matrix + added)
+
+    @property
+    def driven(self):
+        """True if the body's motion is prescribed (a BaseMotion)."""
+        return isinstance(self.motion, BaseMotion)
+
+    @property
+    def free(self):
+        """True if the body moves freely in 6 DOF."""
+        return isinstance(self.motion, str) and self.motion == "free"
+
+    @classmethod
+    def from_mesh(cls, path, density, **options):
+        """A body of uniform ``density`` [kg/m^3] filling the closed
+        triangulated surface in the file ``path`` (any format meshio reads:
+        STL, OBJ, PLY, VTU, ...; coordinates in metres, the body frame).
+        Volume, centre of mass and inertia come from :func:`mesh_properties`;
+        ``options`` are the other arguments of :class:`RigidBody`."""
+        import meshio
+
+        density = _checks.positive("density", density, " kg/m^3")
+        try:
+            mesh = meshio.read(path)
+        except Exception as exc:  # noqa: BLE001 (any reader failure, named with the file)
+            raise ParameterError(f"cannot read the mesh `path` {str(path)!r}: {exc}") from exc
+        triangles = [block.data for block in mesh.cells if block.type == "triangle"]
+        if not triangles:
+            raise ParameterError(f"the mesh `path` {str(path)!r} has no triangles")
+        volume, centre, inertia = mesh_properties(mesh.points, np.concatenate(triangles))
+        return cls(density * volume, density * inertia, volume=volume, centre_of_mass=centre,
+                   mesh=str(path), **options)
+
+
+def mesh_properties(points, triangles):
+    """Volume [m^3], centroid (3,) [m] and inertia tensor per unit density
+    (3, 3) [m^5] about the centroid of the solid bounded by a closed surface.
+
+    ``points`` (n, 3), ``triangles`` (m, 3) vertex indices, consistently
+    oriented (outward or inward: the sign is fixed from the volume's). By the
+    divergence theorem every integral is a sum over the tetrahedra spanned by
+    the origin and each triangle: det/6 for the volume, det/24 (a + b + c)
+    for the first moment, det/120 (sum of v v^T + s s^T, s = a + b + c) for
+    the second moment.
+    """
+    points = np.asarray(points, dtype=float)[:, :3]
+    tri = np.asarray(triangles, dtype=np.int64)
+    a, b, c = points[tri[:, 0]], points[tri[:, 1]], points[tri[:, 2]]
+    det = np.einsum("ij,ij->i", a, np.cross(b, c))
+    volume = det.sum() / 6.0
+    if not np.isfinite(volume) or abs(volume) <= 1e-300:
+        raise ParameterError("the mesh encloses no volume: is it a closed surface?")
+    s = a + b + c
+    centre = (det[:, None] * s).sum(axis=0) / 24.0 / volume
+    second = np.einsum("t,ti,tj->ij", det, a, a) + np.einsum("t,ti,tj->ij", det, b, b)
+    second += np.einsum("t,ti,tj->ij", det, c, c) + np.einsum("t,ti,tj->ij", det, s, s)
+    second /= 120.0
+    if volume < 0.0:  # inward normals: every integral changed sign
+        volume, second = -volume, -second
+    second -= volume * np.outer(centre, centre)  # about the centroid
+    inertia = np.trace(second) * np.eye(3) - second
+    return volume, centre, inertia
+
+
+def _inertia(value):
+    arr = _checks.floats(value)
+    if arr is not None and arr.shape == (3,):
+        arr = np.diag(arr)
+    ok = arr is not None and arr.shape == (3, 3) and np.all(np.isfinite(arr))
+    if ok and np.allclose(arr, arr.T, rtol=1e-9, atol=1e-12 * np.max(np.abs(arr))):
+        arr = 0.5 * (arr + arr.T)
+        if np.all(np.linalg.eigvalsh(arr) > 0.0):
+            return arr
+    raise ParameterError("`inertia` must be three positive numbers or a symmetric positive definite 3x3 "
+                         f"tensor [kg m^2], got {_checks.short(value)}")
+
+
+def _six(name, value, square):
+    """``value`` as a (6, 6) matrix (from None, six diagonal values or, if ``square``, a 6x6)."""
+    if value is None:
+        return np.zeros((6, 6))
+    arr = _checks.floats(value)
+    if arr is not None and arr.shape == (6,) and np.all(np.isfinite(arr)):
+        return np.diag(arr)
+    if square and arr is not None and arr.shape == (6, 6) and np.all(np.isfinite(arr)):
+        return arr
+    shapes = "six numbers or a 6x6 matrix" if square else "six numbers"
+    raise ParameterError(f"`{name}` must be {shapes}, got {_checks.short(value)}")

@@ -1,0 +1,294 @@
+"""The semi-discrete system of a :class:`rodmol.System`: rods and rigid
+bodies in one state vector, dy/dt = f(t, y).
+
+The state is the rods' states (each a :class:`SemiDiscrete`'s, in ``rods``
+order) followed by the bodies' blocks (in ``bodies`` order). A body's block
+(:data:`BODY_FIELDS`) holds the position x [m] of its origin (global), its
+quaternion Q (body to global) and, for a free body only, the velocity v
+[m/s] of its origin and its angular velocity w [rad/s], both in the body
+frame, as the rods' nodes. A fixed or driven body's velocities are not
+state: they are zero or its BaseMotion's, and its pose integrates them.
+
+Coupling (tree joints, the constraint eliminated): a rod clamped at point p
+with rotation Rj (base to body frame) of a body moving with (v, w) has the
+base velocities v0 = Rj^T (v + w x p), w0 = Rj^T w. A body feels, from each
+rod clamped to it, the total stress of the rod's cell 0 (with the cables)
+plus the base node's share of that cell's products (``Scheme.base_share``),
+the same force and moment that node 1 feels with the opposite sign: the pair
+is then the same as between any two nodes of a rod. The rod's header (u0,
+Q0) integrates v0, w0 as for a single rod: it is not tied to the body's pose
+but drifts from it by the integration error only (``pose_drift``).
+
+Newton-Euler of a body about its origin, body frame, with the momentum
+P = m (v + w x c) and H = I_o w + m c x v of its own mass:
+M [v_t, w_t] = [F - w x P, T - w x H - v x P], where the 6x6 mass matrix M
+adds the added mass (its gyroscopic terms are left out), F, T the rods'
+wrenches, weight minus buoyancy at the centre of mass and quadratic drag.
+"""
+
+import numpy as np
+from scipy import sparse
+
+from .layout import BlockLayout
+from .physics import quaternion_rate
+from .rigid import clamp_wrench, free_body_rates, pack_body
+from .rotations import from_matrix, matrices
+from .stencil import WORK_TOTAL
+from .system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE, SemiDiscrete, field_scales
+
+#: Fields of a free body's block; a fixed or driven body holds the pose only.
+BODY_FIELDS = {"x": 3, "Q": 4, "v": 3, "w": 3}
+POSE_FIELDS = {"x": 3, "Q": 4}
+
+
+def _cross(a, b):
+    """a x b over the last axis (numpy's cross costs 20 us on one pair, most of a body's rates)."""
+    a, b = np.asarray(a), np.asarray(b)
+    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1], a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
+                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
+
+
+def clamp_velocities(points, turns, v, w):
+    """(n, 6) base velocities (v0, w0) = (Rj^T (v + w x p), Rj^T w) of rods
+    clamped at ``points`` (n, 3) [m] with ``turns`` (n, 3, 3) (base to body
+    frame) to a body moving with (v, w) (body frame): local frames of the bases."""
+    return np.concatenate([np.einsum("rji,rj->ri", turns, v + _cross(w, points)),
+                           np.einsum("rji,j->ri", turns, np.broadcast_to(w, 3))], axis=1)
+
+
+class BodyPart:
+    """One rigid body's place in the state, its constant data and its rods'
+    clamps stacked for the coupling (points (n, 3) [m] and rotations (n, 3, 3),
+    base to body frame)."""
+
+    def __init__(self, name, body, start, fluid_density):
+        self.name, self.body = name, body
+        self.params = pack_body(body, fluid_density)
+        self.layout = BlockLayout(1, dict(BODY_FIELDS if body.free else POSE_FIELDS))
+        self.slice = slice(start, start + self.layout.size)
+        self.fields = {f: slice(start + s.start, start + s.stop) for f, s in self.layout.slices().items()}
+        self.inverse_mass = np.linalg.inv(body.mass_matrix)
+        self.rigid_mass = body.mass_matrix - body.added_mass  # its own, for the momentum
+        self.rods, self.systems = [], []
+        self.works = []  # each rod kernel's scratch: cell 0's total stress after a call (stencil.rhs)
+        self.points, self.turns = np.zeros((0, 3)), np.zeros((0, 3, 3))
+        self.shares = np.zeros(0)  # the base node's share of cell 0 [m] (Scheme.base_share ds)
+        self.strains = np.zeros((0, 6), dtype=np.int64)  # state indices of (q, k) of each rod's cell 0
+
+    def clamp(self, name, sd, start, point, turn):
+        """Hold the base of rod ``name`` (its system ``sd``, its state from ``start``)."""
+        self.shares = np.append(self.shares, sd.scheme.base_share * sd.model.ds)
+        self.rods.append(name)
+        self.systems.append(sd)
+        self.works.append(sd.kernel_arguments()[-1])
+        self.points = np.vstack([self.points, point])
+        self.turns = np.concatenate([self.turns, np.asarray(turn, dtype=float)[None]])
+        self.flat_turns = np.ascontiguousarray(self.turns.reshape(-1, 9))  # row-major, for the kernel
+        sl, first = sd.layout.slices(), start + sd.layout.header
+        index = np.r_[first + sl["q"].start:first + sl["q"].stop, first + sl["k"].start:first + sl["k"].stop]
+        self.strains = np.vstack([self.strains, index])
+
+    def base_velocities(self, v, w):
+        """(n, 6) base velocities of the rods for the body velocities (v, w) (:func:`clamp_velocities`)."""
+        return clamp_velocities(self.points, self.turns, v, w)
+
+
+class Assembly:
+    """The method-of-lines system of a :class:`rodmol.System`.
+
+    Parameters
+    ----------
+    system : System
+    scheme : str or Scheme
+        The spatial scheme of every rod (``rodmol.SCHEMES``).
+
+    Attributes
+    ----------
+    rods : dict of str to SemiDiscrete
+        Each rod's system; a rod on a driven body or the world moves by its
+        own ``base`` (the body's motion carried to its clamp).
+    parts : dict of str to slice
+        Where each rod's and body's entries sit in the state.
+    size : int
+    """
+
+    def __init__(self, system, scheme=None):
+        self.system = system
+        self.rods, self.parts, self.bodies = {}, {}, {}
+        start = 0
+        for name in system.rods:
+            sd = SemiDiscrete(system.rods[name].replace(base=self._rod_base(name)),
+                              *(() if scheme is None else (scheme,)))
+            self.rods[name] = sd
+            self.parts[name] = slice(start, start + sd.size)
+            start += sd.size
+        self.scheme = next(iter(self.rods.values())).scheme
+        for name, body in system.bodies.items():
+            part = BodyPart(name, body, start, system.medium.rho)
+            for rod in system.rods_on(name):
+                _, point, rotation = system.clamps[rod]
+                part.clamp(rod, self.rods[rod], self.parts[rod].start, point, rotation)
+            self.bodies[name] = part
+            self.parts[name] = part.slice
+            start = part.slice.stop
+        self.size = start
+        self.free = [p for p in self.bodies.values() if p.body.free]
+        self.lightly_damped = any(sd.lightly_damped for sd in self.rods.values())
+        self._gravity = np.ascontiguousarray(system.gravity, dtype=float)
+
+    def _rod_base(self, name):
+        """The Model ``base`` of rod ``name``: its clamp's pose, moving with a driven body."""
+        system = self.system
+        base = system.base_motion(name)
+        body = system.clamps.get(name, (None,))[0]
+        if body is None or not system.bodies[body].driven:
+            return base
+        _, point, rj = system.clamps[name]
+        motion = system.bodies[body].motion
+
+        def velocities(t):
+            return clamp_velocities(point[None], rj[None], *motion.velocities(t))[0]
+
+        return type(base)(lambda t: velocities(t)[:3], lambda t: velocities(t)[3:], base.position, base.rotation)
+
+    # ------------------------------------------------------------------ state
+
+    def initial_state(self):
+        """Every rod straight at rest at its base, every body at rest at its initial pose."""
+        y = np.zeros(self.size)
+        for name, sd in self.rods.items():
+            m = sd.model
+            y[self.parts[name]] = sd.layout.straight(m.s_nodes, np.asarray(m.base.position, dtype=float),
+                                                     np.asarray(m.base.rotation, dtype=float),
+                                                     from_matrix(np.asarray(m.base.rotation, dtype=float)))
+        for part in self.bodies.values():
+            y[part.fields["x"]] = part.body.position
+            y[part.fields["Q"]] = from_matrix(part.body.rotation)
+        return y
+
+    def body_velocities(self, part, t, y):
+        """(v, w) of a body's origin at (t, y) [m/s, rad/s], body frame."""
+        if part.body.free:
+            return y[part.fields["v"]], y[part.fields["w"]]
+        if part.body.driven:
+            return part.body.motion.velocities(t)
+        return np.zeros(3), np.zeros(3)
+
+    def project_quaternions(self, y):
+        """Scale every quaternion of the states ``y`` (..., size) to unit norm, in place."""
+        y = y.reshape(-1, self.size)
+        for name, sd in self.rods.items():
+            rod = np.ascontiguousarray(y[:, self.parts[name]])
+            sd.layout.project_quaternions(rod)
+            y[:, self.parts[name]] = rod
+        for part in self.bodies.values():
+            q = y[:, part.fields["Q"]]
+            y[:, part.fields["Q"]] = q / np.linalg.norm(q, axis=-1, keepdims=True)
+
+    # ------------------------------------------------------------------ evaluation
+
+    def __call__(self, t, y, out=None):
+        """dy/dt at (t, y); writes into ``out`` if given (CVODE's ``yp``)."""
+        if out is None:
+            out = np.empty(self.size)
+        for part in self.free:  # the rods' base velocities first
+            for sd, row in zip(part.systems, part.base_velocities(y[part.fields["v"]], y[part.fields["w"]])):
+                sd.base_velocities[:] = row
+        for name, sd in self.rods.items():
+            sl = self.parts[name]
+            sd(t, y[sl], out[sl])
+        for part in self.bodies.values():
+            self.body_rates(part, t, y, out)
+        return out
+
+    def body_rates(self, part, t, y, out):
+        """The rates of body ``part``'s block at (t, y) into ``out`` (the whole
+        state's rates), after the rods' rates at y (their cell 0's stress)."""
+        if part.body.free:
+            force, torque = self.body_wrench(part, y) if part.rods else ((0.0,) * 3, (0.0,) * 3)
+            free_body_rates(y[part.slice], part.params, part.rigid_mass, part.inverse_mass, self._gravity,
+                            force, torque, DRAG_SMOOTHING_SPEED**2, QUATERNION_RESTORING_RATE, out[part.slice])
+            return
+        quat = y[part.fields["Q"]]
+        v, w = self.body_velocities(part, t, y)
+        out[part.fields["x"]] = matrices(quat) @ v
+        out[part.fields["Q"]] = quaternion_rate(tuple(quat), tuple(w), QUATERNION_RESTORING_RATE)
+
+    def body_wrench(self, part, y):
+        """Force and moment about the origin [N, N m] of the rods clamped to
+        ``part``, body frame, after the rods' rates at ``y``
+        (:func:`rodmol.discretise.rigid.clamp_wrench`)."""
+        stress = np.array([work[0, WORK_TOTAL:WORK_TOTAL + 6] for work in part.works]).reshape(-1, 6)
+        return clamp_wrench(stress, np.ascontiguousarray(y[part.strains]), part.shares, part.flat_turns, part.points)
+
+    # ------------------------------------------------------------------ structure
+
+    def pattern(self):
+        """Structural Jacobian pattern (scipy CSC, size x size): each rod's
+        pattern on the diagonal, each body's block (:func:`_body_pattern`), and for each rod clamped
+        to a free body its header and first element against the body's
+        velocities, and the body's velocity rows against that element."""
+        blocks = [sparse.csr_matrix(sd.pattern()) for sd in self.rods.values()]
+        blocks += [sparse.csr_matrix(_body_pattern(p)) for p in self.bodies.values()]
+        pat = sparse.block_diag(blocks, format="lil", dtype=bool)
+        for part in self.free:
+            velocity = np.r_[part.fields["v"], part.fields["w"]]
+            for name, sd in zip(part.rods, part.systems):
+                start = self.parts[name].start
+                first = np.arange(start, start + sd.layout.header + sd.layout.block)
+                pat[np.ix_(first, velocity)] = True
+                pat[np.ix_(velocity, first)] = True
+        return pat.tocsc()
+
+    def atol_scale(self):
+        """Typical magnitude of each entry: the rods' own
+        (:meth:`SemiDiscrete.atol_scale`); a body's position the longest rod,
+        its velocity the slowest rod's speed scale, its angular velocity that
+        speed over the longest rod (:func:`field_scales`)."""
+        scales = [sd.atol_scale() for sd in self.rods.values()]
+        rods = [field_scales(sd.model) for sd in self.rods.values()]
+        length, speed = max(f["u"] for f in rods), min(f["v"] for f in rods)
+        per_field = {"x": length, "Q": 1.0, "v": speed, "w": speed / length}
+        for part in self.bodies.values():
+            scales.append(np.concatenate([np.full(n, per_field[f]) for f, n in part.layout.fields.items()]))
+        return np.concatenate(scales)
+
+    # ------------------------------------------------------------------ checks
+
+    def momentum(self, y):
+        """Total linear momentum [kg m/s] and angular momentum about the
+        global origin [kg m^2/s] of the bodies and rods, global, at the state
+        ``y``: the nodes' as their mass per length times the length each
+        stands for, at their integrated positions."""
+        linear, angular = np.zeros(3), np.zeros(3)
+        for name, sd in self.rods.items():
+            y_rod, lay = y[self.parts[name]], sd.layout
+            rot = matrices(lay.field(y_rod, "Q"))
+            lengths = sd.node_lengths[:, None]
+            p = np.einsum("nij,nj->ni", rot, sd.sampled.mass * lay.field(y_rod, "v") * lengths)
+            h = np.einsum("nij,nj->ni", rot, sd.sampled.inertia * lay.field(y_rod, "w") * lengths)
+            linear += p.sum(axis=0)
+            angular += (_cross(lay.field(y_rod, "u"), p) + h).sum(axis=0)
+        for part in self.free:
+            r = matrices(y[part.fields["Q"]])
+            v, w = y[part.fields["v"]], y[part.fields["w"]]
+            momentum = part.rigid_mass @ np.concatenate([v, w])
+            linear += r @ momentum[:3]
+            angular += _cross(y[part.fields["x"]], r @ momentum[:3]) + r @ momentum[3:]
+        return linear, angular
+
+
+def _body_pattern(part):
+    """A body block's own coupling: its quaternion rates read Q (the restoring
+    term), its position rates Q unless it is fixed, and a free body's pose
+    rates its velocities; its velocity rates read everything (gravity's
+    direction, gyroscopic terms)."""
+    sl, size = part.layout.slices(), part.layout.size
+    pat = np.zeros((size, size), dtype=bool)
+    pat[sl["Q"], sl["Q"]] = True
+    if part.body.motion != "fixed":
+        pat[sl["x"], sl["Q"]] = True
+    if "v" in sl:
+        pat[sl["x"], sl["v"]] = pat[sl["Q"], sl["w"]] = True
+        pat[sl["v"].start:, :] = True
+    return pat

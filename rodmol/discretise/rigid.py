@@ -1,0 +1,90 @@
+"""Compiled physics of a system's free rigid bodies: the wrench of the rods
+clamped to a body and the body's Newton-Euler rates
+(:mod:`rodmol.discretise.assembly` says the frames and the equations)."""
+
+import numpy as np
+
+from .physics import add, cross, jit, quaternion_rate, rotation, scale, sub, to_global, to_local
+
+#: Entries of a body's parameter row: net mass [kg] (minus the displaced
+#: fluid), centre of mass (3) [m], drag coefficients (6), body frame.
+NET_MASS, CENTRE, DRAG = 0, 1, 4
+N_BODY_PARAMS = 10
+
+
+def pack_body(body, fluid_density):
+    """The parameter row of ``body`` in a fluid of ``fluid_density`` [kg/m^3]."""
+    row = np.empty(N_BODY_PARAMS)
+    row[NET_MASS] = body.mass - fluid_density * body.volume
+    row[CENTRE:CENTRE + 3] = body.centre_of_mass
+    row[DRAG:DRAG + 6] = body.drag
+    return row
+
+
+@jit
+def _row3(a, i):
+    return (a[i], a[i + 1], a[i + 2])
+
+
+@jit
+def clamp_wrench(stress, strains, shares, turns, points):
+    """Total force and moment about the body origin [N, N m], body frame, of
+    the rods clamped to a body: per rod, ``stress`` (6,) cell 0's total N, M
+    and ``strains`` (6,) its q, k (local frame of the base), ``shares`` the
+    base node's share of the cell [m] (``Scheme.base_share`` ds), ``turns``
+    (9,) the base-to-body rotation (row-major), ``points`` (3,) the clamp [m]."""
+    force, torque = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    for r in range(stress.shape[0]):
+        n, m = _row3(stress[r], 0), _row3(stress[r], 3)
+        q, k = _row3(strains[r], 0), _row3(strains[r], 3)
+        h = shares[r]
+        n_base = add(n, scale(h, cross(k, n)))
+        m_base = add(m, scale(h, add(cross(k, m), cross(q, n))))
+        f = to_global(turns[r], n_base)
+        force = add(force, f)
+        torque = add(torque, add(to_global(turns[r], m_base), cross(_row3(points[r], 0), f)))
+    return force, torque
+
+
+@jit
+def free_body_rates(state, params, rigid, inverse, gravity, force, torque, smoothing2, restoring, out):
+    """Rates of a free body's block (x, Q, v, w) into ``out`` (13,): ``state``
+    its block, ``params`` its :func:`pack_body` row, ``rigid`` and
+    ``inverse`` its own 6x6 mass matrix and the inverse of the one with the
+    added mass, ``gravity`` (3,) global, ``force``, ``torque`` the rods'
+    wrench about the origin (body frame)."""
+    quat = (state[3], state[4], state[5], state[6])
+    v, w = _row3(state, 7), _row3(state, 10)
+    r = rotation(quat)
+    c = _row3(params, CENTRE)
+    weight = scale(params[NET_MASS], to_local(r, gravity))
+    v_c = add(v, cross(w, c))
+    drag = (-params[DRAG] * v_c[0] * np.sqrt(v_c[0] * v_c[0] + smoothing2),
+            -params[DRAG + 1] * v_c[1] * np.sqrt(v_c[1] * v_c[1] + smoothing2),
+            -params[DRAG + 2] * v_c[2] * np.sqrt(v_c[2] * v_c[2] + smoothing2))
+    spin = (-params[DRAG + 3] * w[0] * np.sqrt(w[0] * w[0] + smoothing2),
+            -params[DRAG + 4] * w[1] * np.sqrt(w[1] * w[1] + smoothing2),
+            -params[DRAG + 5] * w[2] * np.sqrt(w[2] * w[2] + smoothing2))
+    at_centre = add(weight, drag)
+    total_f = add(at_centre, force)
+    total_t = add(add(cross(c, at_centre), spin), torque)
+    vw = (v[0], v[1], v[2], w[0], w[1], w[2])
+    p = np.zeros(6)
+    for i in range(6):
+        for j in range(6):
+            p[i] += rigid[i, j] * vw[j]
+    lin, ang = _row3(p, 0), _row3(p, 3)
+    total_f = sub(total_f, cross(w, lin))
+    total_t = sub(total_t, add(cross(w, ang), cross(v, lin)))
+    rhs = (total_f[0], total_f[1], total_f[2], total_t[0], total_t[1], total_t[2])
+    for i in range(6):
+        acc = 0.0
+        for j in range(6):
+            acc += inverse[i, j] * rhs[j]
+        out[7 + i] = acc
+    x_t = to_global(r, v)
+    q_t = quaternion_rate(quat, w, restoring)
+    for i in range(3):
+        out[i] = x_t[i]
+    for i in range(4):
+        out[3 + i] = q_t[i]

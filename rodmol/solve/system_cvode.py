@@ -1,0 +1,111 @@
+"""CVODE (BDF) over a system of rods and rigid bodies
+(:class:`rodmol.discretise.assembly.Assembly`).
+
+The Newton systems are solved (``linsolver``) by
+
+* ``"gmres"`` (default): GMRES preconditioned by the rods' exact block
+  preconditioners and the bodies' own blocks
+  (:mod:`rodmol.discretise.system_preconditioner`); about 2x faster than
+  ``"sparse"`` on the octopus (``solvers/octopus.py``, docs/performance.md);
+* ``"sparse"``: SuperLU_MT (scikit-sundae) on the assembly's Jacobian
+  pattern, the rods' banded patterns on the diagonal and the joints'
+  coupling blocks; scikit-sundae fills the Jacobian by its own coloured
+  differences over that pattern;
+* ``"dense"``: small systems and cross-checks.
+"""
+
+import time
+
+import numpy as np
+
+from ..discretise.system_preconditioner import SystemPreconditioner
+from ..errors import ParameterError
+from .outputs import cause
+
+#: Linear solvers of a system run.
+SYSTEM_LINEAR_SOLVERS = ("sparse", "gmres", "dense")
+#: GMRES's Krylov dimension with the block preconditioner.
+KRYLOV_DIM = 5
+
+
+class _OutOfTime(Exception):
+    """Raised inside the right-hand side when the wall-time budget is used up."""
+
+
+def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, linsolver="gmres",
+                 max_step=0.0, max_order="auto"):
+    """Integrate ``assembly`` from ``y0`` at ``t_out[0]`` through the output
+    times ``t_out`` [s].
+
+    ``progress(t, t_end)`` is called at each output time; ``max_wall_time``
+    [s] is checked at every right-hand side, and ends the run when used up.
+
+    ``max_order`` caps the BDF order; ``"auto"`` is 2 when a rod is lightly
+    damped (``SemiDiscrete.lightly_damped``), else 5, as for one rod.
+
+    Returns (t (n,), states (n, size), success, message, stats, error): the
+    output frames reached; on failure (CVODE's, a user function's exception,
+    Ctrl-C) ``message`` says after which output time and why, and ``error``
+    holds the exception that stopped it, if any.
+    """
+    from sksundae.cvode import CVODE, CVODEPrecond
+
+    if linsolver not in SYSTEM_LINEAR_SOLVERS:
+        raise ParameterError(f"unknown `linsolver` {linsolver!r} for a system; valid: {list(SYSTEM_LINEAR_SOLVERS)}")
+    if max_order == "auto":
+        max_order = 2 if assembly.lightly_damped else 5
+    evals = [0]
+
+    def rhs(t, y, yp):
+        evals[0] += 1
+        if max_wall_time is not None and time.perf_counter() - start > max_wall_time:
+            raise _OutOfTime
+        assembly(t, y, yp)
+
+    options = dict(method="BDF", rtol=rtol, atol=atol, linsolver=linsolver, max_num_steps=1_000_000,
+                   max_step=max_step, max_order=int(max_order))
+    precond = None
+    if linsolver == "sparse":
+        options["sparsity"] = assembly.pattern()
+    elif linsolver == "gmres":
+        precond = SystemPreconditioner(assembly, np.broadcast_to(atol, (assembly.size,)) / rtol)
+        options.update(precond=CVODEPrecond(precond.setup, precond.solve, "left"), krylov_dim=KRYLOV_DIM)
+    t_out = np.asarray(t_out, dtype=float)
+    start = time.perf_counter()
+    if progress is not None:
+        progress(float(t_out[0]), float(t_out[-1]))
+    frames, message, error, jac_evals = [np.array(y0, dtype=float)], "", None, 0
+    solver = CVODE(rhs, **options)
+    solver.init_step(float(t_out[0]), frames[0])
+    for t_k in t_out[1:]:
+        reached = float(t_out[len(frames) - 1])
+        try:
+            r = solver.step(float(t_k))
+        except KeyboardInterrupt:
+            message = f"CVODE interrupted after t = {reached:.6g} s"
+            break
+        except _OutOfTime:
+            message = f"CVODE stopped after t = {reached:.6g} s: the wall-time budget max_wall_time = {max_wall_time:g} s is used up"
+            break
+        except Exception as exc:  # noqa: BLE001 (a user function's: reported with the frames before)
+            message, error = f"CVODE stopped after t = {reached:.6g} s: {cause(exc)}", exc
+            break
+        if not r.success:
+            message = f"CVODE stopped after t = {reached:.6g} s: {r.message}"
+            break
+        frames.append(np.array(r.y))
+        jac_evals = int(r.njev)
+        if progress is not None:
+            try:
+                progress(float(t_k), float(t_out[-1]))
+            except Exception as exc:  # noqa: BLE001 (the user's callable, guarded: a UserFunctionError)
+                message, error = f"CVODE stopped at t = {float(t_k):.6g} s: {cause(exc)}", exc
+                break
+    t, y = t_out[:len(frames)], np.array(frames)
+    assembly.project_quaternions(y)
+    success = len(t) == len(t_out)
+    stats = dict(rhs_evals=evals[0], jac_evals=jac_evals, linear_solver=linsolver,
+                 wall_time_s=time.perf_counter() - start)
+    if precond is not None:
+        stats.update(jac_evals=precond.jac_evals, prec_setups=precond.setups, prec_solves=precond.solves)
+    return t, y, success, message, stats, error

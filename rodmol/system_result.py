@@ -1,0 +1,118 @@
+"""The result of a system's run: each rod's :class:`Result` and each body's pose and velocities."""
+
+import numpy as np
+
+from .base_motion import BaseMotion
+from .discretise.rotations import matrices
+from .discretise.system import SemiDiscrete
+from .result import from_states
+
+
+class BodyResult:
+    """Time series of one rigid body.
+
+    Attributes
+    ----------
+    t : (n_t,) output times [s].
+    position : (n_t, 3) position of the body origin [m], global.
+    rotation : (n_t, 3, 3) body-to-global rotation matrices.
+    quaternion : (n_t, 4) the same rotations as unit quaternions (scalar first).
+    velocity : (n_t, 3) velocity of the body origin [m/s], body frame.
+    angular_velocity : (n_t, 3) angular velocity [rad/s], body frame.
+    """
+
+    def __init__(self, t, position, quaternion, velocity, angular_velocity):
+        self.t, self.position, self.quaternion = t, position, quaternion
+        self.rotation = matrices(quaternion)
+        self.velocity, self.angular_velocity = velocity, angular_velocity
+
+
+class SystemResult:
+    """Time series of a system's run; ``result[name]`` is a rod's
+    :class:`rodmol.Result` (built on first access, as a single rod's, its
+    base velocities those its body had at the frames) or a body's
+    :class:`BodyResult`.
+
+    Attributes
+    ----------
+    t : (n_t,) output times [s].
+    states : (n_t, size) the assembled states (``Assembly.parts`` says where each part sits).
+    success, message, stats, error : as for :class:`rodmol.Result`.
+    """
+
+    def __init__(self, assembly, t, states, success, message, stats, error=None):
+        self.assembly, self.t, self.states = assembly, np.asarray(t, dtype=float), np.asarray(states)
+        self.success, self.message, self.stats, self.error = success, message, stats, error
+        self._parts = {}
+
+    @property
+    def names(self):
+        """Names of the rods, then of the bodies."""
+        return list(self.assembly.parts)
+
+    def __getitem__(self, name):
+        if name not in self.assembly.parts:
+            raise KeyError(f"{name!r} is neither a rod nor a body of the system (names: {self.names})")
+        if name not in self._parts:
+            self._parts[name] = self._rod(name) if name in self.assembly.rods else self._body(name)
+        return self._parts[name]
+
+    def _body(self, name):
+        part = self.assembly.bodies[name]
+        y, n_t = self.states, len(self.t)
+        if part.body.free:
+            v, w = y[:, part.fields["v"]], y[:, part.fields["w"]]
+        else:
+            pairs = [self.assembly.body_velocities(part, ti, None) for ti in self.t]
+            v, w = (np.array([p[j] for p in pairs]).reshape(n_t, 3) for j in (0, 1))
+        return BodyResult(self.t, y[:, part.fields["x"]], y[:, part.fields["Q"]], v, w)
+
+    def _rod(self, name):
+        assembly = self.assembly
+        sd, y_rod = assembly.rods[name], self.states[:, assembly.parts[name]]
+        held = next((part for part in assembly.free if name in part.rods), None)
+        if held is not None:  # the same rod, its base moving as its body did at the frames
+            sd = SemiDiscrete(sd.model.replace(base=self._recorded_base(name, held, sd.model.base)), sd.scheme)
+        return from_states(sd, self.t, y_rod, self.success, self.message, dict(self.stats))
+
+    def _recorded_base(self, name, part, base):
+        """A BaseMotion replaying the base velocities of rod ``name`` on the free body
+        ``part`` (exact at the frames, linear between them), local frame of the base."""
+        i = part.rods.index(name)
+        v, w = self.states[:, part.fields["v"]], self.states[:, part.fields["w"]]
+        moving = np.array([part.base_velocities(vk, wk)[i] for vk, wk in zip(v, w)]).reshape(-1, 6)
+        v0, w0 = moving[:, :3], moving[:, 3:]
+        t = self.t
+
+        def replay(values):
+            return lambda s: np.array([np.interp(s, t, values[:, j]) for j in range(3)])
+
+        return BaseMotion(replay(v0), replay(w0), base.position, base.rotation)
+
+    def momentum(self):
+        """Total linear [kg m/s] and angular momentum about the origin [kg m^2/s]
+        of the system at each frame, global: two (n_t, 3) arrays."""
+        pairs = [self.assembly.momentum(y) for y in self.states]
+        return np.array([p[0] for p in pairs]), np.array([p[1] for p in pairs])
+
+    def pose_drift(self, name):
+        """How far the base header of rod ``name`` (integrated with the rod) has
+        drifted from its clamp on its body (integrated with the body): (distance
+        [m], angle [rad]) at each frame, each (n_t,); zeros for a rod not on a body."""
+        assembly, n_t = self.assembly, len(self.t)
+        body = assembly.system.clamps.get(name, (None,))[0]
+        if body is None:
+            return np.zeros(n_t), np.zeros(n_t)
+        _, point, rj = assembly.system.clamps[name]
+        b = self[body]
+        lay, y_rod = assembly.rods[name].layout, self.states[:, assembly.parts[name]]
+        expected_u = b.position + b.rotation @ point
+        expected_r = b.rotation @ rj
+        r0 = matrices(lay.base_quaternion(y_rod))
+        relative = np.einsum("nji,njk->nik", expected_r, r0)
+        cos = np.clip((np.trace(relative, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+        return np.linalg.norm(lay.base_position(y_rod) - expected_u, axis=-1), np.arccos(cos)
+
+    def __repr__(self):
+        state = "success" if self.success else f"failed: {self.message}"
+        return f"SystemResult({self.names}, {len(self.t)} frames, {state})"

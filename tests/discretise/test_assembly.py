@@ -1,0 +1,53 @@
+"""The assembled system of rods and bodies (rodmol.discretise.assembly): its
+composed layout and Jacobian pattern."""
+
+import numpy as np
+
+import rodmol
+from rodmol.discretise.assembly import Assembly
+
+
+def _system():
+    mat = rodmol.Material(E=1e5, nu=0.5, mu=300.0, rho=1080.0)
+    rod = rodmol.Rod(0.2, radius=0.01, material=mat)
+    arm = rodmol.Model(rod, 4, cables=[rodmol.Cable((0.005, 0.0), 0.2, tension=0.1)])
+    head = rodmol.RigidBody(0.05, (2e-5, 3e-5, 4e-5), centre_of_mass=(0.0, 0.004, 0.0), volume=2e-5,
+                            drag=(1, 2, 3, 0.1, 0.2, 0.3), added_mass=(0.01, 0.02, 0.03, 0, 0, 0))
+    plate = rodmol.RigidBody(0.5, (1e-3, 1e-3, 1e-3), motion="fixed", position=(1.0, 0.0, 0.0))
+    joints = [rodmol.Joint(("head", (0.02, 0.0, 0.0)), ("a", "base")),
+              rodmol.Joint(("head", (-0.02, 0.0, 0.0), np.diag([-1.0, -1.0, 1.0])), ("b", "base")),
+              rodmol.Joint(("plate", (0.0, 0.0, 0.0)), ("c", "base"))]
+    return rodmol.System({"a": arm, "b": arm, "c": arm}, {"head": head, "plate": plate}, joints,
+                         medium="water", gravity=(0.0, 0.0, -9.81))
+
+
+def test_parts_tile_the_state_in_order():
+    assembly = Assembly(_system())
+    rod_size = assembly.rods["a"].size
+    spans = [(s.start, s.stop) for s in assembly.parts.values()]
+    assert spans == [(0, rod_size), (rod_size, 2 * rod_size), (2 * rod_size, 3 * rod_size),
+                     (3 * rod_size, 3 * rod_size + 13), (3 * rod_size + 13, 3 * rod_size + 20)]
+    assert assembly.size == 3 * rod_size + 20 == len(assembly.atol_scale())
+
+
+def test_pattern_holds_every_nonzero_of_a_difference_jacobian():
+    assembly = Assembly(_system())
+    rng = np.random.default_rng(3)
+    y = assembly.initial_state()
+    y += 1e-2 * rng.standard_normal(assembly.size) * assembly.atol_scale()
+    f0 = assembly(0.0, y)
+    pattern = assembly.pattern().toarray()
+    touched = np.zeros_like(pattern)
+    for j in range(assembly.size):
+        step = 1e-6 * assembly.atol_scale()[j]
+        z = y.copy()
+        z[j] += step
+        touched[:, j] = assembly(0.0, z) != f0
+    missing = np.argwhere(touched & ~pattern)
+    assert missing.size == 0, f"entries outside the pattern: {missing[:5].tolist()}"
+    head = assembly.bodies["head"].fields
+    first = assembly.parts["a"].start + assembly.rods["a"].layout.header
+    assert touched[head["w"].start, first:first + 19].any()  # the rod pulls on the head
+    assert touched[first:first + 19, head["v"].start].any()  # the head carries the rod
+    plate = assembly.bodies["plate"].fields
+    assert not pattern[:, plate["x"]].any() and not pattern[plate["x"]].any()  # a fixed body stays

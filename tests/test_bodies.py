@@ -1,0 +1,99 @@
+"""Rigid bodies and systems on the problem floor: mass properties of meshes
+against analytic values, and the checks of bodies, joints and systems."""
+
+import meshio
+import numpy as np
+import pytest
+
+import rodmol
+from rodmol.bodies import mesh_properties
+
+# A unit cube's 12 outward triangles, vertices indexed by the bits (x, y, z).
+_CUBE = np.array([[0, 2, 3], [0, 3, 1], [4, 5, 7], [4, 7, 6], [0, 1, 5], [0, 5, 4],
+                  [2, 6, 7], [2, 7, 3], [0, 4, 6], [0, 6, 2], [1, 3, 7], [1, 7, 5]])
+_CORNERS = np.array([[(i >> 2) & 1, (i >> 1) & 1, i & 1] for i in range(8)], dtype=float)
+
+
+@pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")  # meshio's binary-STL size probe
+def test_box_from_an_stl_file_has_the_analytic_mass_properties(tmp_path):
+    size, corner, density = np.array([0.3, 0.2, 0.1]), np.array([1.0, -2.0, 0.5]), 700.0
+    path = tmp_path / "box.stl"
+    meshio.write(path, meshio.Mesh(corner + _CORNERS * size, [("triangle", _CUBE)]), binary=False)
+    body = rodmol.RigidBody.from_mesh(path, density)
+    a, b, c = size
+    mass = density * a * b * c
+    assert body.volume == pytest.approx(a * b * c, rel=1e-12)
+    assert body.mass == pytest.approx(mass, rel=1e-12)
+    np.testing.assert_allclose(body.centre_of_mass, corner + size / 2, rtol=1e-12)
+    expected = mass / 12.0 * np.diag([b * b + c * c, a * a + c * c, a * a + b * b])
+    np.testing.assert_allclose(body.inertia, expected, rtol=1e-9, atol=1e-12 * mass)
+
+
+def test_corner_tetrahedron_matches_its_moments_and_ignores_orientation():
+    # The tetrahedron (0, a e1, b e2, c e3): V = abc/6, centroid (a, b, c)/4,
+    # integral of x^2 = a^3 bc/60, of xy = a^2 b^2 c/120 (about the origin).
+    a, b, c = 0.5, 0.7, 1.1
+    points = np.array([[0, 0, 0], [a, 0, 0], [0, b, 0], [0, 0, c]], dtype=float) + 0.25
+    outward = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    volume, centre, inertia = mesh_properties(points, outward)
+    assert volume == pytest.approx(a * b * c / 6.0, rel=1e-12)
+    np.testing.assert_allclose(centre, np.array([a, b, c]) / 4.0 + 0.25, rtol=1e-12)
+    abc = a * b * c
+    second = np.array([[a * a * abc / 60, a * b * abc / 120, a * c * abc / 120],
+                       [a * b * abc / 120, b * b * abc / 60, b * c * abc / 120],
+                       [a * c * abc / 120, b * c * abc / 120, c * c * abc / 60]])
+    m = np.array([a, b, c]) / 4.0
+    second -= volume * np.outer(m, m)  # about the centroid
+    np.testing.assert_allclose(inertia, np.trace(second) * np.eye(3) - second, rtol=1e-10)
+    flipped = mesh_properties(points, outward[:, ::-1])
+    np.testing.assert_allclose(flipped[2], inertia, rtol=1e-12)
+    assert flipped[0] == pytest.approx(volume)
+
+
+def test_mass_matrix_about_the_origin_shifts_the_inertia_by_parallel_axes():
+    c = np.array([0.1, -0.2, 0.05])
+    body = rodmol.RigidBody(2.0, (0.01, 0.02, 0.03), centre_of_mass=c, added_mass=[1, 1, 1, 0, 0, 0])
+    shifted = np.diag([0.01, 0.02, 0.03]) + 2.0 * (c @ c * np.eye(3) - np.outer(c, c))
+    np.testing.assert_allclose(body.mass_matrix[3:, 3:], shifted)
+    np.testing.assert_allclose(body.mass_matrix[:3, :3], 3.0 * np.eye(3))
+    # The momentum of a body turning about its origin is m w x c.
+    w = np.array([0.3, -1.0, 2.0])
+    np.testing.assert_allclose(body.mass_matrix[:3, 3:] @ w, 2.0 * np.cross(w, c))
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    (dict(mass=-1.0, inertia=(1, 1, 1)), "mass"),
+    (dict(mass=1.0, inertia=(1, -1, 1)), "inertia"),
+    (dict(mass=1.0, inertia=[[1, 0.5, 0], [0, 1, 0], [0, 0, 1]]), "inertia"),
+    (dict(mass=1.0, inertia=(1, 1, 1), drag=(1, 1, 1)), "drag"),
+    (dict(mass=1.0, inertia=(1, 1, 1), motion="floating"), "motion"),
+    (dict(mass=1.0, inertia=(1, 1, 1), motion=rodmol.BaseMotion(), position=(1, 0, 0)), "position"),
+])
+def test_bad_bodies_are_refused_naming_the_parameter(kwargs, name):
+    with pytest.raises(rodmol.ParameterError, match=name):
+        rodmol.RigidBody(**kwargs)
+
+
+def _arm(n=4):
+    rod = rodmol.Rod(0.2, radius=0.01, material=rodmol.Material(E=1e5, nu=0.5, mu=100.0, rho=1000.0))
+    return rodmol.Model(rod, n)
+
+
+def test_system_graph_checks():
+    head = rodmol.RigidBody(1.0, (1e-3, 1e-3, 1e-3))
+    on_head = rodmol.Joint(("head", (0.1, 0, 0)), ("arm", "base"))
+    system = rodmol.System({"arm": _arm()}, {"head": head}, [on_head])
+    assert system.rods_on("head") == ["arm"]
+    with pytest.raises(rodmol.ParameterError, match="'hed'.*did you mean 'head'"):
+        rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint(("hed", (0, 0, 0)), ("arm", "base"))])
+    with pytest.raises(rodmol.NotSupportedYet, match="tip"):
+        rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint("world", ("arm", "tip"))])
+    with pytest.raises(rodmol.NotSupportedYet, match="loops"):
+        rodmol.System({"arm": _arm()}, {"head": head}, [on_head, rodmol.Joint("world", ("arm", "base"))])
+    with pytest.raises(rodmol.NotSupportedYet, match="body 'head'"):
+        rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint("world", ("head", (0, 0, 0)))])
+    with pytest.raises(rodmol.ParameterError, match="used twice"):
+        rodmol.System({"head": _arm()}, {"head": head})
+    moving = _arm().replace(base=rodmol.BaseMotion(velocity=lambda t: (0, 0, 0)))
+    with pytest.raises(rodmol.ParameterError, match="`base` must be the default"):
+        rodmol.System({"arm": moving}, {"head": head}, [on_head])
