@@ -21,9 +21,6 @@ from .markers import Marker, marker_offsets
 from .parameters import Medium
 from .rod import Rod
 
-#: Strain of the straight reference configuration, q* = (1, 0, 0).
-Q_STAR = np.array([1.0, 0.0, 0.0])
-Q_STAR.flags.writeable = False
 #: Most elements a Model accepts (memory, not accuracy, is the limit: a run at
 #: N = 1e4 already takes minutes per simulated second).
 MAX_ELEMENTS = 100_000
