@@ -34,7 +34,7 @@ from .calibrate import (
 from .control import Simulator, StaticFit, inverse_statics, inverse_statics_path
 from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
-from .discretise.system import SemiDiscrete, StateView
+from .discretise.system import SemiDiscrete, StateView, straight_state, undeformed_state
 from .errors import EquilibriumError, IntegrationError, ParameterError, RodmolError, UserFunctionError
 from .loads import (
     CapsuleContact,
@@ -52,7 +52,7 @@ from .parameters import MEDIA, Material, Medium
 from .result import Result
 from .rod import Rod
 from .scenario.file import ScenarioError, load_scenario
-from .simulate import default_atol, simulate, straight_state, undeformed_state
+from .simulate import default_atol, simulate
 from .solve.backends import BACKENDS
 from .solve.equilibrium import equilibrium
 

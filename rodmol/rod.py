@@ -9,7 +9,6 @@ from . import _checks
 from .errors import ParameterError
 from .parameters import Material
 
-
 #: The rest strains of a straight rod, local frame: stretch/shear q* [-] and curvature/twist k* [1/m].
 STRAIGHT_STRETCH, STRAIGHT_CURVATURE = (1.0, 0.0, 0.0), (0.0, 0.0, 0.0)
 

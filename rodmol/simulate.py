@@ -10,7 +10,7 @@ import numpy as np
 from . import _checks, _settings, run_sinks
 from .discretise.layout import StateLayout
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
-from .discretise.system import SemiDiscrete, straight_state, undeformed_state
+from .discretise.system import SemiDiscrete
 from .errors import ParameterError
 from .model import Model
 from .result import Result, from_states
