@@ -165,4 +165,5 @@ def test_backends_agree_on_a_precurved_rod_released_under_gravity():
     cvode, galpha = runs["cvode"].tip, runs["galpha"].tip
     np.testing.assert_allclose(cvode[0], rodmol.undeformed_state(model)[-19:-16], atol=1e-12)
     assert np.linalg.norm(cvode[-1] - cvode[0]) > 0.01  # it moved
-    assert np.max(np.linalg.norm(cvode - galpha, axis=-1)) < 1e-3 * np.max(np.linalg.norm(cvode - cvode[0], axis=-1))
+    motion = np.max(np.linalg.norm(cvode - cvode[0], axis=-1))
+    assert np.max(np.linalg.norm(cvode - galpha, axis=-1)) < 1e-4 * motion  # 3e-6 measured
