@@ -78,7 +78,8 @@ class Model:
             raise ParameterError(f"`n_elements` must be <= {MAX_ELEMENTS}, got {self.n_elements}")
         self.gravity = _checks.vector3("gravity", gravity)
         self.medium = _medium(medium, medium_density)
-        self.cables = _checks.items("cables", cables, Cable, "a rodmol.Cable")
+        # Displacement-controlled cables measure their default rest length on this rod's rest shape.
+        self.cables = tuple(c.on_rod(rod) for c in _checks.items("cables", cables, Cable, "a rodmol.Cable"))
         self.base = BaseMotion() if base is None else base
         if not isinstance(self.base, BaseMotion):
             raise ParameterError(f"`base` must be a rodmol.BaseMotion or None, got {base!r}")
@@ -177,6 +178,7 @@ def _check_no_inline_functions(model):
     inputs += [(f"cable {c.name!r} offset", c.offset) for c in model.cables if callable(c.offset)]
     inputs += [(f"base {k}", getattr(model.base, k)) for k in ("velocity", "angular_velocity")]
     inputs += [(f"load {getattr(x, 'name', x)!r}", x) for x in model.loads]
+    inputs += [(f"rod {name}", getattr(model.rod, name)) for name in ("rest_curvature", "rest_stretch")]
     for label, value in inputs:
         name = _inline_function(value)
         if name:

@@ -107,7 +107,7 @@ def _closed_loop(system, t, tol, max_iter, max_rounds=30):
 
     y = system.undeformed_state()
     tensions = law(y)
-    # A displacement-controlled cable's law on the straight rod can ask for far
+    # A displacement-controlled cable's law on the undeformed rod can ask for far
     # more than the arm carries (the rigid-rod tension); start it slack.
     tensions[[c.actuated for c in model.cables]] = 0.0
     scale = max(load_scale(model, t, tensions, system.grid_loads), 1e-12)

@@ -167,3 +167,22 @@ def test_backends_agree_on_a_precurved_rod_released_under_gravity():
     assert np.linalg.norm(cvode[-1] - cvode[0]) > 0.01  # it moved
     motion = np.max(np.linalg.norm(cvode - cvode[0], axis=-1))
     assert np.max(np.linalg.norm(cvode - galpha, axis=-1)) < 1e-4 * motion  # 3e-6 measured
+
+
+def test_displacement_controlled_cable_follows_the_rest_shape():
+    """A tendon without a given rest length is just taut on the precurved rod
+    at rest: no tension there, the equilibrium is the undeformed rod; its rest
+    length is the path on the curve (on the outside of the bend: longer than
+    on the straight rod by the factor 1 + |p_y| / R)."""
+    rod = rodmol.Rod(QUARTER, RADIUS, MATERIAL, rest_curvature=(0.0, 0.0, 1.0 / BEND_RADIUS))
+    tendon = rodmol.Cable((-0.005, 0.0), QUARTER, displacement=0.0, compliance=1e-3, name="outer")
+    model = rodmol.Model(rod, 10, gravity=(0.0, 0.0, 0.0), cables=[tendon])
+    on_rod = model.cables[0]
+    assert tendon.rest_length == pytest.approx(QUARTER, rel=1e-12)  # the straight rod's
+    assert on_rod.rest_length == pytest.approx(QUARTER * (1.0 + 0.005 / BEND_RADIUS), rel=1e-12)
+    y = rodmol.undeformed_state(model)
+    system = rodmol.SemiDiscrete(model)
+    assert system.tensions(0.0, y)[0] < 1e-9
+    np.testing.assert_allclose(rodmol.equilibrium(model), y, atol=1e-12)
+    # Back on a straight rod, the default is the straight path again.
+    assert model.replace(rod=rodmol.Rod(QUARTER, RADIUS, MATERIAL)).cables[0].rest_length == tendon.rest_length
