@@ -78,8 +78,7 @@ class Model:
             raise ParameterError(f"`n_elements` must be <= {MAX_ELEMENTS}, got {self.n_elements}")
         self.gravity = _checks.vector3("gravity", gravity)
         self.medium = _medium(medium, medium_density)
-        # Displacement-controlled cables measure their default rest length on this rod's rest shape.
-        self.cables = tuple(c.on_rod(rod) for c in _checks.items("cables", cables, Cable, "a rodmol.Cable"))
+        self.cables = _checks.items("cables", cables, Cable, "a rodmol.Cable")
         self.base = BaseMotion() if base is None else base
         if not isinstance(self.base, BaseMotion):
             raise ParameterError(f"`base` must be a rodmol.BaseMotion or None, got {base!r}")
@@ -88,6 +87,8 @@ class Model:
         self.munk_moment = _checks.flag("munk_moment", munk_moment)
         self.drag_law, self.drag_coefficients = _drag_law(drag_law, drag_coefficients)
         self._check_cables()
+        # Displacement-controlled cables measure their default rest length on this rod's rest shape.
+        self.cables = tuple(c.on_rod(rod) for c in self.cables)
         names = ", ".join(t.__name__ for t in load_types.LOAD_TYPES)
         self.loads = _checks.items("loads", loads, load_types.LOAD_TYPES, f"one of rodmol's loads ({names})")
         names = [c.name for c in self.cables]

@@ -43,7 +43,7 @@ class Rod:
 
     Stresses are measured from the rest strains: N = Kl (q - q*) + Vl q_t,
     M = Kth (k - k*) + Vth k_t. The rest shape is the rod these strains
-    build from the base (:func:`rodmol.rest_state`).
+    build from the base (:func:`rodmol.undeformed_state`).
     """
 
     length: float
