@@ -186,3 +186,22 @@ def test_displacement_controlled_cable_follows_the_rest_shape():
     np.testing.assert_allclose(rodmol.equilibrium(model), y, atol=1e-12)
     # Back on a straight rod, the default is the straight path again.
     assert model.replace(rod=rodmol.Rod(QUARTER, RADIUS, MATERIAL)).cables[0].rest_length == tendon.rest_length
+
+
+def test_energy_is_measured_from_the_rest_strains_and_conserved():
+    """A precurved, pretwisted rod without damping, gravity or fluid, set moving
+    from its rest shape: the strain energy starts at zero (it is measured from
+    the rest strains) and kinetic plus strain energy is conserved."""
+    rod = rodmol.Rod(QUARTER, RADIUS, MATERIAL, rest_curvature=_wavy_curvature, rest_stretch=_wavy_stretch)
+    model = rodmol.Model(rod, 10, gravity=(0.0, 0.0, 0.0))
+    y0 = rodmol.undeformed_state(model)
+    lay = rodmol.StateLayout(10)
+    lay.field(y0, "v")[:] = np.outer(np.linspace(0.1, 1.0, 10), [0.0, 0.02, 0.01])
+    lay.field(y0, "w")[:] = np.outer(np.linspace(0.1, 1.0, 10), [0.3, 0.0, -0.2])
+    run = rodmol.simulate(model, 0.1, initial=y0, rtol=1e-9, output_dt=0.02)
+    assert run.success, run.message
+    energy = rodmol.energy(model, run)
+    assert energy["strain"][0] == 0.0 and energy["kinetic"][0] > 0.0
+    assert np.max(energy["strain"]) > 0.3 * energy["kinetic"][0]  # energy went into the strains
+    drift = np.max(np.abs(energy["total"] - energy["total"][0]))
+    assert drift < 1e-5 * energy["total"][0], drift  # 3.2e-6 measured (the time error at rtol 1e-9)
