@@ -51,7 +51,8 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         End time [s], absolute (> ``t0``).
     initial : "equilibrium", "straight", Result or array
         Initial state: the static equilibrium under the loads at ``t0`` (the
-        paper's choice, the default), the undeformed straight rod at rest, an
+        paper's choice, the default), the unloaded rod at rest in its rest
+        shape (straight unless the rod has rest strains: ``undeformed_state``), an
         earlier :class:`Result` (the run continues from its last state, at its
         last time unless ``t0`` is given), or a state vector (``Result.states``).
     scheme : str
