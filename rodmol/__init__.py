@@ -35,7 +35,7 @@ from .calibrate import (
 from .control import Simulator, StaticFit, inverse_statics, inverse_statics_path
 from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
-from .discretise.system import SemiDiscrete, StateView
+from .discretise.system import SemiDiscrete, StateView, straight_state, undeformed_state
 from .errors import (
     EquilibriumError,
     IntegrationError,
@@ -60,7 +60,7 @@ from .parameters import MEDIA, Material, Medium
 from .result import Result
 from .rod import Rod
 from .scenario.file import ScenarioError, load_scenario
-from .simulate import default_atol, simulate, straight_state
+from .simulate import default_atol, simulate
 from .solve.backends import BACKENDS
 from .solve.equilibrium import equilibrium
 from .systems import Joint, System
@@ -72,7 +72,7 @@ __all__ = [
     "SCHEMES", "ScenarioError", "SemiDiscrete", "Simulator", "StateLayout", "StateView", "UserFunctionError",
     "default_atol", "energy",
     "equilibrium", "load_result", "load_scenario", "marker_errors", "oscillation_period", "paper_arm",
-    "read_tension_csv", "scenarios", "simulate", "straight_state", "write_series",
+    "read_tension_csv", "scenarios", "simulate", "straight_state", "undeformed_state", "write_series",
     # rodmol.calibrate: from experiment to model
     "LinearModel", "calibrate_dlt", "identify", "linearize", "paper_errors", "sweep", "triangulate",
     "worsened_models",

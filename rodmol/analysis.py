@@ -8,7 +8,6 @@ import numpy as np
 from .discretise import external
 from .discretise.system import SemiDiscrete
 from .errors import ParameterError
-from .model import Q_STAR
 
 
 def energy(model, result):
@@ -27,8 +26,9 @@ def energy(model, result):
     v, w = result.velocity[:, 1:], result.angular_velocity[:, 1:]
     kinetic = 0.5 * (np.einsum("tni,n,ni,tni->t", v, lengths, system.sampled.mass, v)
                      + np.einsum("tni,n,ni,tni->t", w, lengths, system.sampled.inertia, w))
-    dq = result.linear_strain[:, :-1] - Q_STAR
-    k = result.curvature[:, :-1]
+    rest_q, rest_k = system.rest  # the energy of the strains from the rest strains of each cell
+    dq = result.linear_strain[:, :-1] - rest_q
+    k = result.curvature[:, :-1] - rest_k
     strain = 0.5 * model.ds * (np.einsum("tni,ni,tni->t", dq, kl, dq)
                                + np.einsum("tni,ni,tni->t", k, kth, k))
     # The time-integrated positions, not the rebuilt ones: their rate is exactly R v,

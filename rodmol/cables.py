@@ -18,6 +18,7 @@ A tension input is any of
   the result stays correct).
 """
 
+import copy
 import inspect
 import math
 import os
@@ -110,7 +111,10 @@ class ActuatorTension(Tension):
 
     slack (T = 0) when the path is shorter than the free tendon. It reads the
     path length of the state (``StateView.cable_length``), so it is a
-    feedback law; without a state it assumes the straight rod.
+    feedback law; without a state it assumes the unloaded rod in its rest
+    shape (path length ``unloaded_length`` [m]). ``default_rest`` is True
+    if the rest length was not given (then it follows the rod's rest shape,
+    :meth:`Cable.on_rod`).
     """
 
     feedback = True
@@ -118,10 +122,12 @@ class ActuatorTension(Tension):
     held = False
     label = "displacement-controlled tension"
 
-    def __init__(self, name, position, compliance, base_to_actuator, rest_length, straight_length):
+    def __init__(self, name, position, compliance, base_to_actuator, rest_length, unloaded_length,
+                 default_rest=False):
         self.name, self.position = name, position
         self.compliance, self.base_to_actuator = compliance, base_to_actuator
-        self.rest_length, self.straight_length = rest_length, straight_length
+        self.rest_length, self.unloaded_length = rest_length, unloaded_length
+        self.default_rest = default_rest
 
     def free_length(self, t):
         """Unstretched tendon length [m] between the actuator and the anchor at t."""
@@ -147,7 +153,7 @@ class ActuatorTension(Tension):
         return 1.0 / (free * self.compliance), -(length + self.base_to_actuator) / (free**2 * self.compliance)
 
     def __call__(self, t, state=None):
-        length = self.straight_length if state is None else state.cable_length(self.name)
+        length = self.unloaded_length if state is None else state.cable_length(self.name)
         return self.from_length(t, length)
 
     def __repr__(self):
@@ -185,8 +191,9 @@ class Cable:
         Tendon length [m] from the actuator to the base, >= 0.
     rest_length : float, keyword-only
         Unstretched tendon length [m] from the actuator to the anchor at
-        z = 0; default: the path length on the straight rod plus
-        ``base_to_actuator`` (slack-free and unloaded when straight).
+        z = 0; default: the path length on the rod at rest plus
+        ``base_to_actuator`` (slack-free and unloaded in the rod's rest
+        shape; the model measures it on its rod, :meth:`on_rod`).
     friction : float, keyword-only
         Coefficient of friction [-] between the cable and the body (capstan
         law, see docs/model.md), >= 0; 0 (default) is frictionless.
@@ -241,14 +248,15 @@ class Cable:
         compliance = _checks.positive(f"{label} compliance", self.compliance, " 1/N")
         base = _checks.non_negative(f"{label} base_to_actuator", self.base_to_actuator, " m")
         straight = self.straight_length()
-        rest = straight + base if self.rest_length is None else _checks.positive(
+        default_rest = self.rest_length is None
+        rest = straight + base if default_rest else _checks.positive(
             f"{label} rest_length", self.rest_length, " m")
         object.__setattr__(self, "displacement", position)
         object.__setattr__(self, "compliance", compliance)
         object.__setattr__(self, "base_to_actuator", base)
         object.__setattr__(self, "rest_length", rest)
         object.__setattr__(self, "tension", ActuatorTension(self.name, position, compliance, base, rest,
-                                                            straight))
+                                                            straight, default_rest=default_rest))
 
     @property
     def actuated(self):
@@ -263,6 +271,39 @@ class Cable:
     def offset_at(self, s):
         """(p_y, p_z) [m] at arc lengths ``s`` [m], array (len(s), 2), local frame."""
         return cable_routing.offset_at(self.offset, s, self.name)
+
+    def on_rod(self, rod):
+        """This cable on ``rod``: a displacement-controlled cable whose rest length
+        was not given gets the path length on the rod's rest shape (plus
+        ``base_to_actuator``), so that it is just taut and unloaded there; any
+        other cable is returned as it is."""
+        tension = self.tension
+        if not self.actuated or not tension.default_rest:
+            return self
+        length = self.rest_path_length(rod)
+        if length == tension.unloaded_length:
+            return self
+        out = copy.copy(self)
+        rest = length + self.base_to_actuator
+        object.__setattr__(out, "rest_length", rest)
+        object.__setattr__(out, "tension", ActuatorTension(self.name, tension.position, self.compliance,
+                                                           self.base_to_actuator, rest, length, default_rest=True))
+        return out
+
+    def rest_path_length(self, rod):
+        """Path length [m] from the base to the anchor on ``rod`` at rest: the
+        integral of |q* + k* x p + p'| over s (the path's stretch with the rest
+        strains, docs/model.md; 2000 intervals, the rest strains at their
+        midpoints); :meth:`straight_length` on a straight rod."""
+        if rod.straight:
+            return self.straight_length()
+        s = np.linspace(0.0, self.anchor, 2001)
+        p = np.zeros((s.size, 3))
+        p[:, 1:] = self.offset_at(s)
+        rest_q, rest_k = rod.rest_strains_at(0.5 * (s[1:] + s[:-1]))
+        ds = np.diff(s)[:, None]
+        chords = ds * (rest_q + np.cross(rest_k, 0.5 * (p[1:] + p[:-1]))) + np.diff(p, axis=0)
+        return float(np.sum(np.linalg.norm(chords, axis=1)))
 
     def straight_length(self):
         """Path length [m] from the base to the anchor on the straight rod,

@@ -21,9 +21,6 @@ from .markers import Marker, marker_offsets
 from .parameters import Medium
 from .rod import Rod
 
-#: Strain of the straight reference configuration, q* = (1, 0, 0).
-Q_STAR = np.array([1.0, 0.0, 0.0])
-Q_STAR.flags.writeable = False
 #: Most elements a Model accepts (memory, not accuracy, is the limit: a run at
 #: N = 1e4 already takes minutes per simulated second).
 MAX_ELEMENTS = 100_000
@@ -90,6 +87,8 @@ class Model:
         self.munk_moment = _checks.flag("munk_moment", munk_moment)
         self.drag_law, self.drag_coefficients = _drag_law(drag_law, drag_coefficients)
         self._check_cables()
+        # Displacement-controlled cables measure their default rest length on this rod's rest shape.
+        self.cables = tuple(c.on_rod(rod) for c in self.cables)
         names = ", ".join(t.__name__ for t in load_types.LOAD_TYPES)
         self.loads = _checks.items("loads", loads, load_types.LOAD_TYPES, f"one of rodmol's loads ({names})")
         names = [c.name for c in self.cables]
@@ -180,6 +179,7 @@ def _check_no_inline_functions(model):
     inputs += [(f"cable {c.name!r} offset", c.offset) for c in model.cables if callable(c.offset)]
     inputs += [(f"base {k}", getattr(model.base, k)) for k in ("velocity", "angular_velocity")]
     inputs += [(f"load {getattr(x, 'name', x)!r}", x) for x in model.loads]
+    inputs += [(f"rod {name}", getattr(model.rod, name)) for name in ("rest_curvature", "rest_stretch")]
     for label, value in inputs:
         name = _inline_function(value)
         if name:

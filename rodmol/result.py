@@ -8,7 +8,6 @@ import numpy as np
 from ._files import refuse_directories, write_atomically
 from .discretise import centreline, physics, rotations
 from .discretise.layout import StateLayout
-from .model import Q_STAR
 
 #: Arrays of a Result, with their units (also the keys of the .npz file).
 ARRAYS = {
@@ -221,8 +220,9 @@ def _loads(system, result):
             n_tip[i] -= n_a
             m_tip[i] -= m_a
     kl_tip, kth_tip = model.rod.stiffness(model.rod.length)
+    rest_q, rest_k = model.rod.rest_strains_at(model.rod.length)
     boundary = np.empty((n_t, layout.boundary.size))
-    for name, value in dict(v=v0, w=w0, q=Q_STAR + n_tip / kl_tip, k=m_tip / kth_tip).items():
+    for name, value in dict(v=v0, w=w0, q=rest_q + n_tip / kl_tip, k=rest_k + m_tip / kth_tip).items():
         layout.boundary.field(boundary, name)[:, 0] = value
     rots = result.rotations[:, 1:]  # the pose's (a writer needs both)
     external_force, external_moment = np.zeros((2, n_t, len(result.s), 3))  # none at the clamp, node 0

@@ -1,6 +1,6 @@
-"""Rod geometry (radius profile) and the sectional stiffness, viscosity and inertia."""
+"""Rod geometry (radius profile, rest strains) and the sectional stiffness, viscosity and inertia."""
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -9,10 +9,14 @@ from . import _checks
 from .errors import ParameterError
 from .parameters import Material
 
+#: The rest strains of a straight rod, local frame: stretch/shear q* [-] and curvature/twist k* [1/m].
+STRAIGHT_STRETCH, STRAIGHT_CURVATURE = (1.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+
 
 @dataclass(frozen=True)
 class Rod:
-    """A straight rod of circular section along the local x axis.
+    """A rod of circular section, straight along the local x axis at rest
+    unless its rest strains say otherwise.
 
     Parameters
     ----------
@@ -25,11 +29,28 @@ class Rod:
         file), or a callable ``r(s)`` of the arc length s in [0, L] [m] (it
         is called with numpy arrays).
     material : Material
+    rest_curvature : (3,) floats, [(s, k_x, k_y, k_z), ...] or callable, keyword-only
+        Rest curvature and twist k*(s) [1/m], local (material) frame: k*_x
+        is the twist, k*_y and k*_z the curvatures about the section's axes.
+        A constant, ``(s, k_x, k_y, k_z)`` points [m, 1/m] spanning s = 0 to
+        L with increasing s (linear between them), or a callable ``k(s)`` of
+        an array of arc lengths [m] returning shape ``s.shape + (3,)`` (or
+        (3,) for a constant). Default (0, 0, 0): straight.
+    rest_stretch : (3,) floats, [(s, q_x, q_y, q_z), ...] or callable, keyword-only
+        Rest stretch and shear q*(s) [-], local frame, given like
+        ``rest_curvature``; q*_x > 0 (the section faces forward). Default
+        (1, 0, 0): unstretched, unsheared.
+
+    Stresses are measured from the rest strains: N = Kl (q - q*) + Vl q_t,
+    M = Kth (k - k*) + Vth k_t. The rest shape is the rod these strains
+    build from the base (:func:`rodmol.undeformed_state`).
     """
 
     length: float
     radius: Any
     material: Material
+    rest_curvature: Any = field(default=STRAIGHT_CURVATURE, kw_only=True)
+    rest_stretch: Any = field(default=STRAIGHT_STRETCH, kw_only=True)
 
     def __post_init__(self):
         object.__setattr__(self, "length", _checks.positive("length", self.length, " m"))
@@ -49,18 +70,56 @@ class Rod:
                     "`radius` must be a number, a (base, tip) pair, (s, r) points or a callable "
                     f"r(s), got {_checks.short(self.radius)}"
                 )
+        for name in REST_STRAINS:
+            self._rest_profile(name)
         # Callables are checked where they are sampled, on the actual grid.
-        self.radius_at(np.linspace(0.0, self.length, 65))
+        s = np.linspace(0.0, self.length, 65)
+        self.radius_at(s)
+        self.rest_strains_at(s)
 
-    def _points(self, points):
-        """``(s, r)`` points as a tuple of pairs, checked: increasing s from 0 to L."""
-        s, r = np.asarray(points, dtype=float).T
+    def _points(self, points, name="radius"):
+        """``(s, values...)`` points as a tuple of rows, checked: increasing s from 0 to L."""
+        points = np.asarray(points, dtype=float)
+        s = points[:, 0]
         if np.any(np.diff(s) <= 0):
-            raise ParameterError(f"`radius` points must have increasing s, got s = {_checks.short(s.tolist())}")
+            raise ParameterError(f"`{name}` points must have increasing s, got s = {_checks.short(s.tolist())}")
         if s[0] != 0.0 or abs(s[-1] - self.length) > 1e-9 * self.length:
-            raise ParameterError(f"`radius` points must span s = 0 to the length {self.length!r} m, "
+            raise ParameterError(f"`{name}` points must span s = 0 to the length {self.length!r} m, "
                                  f"got s from {s[0].item()!r} to {s[-1].item()!r} m")
-        return tuple((float(a), float(b)) for a, b in zip(s, r))
+        return tuple(tuple(float(x) for x in row) for row in points)
+
+    def _rest_profile(self, name):
+        """Check the form of a rest strain (a 3-vector, points or a callable) and
+        store constants and points as tuples."""
+        value = getattr(self, name)
+        if callable(value):
+            return
+        shape = np.shape(v) if (v := _checks.floats(value)) is not None else None
+        if shape == (3,):
+            object.__setattr__(self, name, tuple(float(x) for x in v))
+        elif len(shape or ()) == 2 and shape[1] == 4 and shape[0] >= 2:
+            object.__setattr__(self, name, self._points(v, name))
+        else:
+            raise ParameterError(
+                f"`{name}` must be a 3-vector (local frame), (s, x, y, z) points or a callable of s, "
+                f"got {_checks.short(value)}")
+
+    @property
+    def straight(self):
+        """True if the rod is straight and unstretched at rest (the default rest strains)."""
+        return self.rest_stretch == STRAIGHT_STRETCH and self.rest_curvature == STRAIGHT_CURVATURE
+
+    def rest_strains_at(self, s):
+        """Rest strains (q*, k*) at arc lengths ``s`` [m], each ``s.shape + (3,)``,
+        local frame: stretch/shear [-] and curvature/twist [1/m]."""
+        s = np.asarray(s, dtype=float)
+        q, k = (_vector_profile(name, getattr(self, name), s) for name in REST_STRAINS)
+        bad = ~(q[..., 0] > 0.0)
+        if np.any(bad):
+            i = np.flatnonzero(bad.ravel())[0]
+            raise ParameterError(f"`rest_stretch` must have q*_x > 0 along the rod (the section faces "
+                                 f"forward); q*({s.ravel()[i]:.6g} m) = {q.reshape(-1, 3)[i].tolist()}")
+        return q, k
 
     def radius_at(self, s):
         """Radius [m] at arc lengths ``s`` [m] (array in, array out)."""
@@ -125,3 +184,29 @@ class Rod:
     def mass(self):
         """Mass [kg]."""
         return self.material.rho * self.volume()
+
+
+#: The rest strain parameters, in the order :meth:`Rod.rest_strains_at` returns them.
+REST_STRAINS = ("rest_stretch", "rest_curvature")
+
+
+def _vector_profile(name, value, s):
+    """A rest strain ``value`` (checked by the Rod) sampled at arc lengths ``s`` [m],
+    ``s.shape + (3,)``, finite (else a ParameterError naming ``name``)."""
+    if callable(value):
+        try:
+            out = np.broadcast_to(np.asarray(value(s), dtype=float), s.shape + (3,))
+        except Exception as exc:
+            raise ParameterError(f"`{name}` callable failed on arc lengths (it must return "
+                                 f"s.shape + (3,) values, local frame): {exc}") from exc
+    elif np.ndim(value) == 1:
+        out = np.broadcast_to(np.asarray(value, dtype=float), s.shape + (3,))
+    else:
+        knots = np.asarray(value)
+        out = np.stack([np.interp(s, knots[:, 0], knots[:, c]) for c in (1, 2, 3)], axis=-1)
+    bad = ~np.all(np.isfinite(out), axis=-1)
+    if np.any(bad):
+        i = np.flatnonzero(bad.ravel())[0]
+        raise ParameterError(f"`{name}` must be finite along the rod; at s = {s.ravel()[i]:.6g} m it is "
+                             f"{out.reshape(-1, 3)[i].tolist()}")
+    return np.array(out)

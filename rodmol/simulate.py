@@ -10,7 +10,7 @@ import numpy as np
 from . import _checks, _settings, run_sinks
 from .discretise.layout import StateLayout
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
-from .discretise.system import SemiDiscrete, straight_state
+from .discretise.system import SemiDiscrete
 from .errors import ParameterError
 from .model import Model
 from .result import Result, from_states
@@ -55,7 +55,8 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         End time [s], absolute (> ``t0``).
     initial : "equilibrium", "straight", Result or array
         Initial state: the static equilibrium under the loads at ``t0`` (the
-        paper's choice, the default), the undeformed straight rod at rest, an
+        paper's choice, the default), the unloaded rod at rest in its rest
+        shape (straight unless the rod has rest strains: ``undeformed_state``), an
         earlier :class:`Result` (the run continues from its last state, at its
         last time unless ``t0`` is given), or a state vector (``Result.states``).
     scheme : str
@@ -272,7 +273,7 @@ def prepare_run(model, args, progress, sink=None):
         if args.atol is None:
             args = replace(args, atol=args.rtol * system.atol_scale())
         check_scales(system, args.t0, args.atol)  # before the kernels' first run, which would fail on them
-        kernels.prepare(system, args.t0, straight_state(system.model), args.run, args.rtol, args.atol,
+        kernels.prepare(system, args.t0, system.undeformed_state(), args.run, args.rtol, args.atol,
                         args.backend_options)
         getattr(sink, "prepare", lambda system: None)(system)
     initial = args.initial
@@ -345,8 +346,8 @@ def _initial_state(system, initial, t0):
     if isinstance(initial, str):
         if initial == "equilibrium":
             return equilibrium(system, t0)
-        if initial == "straight":
-            return straight_state(system.model)
+        if initial == "straight":  # the rest shape: straight unless the rod has rest strains
+            return system.undeformed_state()
     y0 = np.array(initial, dtype=float)  # sized by check_run, or the resumed run's own state
     problem = state_problem(system.layout, system.model.ds, t0, y0)
     if problem:

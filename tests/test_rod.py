@@ -77,3 +77,34 @@ def test_model_arrays_are_read_only():
     for array in (sampled.kth, sampled.kl, sampled.mass, sampled.cable_weights, model.s_nodes):
         with pytest.raises(ValueError, match="read-only"):
             array[:] *= 2.0
+
+
+def test_rest_strains_given_as_constant_points_or_callable():
+    """The three forms of a rest strain sample alike (points linear between them), the
+    default is the straight rod, and bad input is refused naming the parameter."""
+    mat = rodmol.Material(E=1e5, nu=0.5, rho=1000.0)
+    s = np.linspace(0.0, 0.3, 13)
+    straight = rodmol.Rod(0.3, 0.01, mat)
+    assert straight.straight
+    q, k = straight.rest_strains_at(s)
+    np.testing.assert_array_equal(q, np.tile([1.0, 0.0, 0.0], (13, 1)))
+    np.testing.assert_array_equal(k, np.zeros((13, 3)))
+    points = rodmol.Rod(0.3, 0.01, mat, rest_curvature=[(0.0, 1.0, 0.0, 2.0), (0.3, 1.0, 3.0, -1.0)],
+                        rest_stretch=[(0.0, 1.1, 0.0, 0.0), (0.1, 0.9, 0.0, 0.0), (0.3, 1.0, 0.05, 0.0)])
+    function = rodmol.Rod(0.3, 0.01, mat, rest_curvature=lambda s: np.stack([1 + 0 * s, 10 * s, 2 - 10 * s], -1),
+                          rest_stretch=lambda s: np.stack([np.interp(s, [0, 0.1, 0.3], [1.1, 0.9, 1.0]),
+                                                           np.interp(s, [0, 0.1, 0.3], [0, 0, 0.05]), 0 * s], -1))
+    assert not points.straight and not function.straight
+    for a, b in zip(points.rest_strains_at(s), function.rest_strains_at(s)):
+        np.testing.assert_allclose(a, b, atol=1e-15)
+    constant = rodmol.Rod(0.3, 0.01, mat, rest_curvature=[0, 0, 5])
+    assert constant.rest_curvature == (0.0, 0.0, 5.0)
+    np.testing.assert_array_equal(constant.rest_strains_at(s)[1], np.tile([0.0, 0.0, 5.0], (13, 1)))
+    for kwargs, says in ((dict(rest_curvature=(1.0, 2.0)), "`rest_curvature` must be a 3-vector"),
+                         (dict(rest_stretch="straight"), "`rest_stretch` must be a 3-vector"),
+                         (dict(rest_curvature=(0.0, np.nan, 1.0)), "`rest_curvature` must be finite"),
+                         (dict(rest_stretch=(-1.0, 0.0, 0.0)), r"`rest_stretch` must have q\*_x > 0"),
+                         (dict(rest_curvature=[(0.0, 0, 0, 1), (0.2, 0, 0, 1)]), "span s = 0 to the length"),
+                         (dict(rest_curvature=lambda s: s), "`rest_curvature` callable failed")):
+        with pytest.raises(rodmol.ParameterError, match=says):
+            rodmol.Rod(0.3, 0.01, mat, **kwargs)

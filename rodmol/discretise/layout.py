@@ -1,5 +1,5 @@
 """Packing of the semi-discrete state vector, node by node, and every structure
-derived from it: offsets, accessors, the straight state, absolute-tolerance
+derived from it: offsets, accessors, absolute-tolerance
 scales, the Jacobian pattern, its bandwidths and its colouring.
 
 The state starts with the base pose (u0, Q0: 7 values), then one block of 19
@@ -209,14 +209,6 @@ class StateLayout(BlockLayout):
         for name, value in zip(STATE_FIELDS, (u, quat, q, k, v, w)):
             b[:, FIELDS[name]] = value
         return y
-
-    def straight(self, s_nodes, position, rotation, quaternion):
-        """The undeformed rod at rest along the base's local x axis."""
-        n = self.n_blocks
-        u = np.asarray(position) + s_nodes[1:, None] * np.asarray(rotation)[:, 0]
-        zeros = np.zeros((n, 3))
-        q = np.tile([1.0, 0.0, 0.0], (n, 1))
-        return self.pack(position, quaternion, u, np.tile(quaternion, (n, 1)), q, zeros, zeros, zeros)
 
     def scales(self, per_field):
         """Every entry's typical magnitude, from one scale per field

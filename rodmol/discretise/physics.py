@@ -158,12 +158,11 @@ def strain_rate_terms(q, k, v, w):
 
 
 @jit
-def kelvin_voigt(kl, kth, vl, vth, q, k, q_t, k_t):
-    """Sectional stress (eq. 5): N = Kl (q - q*) + Vl q_t, M = Kth k + Vth k_t,
-    q* = (1, 0, 0); the diagonals are [N, N m^2, N s, N m^2 s]."""
-    n = (kl[0] * (q[0] - 1.0) + vl[0] * q_t[0], kl[1] * q[1] + vl[1] * q_t[1],
-         kl[2] * q[2] + vl[2] * q_t[2])
-    return n, add(mul(kth, k), mul(vth, k_t))
+def kelvin_voigt(kl, kth, vl, vth, q, k, q_t, k_t, rest_q, rest_k):
+    """Sectional stress (eq. 5) measured from the rest strains q* = ``rest_q``
+    [-] and k* = ``rest_k`` [1/m]: N = Kl (q - q*) + Vl q_t, M = Kth (k - k*)
+    + Vth k_t; the diagonals are [N, N m^2, N s, N m^2 s]."""
+    return add(mul(kl, sub(q, rest_q)), mul(vl, q_t)), add(mul(kth, sub(k, rest_k)), mul(vth, k_t))
 
 
 @jit

@@ -26,6 +26,12 @@ def cell_properties(model, s):
     return kl, kth, vl, vth
 
 
+def rest_strains(model, s):
+    """The rod's rest strains (q*, k*) at arc lengths ``s`` [m], each (len(s), 3),
+    local frame [-, 1/m]: a scheme samples them at its cells, with the stiffness."""
+    return model.rod.rest_strains_at(np.asarray(s, dtype=float))
+
+
 def cable_weights(model):
     """(n_cables, N) fraction of each strain node's cell on the cable's path:
     moving the anchor inside a cell shifts its concentrated load smoothly

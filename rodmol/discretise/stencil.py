@@ -21,8 +21,8 @@ The per-node physics comes from :mod:`rodmol.discretise.physics` and
 
 Packing of the sampled model (built once by ``SemiDiscrete``):
 
-* ``params`` (N, 25): per element, the constant sectional data, one row per
-  element (columns ``P_*``);
+* ``params`` (N, 31): per element, the constant sectional data, one row per
+  element (columns ``P_*``), the cell's rest strains q*, k* among them;
 * ``consts`` (9,): ds, quaternion restoring rate, drag smoothing speed^2,
   Munk switch (0/1), gravity (3, global), the scheme's kernel code, drag law
   (0 Morison, 1 componentwise C v|v|: then ``P_DRAG`` holds C);
@@ -71,19 +71,20 @@ COMPONENTWISE_DRAG = 8
 N_CONSTS = 9
 
 P_KL, P_KTH, P_VL, P_VTH, P_MASS, P_INERTIA = 0, 3, 6, 9, 12, 15
-P_NET_MASS, P_DRAG, P_ADDED = 18, 19, 22
-N_PARAMS = 25
+P_NET_MASS, P_DRAG, P_ADDED, P_REST_Q, P_REST_K = 18, 19, 22, 25, 28
+N_PARAMS = 31
 #: Columns of a ``work`` row: the Kelvin-Voigt N, M (6), the total N, M with
 #: the cables (6) and the external force and moment densities (6).
 WORK_STRESS, WORK_TOTAL, WORK_LOADS = 0, 6, 12
 WORK_COLUMNS = 18
 
 
-def pack_params(kl, kth, vl, vth, mass, inertia, net_mass, drag, added):
-    """The (N, 25) parameter rows of the sampled model."""
+def pack_params(kl, kth, vl, vth, mass, inertia, net_mass, drag, added, rest_q, rest_k):
+    """The (N, 31) parameter rows of the sampled model."""
     params = np.empty((len(kl), N_PARAMS))
     for col, arr in ((P_KL, kl), (P_KTH, kth), (P_VL, vl), (P_VTH, vth), (P_MASS, mass),
-                     (P_INERTIA, inertia), (P_DRAG, drag), (P_ADDED, added)):
+                     (P_INERTIA, inertia), (P_DRAG, drag), (P_ADDED, added), (P_REST_Q, rest_q),
+                     (P_REST_K, rest_k)):
         params[:, col:col + 3] = arr
     params[:, P_NET_MASS] = net_mass
     return params
@@ -147,7 +148,7 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
         _put(out, o + K, k_t)
         pr = params[i]
         n_el, m_el = kelvin_voigt(_vec(pr, P_KL), _vec(pr, P_KTH), _vec(pr, P_VL), _vec(pr, P_VTH),
-                                  q, k, q_t, k_t)
+                                  q, k, q_t, k_t, _vec(pr, P_REST_Q), _vec(pr, P_REST_K))
         row = work[i]
         _put(row, WORK_STRESS, n_el)
         _put(row, WORK_STRESS + 3, m_el)
@@ -196,7 +197,7 @@ def rhs(y, out, params, consts, offsets, weights, tensions, base,
             n_next, m_next = _vec(work[i + 1], WORK_TOTAL), _vec(work[i + 1], WORK_TOTAL + 3)
             k_next, q_next = _vec(y, o + BLOCK + K), _vec(y, o + BLOCK + QS)
         else:
-            n_next, m_next, k_next, q_next = zero, zero, zero, (1.0, 0.0, 0.0)
+            n_next, m_next, k_next, q_next = zero, zero, zero, zero  # no stress, no products
         f_next, t_next = cross(k_next, n_next), add(cross(k_next, m_next), cross(q_next, n_next))
         if not centred:
             length, f_cells, t_cells = ds, f_next, t_next

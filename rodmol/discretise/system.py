@@ -19,7 +19,7 @@ from . import centreline, external, load_entries, rotations, stencil
 from .layout import StateLayout, merge
 from .physics import compile_signatures
 from .routing import CableRouting
-from .sampling import Sampled, cell_properties
+from .sampling import Sampled, cell_properties, rest_strains
 from .schemes import DEFAULT_SCHEME, get_scheme
 
 #: Rate [1/s] at which the quaternion norm is pulled back to 1; the exact
@@ -41,12 +41,35 @@ def first_bending_frequency(model):
     return 1.8751**2 * np.sqrt(mat.E * r_base**2 / (4.0 * mat.rho)) / rod.length**2
 
 
-def straight_state(model):
-    """The undeformed rod at rest along the base's x axis."""
-    base = model.base
-    return StateLayout(model.n_elements).straight(
-        model.s_nodes, np.asarray(base.position, dtype=float), np.asarray(base.rotation, dtype=float),
-        rotations.from_matrix(base.rotation))
+def undeformed_state(model, scheme=DEFAULT_SCHEME):
+    """The unloaded rod at rest in its rest shape, for the spatial ``scheme``.
+
+    The strains are the rod's rest strains sampled at the scheme's cells (where
+    the stresses measure them from), the orientations follow from the base's
+    with the scheme's own kinematics, Q_{i+1} = Q_i exp(ds k*_i), and the
+    positions are the chords of ``physics.chord`` (as ``Result.positions``
+    rebuilds them): without loads every rate vanishes. A straight rod lies
+    along the base's local x axis, with positions s_i on it.
+    """
+    base, n = model.base, model.n_elements
+    position, rotation = np.asarray(base.position, dtype=float), np.asarray(base.rotation, dtype=float)
+    quat0 = rotations.from_matrix(base.rotation)
+    q, k = rest_strains(model, get_scheme(scheme).cell_points(model.s_nodes))
+    if model.rod.straight:  # in closed form: no round-off accumulated along the rod
+        u, quat = position + model.s_nodes[1:, None] * rotation[:, 0], np.tile(quat0, (n, 1))
+    else:
+        chain = np.empty((n + 1, 4))
+        chain[0] = quat0
+        for i, step in enumerate(rotations.from_rotation_vector(model.ds * k)):
+            chain[i + 1] = rotations.multiply(chain[i], step)
+        rotations.normalise(chain[None])
+        u, quat = centreline.positions(position, chain, q, k, model.ds)[1:], chain[1:]
+    zeros = np.zeros((n, 3))
+    return StateLayout(n).pack(position, quat0, u, quat, q, k, zeros, zeros)
+
+
+#: The undeformed state under its former name (the same function: straight unless the rod has rest strains).
+straight_state = undeformed_state
 
 
 def tensions_by_hand(model):
@@ -178,10 +201,12 @@ class SemiDiscrete:
         s_cells = self.scheme.cell_points(m.s_nodes)
         self.sampled = sampled = Sampled(m)
         self.cells = cell_properties(m, s_cells)
+        #: The rest strains (q*, k*) of the cells, each (N, 3), local frame [-, 1/m].
+        self.rest = rest_strains(m, s_cells)
         self.node_lengths = self.scheme.node_lengths(m.n_elements, m.ds)
         self.lightly_damped = grid_damping_ratio(m) < 1.0
         self._params = stencil.pack_params(*self.cells, sampled.mass, sampled.inertia, sampled.net_mass,
-                                           sampled.drag_coefficient, sampled.added)
+                                           sampled.drag_coefficient, sampled.added, *self.rest)
         self._consts = np.zeros(stencil.N_CONSTS)
         self._consts[:7] = (m.ds, QUATERNION_RESTORING_RATE, DRAG_SMOOTHING_SPEED**2,
                             1.0 if m.munk_moment else 0.0, *m.gravity)
@@ -316,6 +341,10 @@ class SemiDiscrete:
         """Arguments of :func:`rodmol.discretise.stencil.rhs` after (y, out):
         the packed model, the inputs :meth:`update_inputs` refreshes, scratch."""
         return self._args
+
+    def undeformed_state(self):
+        """The unloaded rod at rest in its rest shape, on this system's cells (:func:`undeformed_state`)."""
+        return undeformed_state(self.model, self.scheme)
 
     # ------------------------------------------------------------------ evaluation
 

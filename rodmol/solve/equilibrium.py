@@ -21,7 +21,7 @@ from ..discretise.jacobian import BandedDifferences
 from ..discretise.layout import BlockLayout
 from ..discretise.load_entries import load_scale
 from ..discretise.schemes import DEFAULT_SCHEME
-from ..discretise.system import SemiDiscrete, straight_state
+from ..discretise.system import SemiDiscrete
 from ..errors import EquilibriumError, ParameterError
 from ..model import Model
 from .watch import state_problem
@@ -105,9 +105,9 @@ def _closed_loop(system, t, tol, max_iter, max_rounds=30):
     def law(y):
         return system.tensions(t, y)
 
-    y = straight_state(model)
+    y = system.undeformed_state()
     tensions = law(y)
-    # A displacement-controlled cable's law on the straight rod can ask for far
+    # A displacement-controlled cable's law on the undeformed rod can ask for far
     # more than the arm carries (the rigid-rod tension); start it slack.
     tensions[[c.actuated for c in model.cables]] = 0.0
     scale = max(load_scale(model, t, tensions, system.grid_loads), 1e-12)
@@ -179,7 +179,7 @@ class RestEquations:
         base = model.base
         self._quat0 = rotations.from_matrix(base.rotation)
         self._u0 = np.asarray(base.position, dtype=float)
-        self._y = straight_state(model)
+        self._y = system.undeformed_state()
         self._rates = np.empty(self.layout.size)
         # Views and slices made once: the residual runs thousands of times per solve.
         self._sl, self._state_sl = self.static.slices(), self.layout.slices()
@@ -284,7 +284,7 @@ def rest_state(system, tensions, t=0.0, *, start=None, tol=1e-10, max_iter=40):
     """The rest state of ``system`` under cable ``tensions`` [N] (the other
     loads at t), as :func:`equilibrium` finds it but without its checks:
     Newton's method from ``start`` (a nearby rest state) first, the load
-    continuation from the straight rod if that fails. For loops that solve
+    continuation from the undeformed rod (its rest shape) if that fails. For loops that solve
     many nearby equilibria (the inverse statics); raises
     :class:`EquilibriumError` if none is found."""
     return _rest_state(system, t, tol, max_iter, tensions, start)
@@ -293,10 +293,10 @@ def rest_state(system, tensions, t=0.0, *, start=None, tol=1e-10, max_iter=40):
 def _rest_state(system, t, tol, max_iter, tensions=None, start=None):
     """The rest state under the loads at t (cable ``tensions`` [N] if given).
     ``start``, a nearby rest state (the closed loop's last iterate), is tried
-    first at the full loads; the continuation from the straight rod is the
+    first at the full loads; the continuation from the undeformed rod is the
     fallback."""
     equations = RestEquations(system, t, tensions)
-    y = straight_state(system.model)
+    y = system.undeformed_state()
     if equations.unloaded:
         return y
     z = equations.unknowns(y)

@@ -15,7 +15,7 @@ import inspect
 
 import numpy as np
 
-from ..discretise.system import SemiDiscrete, straight_state
+from ..discretise.system import SemiDiscrete
 from ..errors import ParameterError
 
 #: The Model arguments that bring a load, each with the value that removes it.
@@ -44,7 +44,7 @@ def check_scales(system, t, atol):
 def _sizes(system, t, atol):
     """(largest rate in tolerance units [1/s], the sum of their squares, largest Jacobian
     entry) at the straight rod, inf where they overflow, or None if a user function fails there."""
-    y = straight_state(system.model)
+    y = system.undeformed_state()
     try:
         with np.errstate(all="ignore"):
             rates = system(t, y)

@@ -20,7 +20,6 @@ import numpy as np
 
 import rodmol
 
-Q_STAR = np.array([1.0, 0.0, 0.0])
 #: The constants the scheme is documented to use (rodmol.discretise.system).
 RESTORING = 1.0
 DRAG_SMOOTHING_SPEED = 1e-6
@@ -117,6 +116,8 @@ class Sampled:
         self.componentwise = model.drag and model.drag_law == "componentwise"
         if self.componentwise:  # C v|v| per component replaces the medium's drag
             self.drag = np.tile(np.asarray(model.drag_coefficients, dtype=float), (n, 1))
+        # Rest strains q*, k* (the user's input, read through rodmol) where the cells are sampled.
+        self.rest_q, self.rest_k = rod.rest_strains_at(s_cell)
         self.radius = r_vel  # at velocity nodes 1..N
         self.gravity = np.asarray(model.gravity, dtype=float)
         self.munk = bool(model.munk_moment)
@@ -195,8 +196,8 @@ def friction_factors(model, data, q, k, v, w, v0, w0):
 
 def stresses(data, q, k, q_t, k_t, tensions):
     """(N_el, M_el, N_tot, M_tot) at the strain nodes."""
-    n_el = data.kl * (q - Q_STAR) + data.vl * q_t
-    m_el = data.kth * k + data.vth * k_t
+    n_el = data.kl * (q - data.rest_q) + data.vl * q_t
+    m_el = data.kth * (k - data.rest_k) + data.vth * k_t
     n_tot, m_tot = n_el.copy(), m_el.copy()
     tensions = np.asarray(tensions, dtype=float)
     tensions = np.broadcast_to(tensions[:, None] if tensions.ndim == 1 else tensions, data.cable_weights.shape)
@@ -303,11 +304,10 @@ def rates(model, t, y, tensions=None, scheme="upwind"):
     _, _, n_tot, m_tot = stresses(data, q, k, q_t, k_t, tensions)
 
     # Velocity nodes 1..N: differences of the total stress of the cells
-    # around them; it vanishes beyond the tip, where the strains are the
-    # reference ones.
+    # around them; it vanishes beyond the tip, and so do its products.
     zero = np.zeros((1, 3))
     n_next, m_next = np.vstack([n_tot[1:], zero]), np.vstack([m_tot[1:], zero])
-    k_next, q_next = np.vstack([k[1:], zero]), np.vstack([q[1:], Q_STAR])
+    k_next, q_next = np.vstack([k[1:], zero]), np.vstack([q[1:], zero])
     f_cells = cross(k_next, n_next)
     t_cells = cross(k_next, m_next) + cross(q_next, n_next)
     if data.centred:

@@ -53,6 +53,12 @@ def _models():
         "Munk moment": arm(7, tensions={7: 0.8, 2: 0.3}, munk_moment=True),
         "timed tensions (knots, callable)": arm(6, tensions={1: [(0.0, 0.0), (1.0, 2.0)],
                                                              10: lambda t: 0.4 + 0.1 * t}),
+        "precurved, pretwisted and stretched rod (points, callable), routed cable": rodmol.Model(
+            rodmol.Rod(0.3, (0.01, 0.006), rodmol.Material(E=2e5, nu=0.4, mu=40.0, rho=1100.0),
+                       rest_curvature=lambda s: np.stack([2.0 + 0 * s, -3.0 * s, 4.0 + 10.0 * s], axis=-1),
+                       rest_stretch=[(0.0, 1.05, 0.01, -0.02), (0.3, 0.95, -0.01, 0.03)]), 7,
+            medium="water", cables=[rodmol.Cable(lambda s: (0.003 * np.cos(20 * s), 0.003 * np.sin(20 * s)),
+                                                 0.25, 0.6, name="helix")]),
         "Timoshenko rod, G given, buoyancy only": rodmol.Model(timoshenko, 7, medium_density=500.0,
                                                                cables=[rodmol.Cable((0.0, 0.004), 0.3, 0.4)]),
         "point loads, global": arm(8, loads=[rodmol.PointForce(0.37 * L, (0.1, -0.2, 0.05)),
@@ -242,10 +248,10 @@ def test_strain_rate_terms():
 
 def test_kelvin_voigt():
     kl, kth, vl, vth = (tuple(abs(x) for x in _vec()) for _ in range(4))
-    q, k, q_t, k_t = _vec(), _vec(), _vec(), _vec()
-    n, m = physics.kelvin_voigt(kl, kth, vl, vth, q, k, q_t, k_t)
-    _close(n, np.multiply(kl, np.subtract(q, [1.0, 0.0, 0.0])) + np.multiply(vl, q_t))
-    _close(m, np.multiply(kth, k) + np.multiply(vth, k_t))
+    q, k, q_t, k_t, rest_q, rest_k = _vec(), _vec(), _vec(), _vec(), _vec(), _vec()
+    n, m = physics.kelvin_voigt(kl, kth, vl, vth, q, k, q_t, k_t, rest_q, rest_k)
+    _close(n, np.multiply(kl, np.subtract(q, rest_q)) + np.multiply(vl, q_t))
+    _close(m, np.multiply(kth, np.subtract(k, rest_k)) + np.multiply(vth, k_t))
 
 
 def test_cable_stress():

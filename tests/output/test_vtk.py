@@ -131,3 +131,17 @@ def test_external_loads_are_written_as_in_the_result(loaded, tmp_path):
     assert force[-1, 2] == pytest.approx(0.02 / (loaded.s[1] / 2), rel=1e-12)
     np.testing.assert_allclose(force[:-1, 2], 0.0, rtol=0, atol=1e-14)
     assert np.max(force[:, 1]) > 0.5  # the floor pushes up where the rod rests on it
+
+
+def test_a_precurved_rod_is_drawn_in_its_rest_shape_at_t0(tmp_path):
+    """The view's first frame is the undeformed precurved rod (a quarter circle of
+    radius R, tip near (R, R, 0)), with its rest curvature on the nodes."""
+    bend = 0.1
+    rod = rodmol.Rod(0.5 * np.pi * bend, 0.005, rodmol.Material(E=1e5, nu=0.5, mu=50.0, rho=1000.0),
+                     rest_curvature=(0.0, 0.0, 1.0 / bend))
+    run = rodmol.simulate(rodmol.Model(rod, 8, gravity=(0.0, 0.0, -9.81)), 0.01, initial="straight",
+                          output_dt=0.01)
+    mesh = pv.read(read_pvd(write_series(run, tmp_path, format="vtp"))[0][1])
+    # the chords ds R(mid) q of an arc of angle phi are long by about phi^2 / 24 (1.6e-3 here)
+    np.testing.assert_allclose(mesh.points[-1], [bend, bend, 0.0], atol=3e-3 * bend)
+    np.testing.assert_allclose(mesh.point_data["curvature [1/m]"][:, 2], 1.0 / bend, rtol=1e-12)
