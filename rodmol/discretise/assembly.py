@@ -154,13 +154,10 @@ class Assembly:
     # ------------------------------------------------------------------ state
 
     def initial_state(self):
-        """Every rod straight at rest at its base, every body at rest at its initial pose."""
+        """Every rod at rest in its rest shape at its base, every body at rest at its initial pose."""
         y = np.zeros(self.size)
         for name, sd in self.rods.items():
-            m = sd.model
-            y[self.parts[name]] = sd.layout.straight(m.s_nodes, np.asarray(m.base.position, dtype=float),
-                                                     np.asarray(m.base.rotation, dtype=float),
-                                                     from_matrix(np.asarray(m.base.rotation, dtype=float)))
+            y[self.parts[name]] = sd.undeformed_state()
         for part in self.bodies.values():
             y[part.fields["x"]] = part.body.position
             y[part.fields["Q"]] = from_matrix(part.body.rotation)
