@@ -40,6 +40,7 @@ from .loads import (
     CapsuleContact,
     DistributedForce,
     DistributedMoment,
+    Hold,
     PlaneContact,
     PointForce,
     PointMoment,
@@ -58,7 +59,7 @@ from .solve.equilibrium import equilibrium
 
 __all__ = [
     "BACKENDS", "Base", "BaseMotion", "Cable", "CapsuleContact", "DistributedForce",
-    "DistributedMoment", "PlaneContact", "PointForce", "PointMoment", "SphereContact", "EquilibriumError", "IntegrationError", "MEDIA",
+    "DistributedMoment", "Hold", "PlaneContact", "PointForce", "PointMoment", "SphereContact", "EquilibriumError", "IntegrationError", "MEDIA",
     "Marker", "Material", "Medium", "Model", "ParameterError", "Result", "Rod", "RodmolError",
     "SCHEMES", "ScenarioError", "SemiDiscrete", "Simulator", "StateLayout", "StateView", "UserFunctionError",
     "default_atol", "energy",

@@ -16,13 +16,14 @@ the compiled Jacobian of the dynamics takes them), and it is factorised with
 import numpy as np
 from scipy.linalg import solve_banded
 
-from ..discretise import centreline, rotations
+from ..discretise import centreline, external, rotations
 from ..discretise.jacobian import BandedDifferences
 from ..discretise.layout import BlockLayout
 from ..discretise.load_entries import load_scale
 from ..discretise.schemes import DEFAULT_SCHEME
 from ..discretise.system import SemiDiscrete, straight_state
 from ..errors import EquilibriumError, ParameterError
+from ..loads import P_STIFFNESS
 from ..model import Model
 from .watch import state_problem
 
@@ -191,9 +192,13 @@ class RestEquations:
 
     def tolerance(self, tol):
         """``tol`` raised to the round-off floor of the difference quotients:
-        differencing stresses of size EA * strain over ds loses digits as N grows."""
-        model = self.system.model
-        return max(tol, 10 * np.finfo(float).eps * np.max(self.system.sampled.kl) / (model.ds * self._force_scale))
+        differencing stresses of size EA * strain over ds loses digits as N grows,
+        and a hold's stiff penalty (rodmol.Hold) sees positions of size L rounded."""
+        model, grid = self.system.model, self.system.grid_loads
+        held = np.isin(grid.kind, (external.PIN, external.CLAMP))
+        hold_density = np.max(grid.params[held, P_STIFFNESS] * grid.weight[held], initial=0.0)
+        stiffest = max(np.max(self.system.sampled.kl) / model.ds, hold_density * model.rod.length)
+        return max(tol, 10 * np.finfo(float).eps * stiffest / self._force_scale)
 
     def unknowns(self, y):
         """The static unknowns z of a state vector ``y``."""
