@@ -146,7 +146,7 @@ def load(kind, p, value, u, quat, v, w):
         return to_local(r, value), zero
     if kind == DEAD_MOMENT:
         return zero, to_local(r, value)
-    if kind == PIN or kind == CLAMP:
+    if kind in (PIN, CLAMP):
         return hold(kind, p, value, u, quat, r, v, w)
     return contact(kind, p, u, r, v, w)
 

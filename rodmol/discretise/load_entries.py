@@ -11,8 +11,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..loads import HOLD_STIFFNESS_FACTOR, KERNELS, N_PARAMS, P_DAMPING, P_STIFFNESS, P_TURN_DAMPING, \
-    P_TURN_STIFFNESS
+from ..loads import (
+    HOLD_STIFFNESS_FACTOR,
+    KERNELS,
+    N_PARAMS,
+    P_DAMPING,
+    P_STIFFNESS,
+    P_TURN_DAMPING,
+    P_TURN_STIFFNESS,
+)
 from .layout import StateLayout
 from .rotations import from_matrix
 
