@@ -250,3 +250,16 @@ def test_default_law_is_the_documented_multiple_of_the_element_and_critical():
     np.testing.assert_allclose(law, (k, 2 * np.sqrt(k * mass), k * BEAM["radius"] ** 2 / 4,
                                      2 * np.sqrt(k * mass) * BEAM["radius"] ** 2 / 4), rtol=1e-12)
     assert list(grid.node) == [5]
+
+
+def test_a_very_stiff_pin_still_gives_the_propped_cantilever():
+    """1000 times the default stiffness: the equilibrium's residual floor is
+    raised for the pinned node's force rows only, so the rest state (its
+    positions rebuilt from the strains) still carries the beam's reaction."""
+    length = BEAM["length"]
+    w, ea, ga, ei = _section(**BEAM)
+    model = _model(_rod(**BEAM), 20, [])
+    k = 1e3 * HOLD_STIFFNESS_FACTOR * ea / model.ds
+    model = model.replace(loads=[rodmol.Hold(length, stiffness=k)])
+    force, _ = _hold_wrench(model, rodmol.equilibrium(model))
+    np.testing.assert_allclose(force[2], propped_cantilever(length, length, w, ei, ga)[0], rtol=2e-3)

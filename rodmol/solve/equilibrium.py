@@ -191,14 +191,19 @@ class RestEquations:
         self._force_scale = (self.scale or 1.0) / model.rod.length  # contact alone: forces of about 1 N
 
     def tolerance(self, tol):
-        """``tol`` raised to the round-off floor of the difference quotients:
-        differencing stresses of size EA * strain over ds loses digits as N grows,
-        and a hold's stiff penalty (rodmol.Hold) sees positions of size L rounded."""
+        """``tol`` raised to the round-off floor of the difference quotients, per
+        residual row: differencing stresses of size EA * strain over ds loses
+        digits as N grows; a hold's stiff penalty (rodmol.Hold) sees positions of
+        size L rounded, which raises the floor of its node's force rows only (the
+        compatibility rows keep theirs, or the positions would loosen with k)."""
         model, grid = self.system.model, self.system.grid_loads
-        held = np.isin(grid.kind, (external.PIN, external.CLAMP))
-        hold_density = np.max(grid.params[held, P_STIFFNESS] * grid.weight[held], initial=0.0)
-        stiffest = max(np.max(self.system.sampled.kl) / model.ds, hold_density * model.rod.length)
-        return max(tol, 10 * np.finfo(float).eps * stiffest / self._force_scale)
+        floor = 10 * np.finfo(float).eps / self._force_scale
+        elastic = max(tol, floor * np.max(self.system.sampled.kl) / model.ds)
+        out = self.static.blocks(np.full(self.static.size, elastic))
+        for e in np.flatnonzero(np.isin(grid.kind, (external.PIN, external.CLAMP))):
+            hold_density = grid.params[e, P_STIFFNESS] * grid.weight[e]
+            out[grid.node[e] - 1, self._sl["q"]] = max(elastic, floor * hold_density * model.rod.length)
+        return out.ravel()
 
     def unknowns(self, y):
         """The static unknowns z of a state vector ``y``."""
@@ -332,7 +337,7 @@ def _newton(fun, z, tol, max_iter, jacobian):
     f = fun(z)
     norm = np.linalg.norm(f)
     for _ in range(max_iter):
-        if np.max(np.abs(f)) < tol:
+        if np.all(np.abs(f) < tol):
             return z
         try:
             dz = solve_banded(jacobian.bands, jacobian(fun, z, f), -f)
@@ -349,4 +354,4 @@ def _newton(fun, z, tol, max_iter, jacobian):
             if alpha < 1.0 / 256:
                 return None
         z, f, norm = z_try, f_try, norm_try
-    return z if np.max(np.abs(f)) < tol else None
+    return z if np.all(np.abs(f) < tol) else None
