@@ -12,6 +12,7 @@ import shutil
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -166,6 +167,17 @@ def _quaternion_norm(out):
         assert row["tip_difference_m"] < 1e-6 and row["steps_with"] == row["steps_without"], row
 
 
+def _holds(out):
+    table = rows(out / "holds.csv")
+    assert all(row["success"] for row in table)
+    for problem in {row["problem"] for row in table}:
+        runs = sorted((row for row in table if row["problem"] == problem), key=lambda row: row["factor"])
+        for soft, stiff in zip(runs, runs[1:]):  # the pin's drift is F / k: it falls as the factor grows
+            ratio = soft["rest_drift_over_L"] / stiff["rest_drift_over_L"]
+            np.testing.assert_allclose(ratio, stiff["factor"] / soft["factor"], rtol=0.2)
+        assert all(row["steps_over_free"] < 3 for row in runs), runs
+
+
 SCRIPTS = {
     "scaling.py": (["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"], _scaling),
     "temporal.py": (["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv", "temporal_options.csv"],
@@ -187,6 +199,7 @@ SCRIPTS = {
     "inverse_statics.py": (["inverse_statics.csv", "inverse_statics.md"], _inverse_statics),
     "linear_mpc.py": (["linear_mpc.csv", "linear_mpc.md"], _linear_mpc),
     "quaternion_norm.py": (["quaternion_norm.csv", "quaternion_norm.md"], _quaternion_norm),
+    "holds.py": (["holds.csv", "holds.md"], _holds),
 }
 
 
