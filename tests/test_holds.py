@@ -263,3 +263,19 @@ def test_a_very_stiff_pin_still_gives_the_propped_cantilever():
     model = model.replace(loads=[rodmol.Hold(length, stiffness=k)])
     force, _ = _hold_wrench(model, rodmol.equilibrium(model))
     np.testing.assert_allclose(force[2], propped_cantilever(length, length, w, ei, ga)[0], rtol=2e-3)
+
+
+def test_a_stiffer_slack_rod_sags_instead_of_staying_compressed(clamped_pinned_rod):
+    """Ten times stiffer (E = 10 MPa): ramped together with the weight, the
+    pulled-in pin kept the rod on the straight, compressed branch (strain
+    -0.2, a rest state the dynamics would leave at once); the equilibrium
+    lets the rod sag first and then moves the pin in steps, so it hangs as
+    ``solve_bvp`` says."""
+    stiff = dict(SLACK, E=1e7)
+    length = stiff["length"]
+    w, ea, ga, ei = _section(**stiff)
+    shape, _ = clamped_pinned_rod(length, w, ea, ga, ei, (SPAN, 0.0))
+    model = _model(_rod(**stiff), 20, [rodmol.Hold(length, position=(SPAN, 0.0, 0.0))])
+    u = _positions(model, rodmol.equilibrium(model))
+    x, z = shape(model.s_nodes[1:])[:2]
+    assert np.max(np.hypot(u[:, 0] - x, u[:, 2] - z)) < 5e-3 * length

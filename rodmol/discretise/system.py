@@ -239,6 +239,7 @@ class SemiDiscrete:
         self._entry_weights = np.ascontiguousarray(entries.weight * stretch, dtype=float)
         self._entry_params = np.ascontiguousarray(entries.params, dtype=float).reshape(-1, external.N_PARAMS)
         self.entry_values = np.ascontiguousarray(entries.initial, dtype=float).reshape(-1, 3)
+        self._held = np.isin(self._kinds, (external.PIN, external.CLAMP))  # values: held displacements
         self.grid_loads = entries
 
     @property
@@ -328,16 +329,20 @@ class SemiDiscrete:
         stencil.rhs(y, out, *self._args)
         return out
 
-    def rest_rates(self, t, y, out, load_factor=1.0, tensions=None):
+    def rest_rates(self, t, y, out, load_factor=1.0, tensions=None, held_factor=None):
         """dy/dt at (t, y) with every applied load (gravity, tensions, external
-        load values) scaled by ``load_factor``, for the equilibrium's
-        continuation. ``tensions`` (n_cables,) [N] replace the cables' inputs
-        (the equilibrium of a feedback law iterates on them)."""
+        load values) scaled by ``load_factor`` and the held points'
+        displacements from rest (rodmol.Hold) by ``held_factor`` (default:
+        ``load_factor``), for the equilibrium's continuation. ``tensions``
+        (n_cables,) [N] replace the cables' inputs (the equilibrium of a
+        feedback law iterates on them)."""
         self.update_inputs(t, y, tensions)
         scaled = (self.tension_values, self._consts[4:7], self.entry_values)  # views, in place
         saved = [inputs.copy() for inputs in scaled]
         for inputs in scaled:
             inputs *= load_factor
+        if held_factor is not None:
+            self.entry_values[self._held] = saved[2][self._held] * held_factor
         try:
             stencil.rhs(y, out, *self._args)
         finally:
