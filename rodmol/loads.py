@@ -443,10 +443,10 @@ class Hold(_Load):
         ds = s_nodes[1] - s_nodes[0]
         i = int(round(self.s / ds))
         if i < 1 or abs(self.s - s_nodes[min(i, len(s_nodes) - 1)]) > 1e-9 * s_nodes[-1]:
-            below = s_nodes[max(1, min(int(self.s // ds), len(s_nodes) - 1))]
+            below = float(s_nodes[max(1, min(int(self.s // ds), len(s_nodes) - 2))])
             raise ParameterError(f"{self.name}: `s` must be a velocity node i L / N (i = 1..N) of the "
-                                 f"grid, got {self.s!r} m (nearest nodes: {below!r}, "
-                                 f"{min(below + ds, s_nodes[-1])!r} m)")
+                                 f"grid, got {self.s!r} m (nearest nodes: {below:.6g}, "
+                                 f"{below + ds:.6g} m)")
 
 
 #: The load types a Model accepts.

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 import rodmol
+from rodmol import loads as loads_module
 from rodmol.discretise import external, load_entries
 from rodmol.loads import HOLD_STIFFNESS_FACTOR
 
@@ -279,3 +280,30 @@ def test_a_stiffer_slack_rod_sags_instead_of_staying_compressed(clamped_pinned_r
     u = _positions(model, rodmol.equilibrium(model))
     x, z = shape(model.s_nodes[1:])[:2]
     assert np.max(np.hypot(u[:, 0] - x, u[:, 2] - z)) < 5e-3 * length
+
+
+def test_the_compiled_hold_law_against_scipy_rotations():
+    """Pin: F = R^T (-k (u - p)) - c v, local. Clamp: M = k_r sin(theta) n - c_r w,
+    theta n the rotation vector (local) from the section to the held orientation
+    (scipy's Rotation, scalar-last), whatever the quaternions' signs and norms."""
+    from scipy.spatial.transform import Rotation
+
+    rng = np.random.default_rng(7)
+    section, held = Rotation.random(2, random_state=rng)
+    quat = 1.3 * np.roll(section.as_quat(), 1)  # rodmol's quaternions: scalar first, any norm
+    held_quat = -0.8 * np.roll(held.as_quat(), 1)
+    u, p, shift = rng.normal(size=3), rng.normal(size=3), rng.normal(size=3)
+    v, w = rng.normal(size=3), rng.normal(size=3)
+    row = np.zeros(loads_module.N_PARAMS)
+    row[:3], row[3:7] = p, held_quat
+    k, c, k_r, c_r = 3.0, 0.5, 0.2, 0.05
+    row[[loads_module.P_STIFFNESS, loads_module.P_DAMPING, loads_module.P_TURN_STIFFNESS,
+         loads_module.P_TURN_DAMPING]] = k, c, k_r, c_r
+    r = section.as_matrix()
+    theta = (section.inv() * held).as_rotvec()  # local: held = section * exp(theta)
+    angle = np.linalg.norm(theta)
+    for kind, moment in ((external.PIN, np.zeros(3)),
+                         (external.CLAMP, k_r * np.sin(angle) * theta / angle - c_r * w)):
+        f, m = external.load(kind, row, tuple(shift), tuple(u), tuple(quat), tuple(v), tuple(w))
+        np.testing.assert_allclose(f, r.T @ (-k * (u - p - shift)) - c * v, rtol=1e-12, atol=1e-14)
+        np.testing.assert_allclose(m, moment, rtol=1e-12, atol=1e-14)
