@@ -307,3 +307,27 @@ def test_the_compiled_hold_law_against_scipy_rotations():
         f, m = external.load(kind, row, tuple(shift), tuple(u), tuple(quat), tuple(v), tuple(w))
         np.testing.assert_allclose(f, r.T @ (-k * (u - p - shift)) - c * v, rtol=1e-12, atol=1e-14)
         np.testing.assert_allclose(m, moment, rtol=1e-12, atol=1e-14)
+
+
+@pytest.mark.parametrize("kind", ["pin", "clamp"])
+def test_an_undamped_hold_conserves_the_energy_with_its_penalty(kind):
+    """mu = 0, no gravity, no fluid, hold damping 0: the hold is a spring, so
+    kinetic + strain + its penalty energy (``energy()["hold"]``, which starts
+    with all of it: the rod is released straight, 1 mm from the held point
+    and, for a clamp, 3 degrees off the held rotation) stays constant."""
+    length = BEAM["length"]
+    rod = rodmol.Rod(length, 0.01, rodmol.Material(E=1e6, nu=0.5, mu=0.0, rho=1000.0))
+    angle = np.radians(3.0)
+    turned = np.array([[np.cos(angle), 0.0, np.sin(angle)], [0.0, 1.0, 0.0],
+                       [-np.sin(angle), 0.0, np.cos(angle)]])
+    hold = rodmol.Hold(length, kind=kind, position=(length, 1e-3, 0.0), stiffness=50.0, damping=0.0,
+                       rotation=turned if kind == "clamp" else None)
+    model = rodmol.Model(rod, 10, gravity=(0.0, 0.0, 0.0), medium=rodmol.MEDIA["air"], loads=[hold])
+    result = rodmol.simulate(model, 0.2, initial="straight", output_dt=0.01, rtol=1e-8)
+    assert result.success
+    e = rodmol.energy(model, result)
+    start = e["hold"][0]
+    np.testing.assert_allclose(start, 0.5 * 50.0 * 1e-6 + (kind == "clamp") * 50.0 * 0.01**2 / 4
+                               * (1 - np.cos(angle)), rtol=1e-9)
+    assert np.min(e["hold"]) < 0.7 * start  # the spring gives its energy to the rod and back
+    np.testing.assert_allclose(e["kinetic"] + e["strain"] + e["hold"], start, rtol=1e-4)

@@ -166,3 +166,19 @@ def contact_energy(kind, p, u):
     return p[P_STIFFNESS] * (h * h / 6.0 + 0.5 * (depth - h) * (depth + h) - 0.5 * h * (depth - h))
 
 
+
+
+@jit
+def hold_energy(kind, p, value, u, quat):
+    """Elastic energy [J] of a hold's penalty at a node of pose (u, quat):
+    stiffness |u - p|^2 / 2, plus for a clamp turning stiffness (1 - cos
+    theta), the potential of :func:`clamp_moment` (1 - cos theta = 2 sin^2(theta / 2),
+    from e = conj(quat) held: its vector part's squared norm over its own)."""
+    if kind != PIN and kind != CLAMP:
+        return 0.0
+    gap = sub(u, add((p[0], p[1], p[2]), value))
+    energy = 0.5 * p[P_STIFFNESS] * dot(gap, gap)
+    if kind == CLAMP:
+        a, b, c, d = quaternion_product((quat[0], -quat[1], -quat[2], -quat[3]), (p[3], p[4], p[5], p[6]))
+        energy += p[P_TURN_STIFFNESS] * 2.0 * (b * b + c * c + d * d) / (a * a + b * b + c * c + d * d)
+    return energy
