@@ -398,8 +398,9 @@ class Hold(_Load):
         held by a clamp; default: the section's orientation at rest.
     stiffness : penalty stiffness [N/m]; default ``HOLD_STIFFNESS_FACTOR``
         times the held element's axial stiffness E A / ds.
-    damping : penalty damping [N s/m]; default critical, 2 sqrt(stiffness m)
-        with m the node's mass (rho A + added mass) ds.
+    damping : penalty damping [N s/m]; default critical for the node's own
+        mass, 2 sqrt(stiffness m) with m = rho A ds (added mass left out).
+    name : used in messages and in the result's ``meta["loads"]``.
     """
 
     s: float

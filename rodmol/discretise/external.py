@@ -166,8 +166,6 @@ def contact_energy(kind, p, u):
     return p[P_STIFFNESS] * (h * h / 6.0 + 0.5 * (depth - h) * (depth + h) - 0.5 * h * (depth - h))
 
 
-
-
 @jit
 def hold_energy(kind, p, value, u, quat):
     """Elastic energy [J] of a hold's penalty at a node of pose (u, quat):

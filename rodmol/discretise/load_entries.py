@@ -80,8 +80,8 @@ def hold_law(hold, axial_stiffness, mass, radius):
 def _held_entries(load, s_nodes, rest):
     """The one entry of a hold (a :class:`rodmol.Hold`): its node, weight
     (the whole force at the node), parameter row and values (the held
-    displacement from the rest position, global, so that the equilibrium's
-    load continuation ramps it with the loads); ``rest`` as from :func:`rest_nodes`."""
+    displacement from the rest position, global: the equilibrium's
+    continuation ramps it as a load of its own); ``rest`` as from :func:`rest_nodes`."""
     ds = s_nodes[1] - s_nodes[0]
     node = int(round(load.s / ds))
     row = np.zeros((1, N_PARAMS))
