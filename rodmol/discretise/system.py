@@ -239,7 +239,8 @@ class SemiDiscrete:
         self._entry_weights = np.ascontiguousarray(entries.weight * stretch, dtype=float)
         self._entry_params = np.ascontiguousarray(entries.params, dtype=float).reshape(-1, external.N_PARAMS)
         self.entry_values = np.ascontiguousarray(entries.initial, dtype=float).reshape(-1, 3)
-        self._held = np.isin(self._kinds, (external.PIN, external.CLAMP))  # values: held displacements
+        # Entries of held points (rodmol.Hold): their values are the held displacements.
+        self._hold_entries = np.isin(self._kinds, (external.PIN, external.CLAMP))
         self.grid_loads = entries
 
     @property
@@ -342,7 +343,8 @@ class SemiDiscrete:
         for inputs in scaled:
             inputs *= load_factor
         if held_factor is not None:
-            self.entry_values[self._held] = saved[2][self._held] * held_factor
+            held = self._hold_entries
+            self.entry_values[held] = saved[2][held] * held_factor
         try:
             stencil.rhs(y, out, *self._args)
         finally:
