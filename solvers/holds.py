@@ -16,7 +16,7 @@ the round-off floor of the residual grows with k); CVODE's steps, right-hand
 sides, the solver's wall time and the whole call's (with the initial
 equilibrium and the Result), each as a ratio to the same rod with its tip
 free (measured in the same run, median of --reps). The default factor
-(``rodmol.loads.HOLD_STIFFNESS_FACTOR``) is marked.
+(``rodmol.holds.HOLD_STIFFNESS_FACTOR``) is marked.
 
     python solvers/holds.py [--quick | --smoke] [--out DIR] [--reps K]
 """
@@ -27,7 +27,7 @@ import _common as C
 from _common import np, rodmol
 
 from rodmol.discretise import load_entries
-from rodmol.loads import HOLD_STIFFNESS_FACTOR
+from rodmol.holds import HOLD_STIFFNESS_FACTOR
 
 SCRIPT = "holds.py"
 

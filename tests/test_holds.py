@@ -14,7 +14,7 @@ import pytest
 import rodmol
 from rodmol import loads as loads_module
 from rodmol.discretise import external, load_entries
-from rodmol.loads import HOLD_STIFFNESS_FACTOR
+from rodmol.holds import HOLD_STIFFNESS_FACTOR
 
 G_ACC = 9.81
 # A short stiff rod: small deflections, so the beam formulas hold.

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..holds import HOLD_STIFFNESS_FACTOR
 from ..loads import (
-    HOLD_STIFFNESS_FACTOR,
     KERNELS,
     N_PARAMS,
     P_DAMPING,

@@ -239,8 +239,7 @@ class SemiDiscrete:
         self._entry_weights = np.ascontiguousarray(entries.weight * stretch, dtype=float)
         self._entry_params = np.ascontiguousarray(entries.params, dtype=float).reshape(-1, external.N_PARAMS)
         self.entry_values = np.ascontiguousarray(entries.initial, dtype=float).reshape(-1, 3)
-        # Entries of held points (rodmol.Hold): their values are the held displacements.
-        self._hold_entries = np.isin(self._kinds, (external.PIN, external.CLAMP))
+        self._hold_entries = np.isin(self._kinds, (external.PIN, external.CLAMP))  # rodmol.Hold
         self.grid_loads = entries
 
     @property
@@ -342,9 +341,8 @@ class SemiDiscrete:
         saved = [inputs.copy() for inputs in scaled]
         for inputs in scaled:
             inputs *= load_factor
-        if held_factor is not None:
-            held = self._hold_entries
-            self.entry_values[held] = saved[2][held] * held_factor
+        if held_factor is not None:  # a hold's value is its held displacement
+            self.entry_values[self._hold_entries] = saved[2][self._hold_entries] * held_factor
         try:
             stencil.rhs(y, out, *self._args)
         finally:

@@ -9,6 +9,7 @@ distributed loads take a constant 3-vector.
 from functools import partial
 
 from .. import loads as rodmol_loads
+from ..holds import HOLD_KINDS
 from . import readers as read
 from .arm import entries
 from .problems import FAILED, failed
@@ -30,7 +31,7 @@ _READERS = {
     "friction": read.number("non-negative"),
     "slip_speed": read.number("positive", "m/s"),
     "smoothing_depth": read.number("positive", "m"),
-    "kind": read.choice(rodmol_loads.HOLD_KINDS),
+    "kind": read.choice(HOLD_KINDS),
     "position": read.vector(3, "m"),
     "rotation": read.matrix3,
 }
