@@ -48,6 +48,7 @@ from .loads import (
     CapsuleContact,
     DistributedForce,
     DistributedMoment,
+    Hold,
     PlaneContact,
     PointForce,
     PointMoment,
@@ -67,7 +68,7 @@ from .systems import Joint, System
 
 __all__ = [
     "BACKENDS", "Base", "BaseMotion", "Cable", "CapsuleContact", "DistributedForce",
-    "DistributedMoment", "PlaneContact", "PointForce", "PointMoment", "SphereContact", "EquilibriumError", "IntegrationError", "MEDIA",
+    "DistributedMoment", "Hold", "PlaneContact", "PointForce", "PointMoment", "SphereContact", "EquilibriumError", "IntegrationError", "MEDIA",
     "Joint", "Marker", "Material", "Medium", "Model", "NotSupportedYet", "RigidBody", "System", "ParameterError", "Result", "Rod", "RodmolError",
     "SCHEMES", "ScenarioError", "SemiDiscrete", "Simulator", "StateLayout", "StateView", "UserFunctionError",
     "default_atol", "energy",

@@ -17,7 +17,8 @@ def energy(model, result):
     over the length of rod it stands for, with added mass), ``strain`` (the
     cells, with the scheme's cell stiffness), ``gravity`` (potential of
     weight minus buoyancy), ``contact`` (elastic energy of the contact
-    penalties) and ``total``. With mu = 0, no gravity, no fluid, no cables and
+    penalties), ``hold`` (elastic energy of the held points' penalties,
+    rodmol.Hold) and ``total``. With mu = 0, no gravity, no fluid, no cables and
     no external loads, ``kinetic + strain`` is conserved by the semi-discrete
     system of either scheme; contact damping and friction only remove energy.
     """
@@ -36,8 +37,23 @@ def energy(model, result):
     u = result.integrated_positions[:, 1:]
     gravity = -np.einsum("n,n,tni,i->t", lengths, system.sampled.net_mass, u, model.gravity)
     contact = _contact_energy(system.grid_loads, u, lengths)
-    return dict(kinetic=kinetic, strain=strain, gravity=gravity, contact=contact,
-                total=kinetic + strain + gravity + contact)
+    hold = _hold_energy(system.grid_loads, u, result.states, system.layout)
+    return dict(kinetic=kinetic, strain=strain, gravity=gravity, contact=contact, hold=hold,
+                total=kinetic + strain + gravity + contact + hold)
+
+
+def _hold_energy(g, u, states, layout):
+    """Penalty energy [J] of the held points (rodmol.Hold) in every frame, at the
+    integrated positions ``u`` (n_t, N, 3) and the states' quaternions."""
+    out = np.zeros(len(u))
+    held = np.flatnonzero(np.isin(g.kind, (external.PIN, external.CLAMP)))
+    if held.size:
+        quat = layout.field(np.asarray(states), "Q")
+    for e in held:
+        node, kind, params, value = int(g.node[e]) - 1, int(g.kind[e]), g.params[e], tuple(g.initial[e])
+        for i in range(len(u)):
+            out[i] += external.hold_energy(kind, params, value, tuple(u[i, node]), tuple(quat[i, node]))
+    return out
 
 
 def _contact_energy(g, u, lengths):

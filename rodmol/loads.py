@@ -27,6 +27,7 @@ import numpy as np
 
 from . import _checks
 from .errors import ParameterError, RodmolError
+from .holds import Hold
 from .inputs import as_time_input
 
 FRAMES = ("global", "local")
@@ -57,14 +58,19 @@ KERNELS = {
     "dead_moment": Kernel(3, ("Q",), "moment"),
     "plane": Kernel(4, ("u", "Q", "v", "w"), "contact"),
     "capsule": Kernel(5, ("u", "Q", "v", "w"), "contact"),
+    "pin": Kernel(6, ("u", "Q", "v"), "hold"),
+    "clamp": Kernel(7, ("u", "Q", "v", "w"), "hold"),
 }
 
 # The parameter row a load hands its kernel at each node (``params``): the
 # contact kinds' geometry (plane: point, normal; capsule: start, end,
 # radius), then the law, the section radius at the node and the depth over
-# which the penalty is smoothed. Vector loads have none.
+# which the penalty is smoothed. Vector loads have none. A hold's row: the
+# node's rest position (3), the held orientation's quaternion (4), then its
+# stiffness, damping, turning stiffness and turning damping.
 N_PARAMS = 13
 P_STIFFNESS, P_DAMPING, P_FRICTION, P_SLIP, P_RADIUS, P_SMOOTHING = 7, 8, 9, 10, 11, 12
+P_TURN_STIFFNESS, P_TURN_DAMPING = 9, 10
 
 
 def _frame(frame, name):
@@ -88,6 +94,9 @@ class _Load:
 
     def check_within(self, length):
         """Refuse a load that does not fit a rod of ``length`` [m]."""
+
+    def check_grid(self, s_nodes):
+        """Refuse a load that does not fit the grid of nodes ``s_nodes`` [m]."""
 
     def values(self, s, t):
         return np.zeros((len(s), 3))
@@ -352,7 +361,7 @@ def SphereContact(centre, radius, stiffness, damping=0.0, friction=0.0, slip_spe
 
 #: The load types a Model accepts.
 LOAD_TYPES = (PointForce, PointMoment, DistributedForce, DistributedMoment, PlaneContact,
-              CapsuleContact)
+              CapsuleContact, Hold)
 
 
 _CONTACT_UNITS = {"stiffness": "N/m^2", "damping": "N s/m^2", "friction": "-", "slip_speed": "m/s",
@@ -369,4 +378,6 @@ SCENARIO_TYPES = {
     "plane_contact": (PlaneContact, {"point": "m", "normal": "-", **_CONTACT_UNITS}),
     "sphere_contact": (SphereContact, {"centre": "m", "radius": "m", **_CONTACT_UNITS}),
     "capsule_contact": (CapsuleContact, {"start": "m", "end": "m", "radius": "m", **_CONTACT_UNITS}),
+    "hold": (Hold, {"s": "m", "position": "m", "rotation": "-", "stiffness": "N/m",
+                    "damping": "N s/m", "kind": "-"}),
 }

@@ -100,6 +100,8 @@ class Model:
         self.markers = _checks.items("markers", markers, Marker, "a rodmol.Marker")
         self.marker_offsets = marker_offsets(self.markers, rod)
         self._grid()
+        for load in self.loads:
+            load.check_grid(self.s_nodes)
 
     def options(self):
         """The keyword arguments this model was built with (after checking)."""

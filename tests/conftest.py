@@ -4,6 +4,7 @@ import sys
 
 import numpy as np
 import pytest
+from rod_bvp import catenary, clamped_pinned
 from scipy.integrate import solve_bvp
 
 
@@ -83,3 +84,16 @@ def checks_only(monkeypatch):
 
     monkeypatch.setattr(sys.modules["rodmol.simulate"], "SemiDiscrete", stop)
     return ChecksPassed
+
+
+@pytest.fixture
+def clamped_pinned_rod():
+    """:func:`rod_bvp.clamped_pinned`, the planar Reissner rod clamped at one end
+    and pinned at the other under its weight, by ``solve_bvp``."""
+    return clamped_pinned
+
+
+@pytest.fixture
+def extensible_catenary():
+    """:func:`rod_bvp.catenary`, the analytical extensible catenary."""
+    return catenary

@@ -12,6 +12,7 @@ import shutil
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -179,6 +180,17 @@ def _rest_strains_speed(out):
     assert {row["quantity"] for row in rows(out / "rest_strains_speed.csv")} >= {"integration wall time [s]"}
 
 
+def _holds(out):
+    table = rows(out / "holds.csv")
+    assert all(row["success"] for row in table)
+    for problem in {row["problem"] for row in table}:
+        runs = sorted((row for row in table if row["problem"] == problem), key=lambda row: row["factor"])
+        for soft, stiff in zip(runs, runs[1:]):  # the pin's drift is F / k: it falls as the factor grows
+            ratio = soft["rest_drift_over_L"] / stiff["rest_drift_over_L"]
+            np.testing.assert_allclose(ratio, stiff["factor"] / soft["factor"], rtol=0.2)
+        assert all(row["steps_over_free"] < 3 for row in runs), runs
+
+
 SCRIPTS = {
     "scaling.py": (["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"], _scaling),
     "temporal.py": (["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv", "temporal_options.csv"],
@@ -202,6 +214,7 @@ SCRIPTS = {
     "quaternion_norm.py": (["quaternion_norm.csv", "quaternion_norm.md"], _quaternion_norm),
     "octopus.py": (["octopus.csv", "octopus.md"], _octopus),
     "rest_strains_speed.py": (["rest_strains_speed.csv", "rest_strains_speed.md"], _rest_strains_speed),
+    "holds.py": (["holds.csv", "holds.md"], _holds),
 }
 
 

@@ -24,13 +24,16 @@ from ..loads import (
     P_SLIP,
     P_SMOOTHING,
     P_STIFFNESS,
+    P_TURN_DAMPING,
+    P_TURN_STIFFNESS,
 )
-from .physics import add, cross, dot, jit, rotation, scale, sub, to_local
+from .physics import add, cross, dot, jit, quaternion_product, rotation, scale, sub, to_local
 
 # The codes as module constants: the compiled branches read them as such.
 FOLLOWER_FORCE, DEAD_FORCE = KERNELS["follower_force"].code, KERNELS["dead_force"].code
 FOLLOWER_MOMENT, DEAD_MOMENT = KERNELS["follower_moment"].code, KERNELS["dead_moment"].code
 PLANE, CAPSULE = KERNELS["plane"].code, KERNELS["capsule"].code
+PIN, CLAMP = KERNELS["pin"].code, KERNELS["clamp"].code
 
 #: Which fields of its own element block each kind reads (force rows "v" and
 #: moment rows "w" of that block are the ones written).
@@ -95,6 +98,41 @@ def contact(kind, p, u, r, v, w):
 
 
 @jit
+def pin_force(gap, gap_rate, stiffness, damping):
+    """Penalty force [N] of a pin joint, -stiffness gap - damping gap_rate,
+    in the frame of the gap [m] and its rate [m/s] (a body-side joint passes
+    the gap between the two points and their relative velocity)."""
+    return sub(scale(-stiffness, gap), scale(damping, gap_rate))
+
+
+@jit
+def clamp_moment(quat, held, w, stiffness, damping):
+    """Penalty moment [N m], local, turning a section of orientation ``quat``
+    toward the orientation ``held`` (quaternions, global): stiffness sin(theta) n
+    - damping w, theta n the rotation (local) from the section to ``held`` and
+    ``w`` [rad/s] the section's angular velocity relative to ``held``, local.
+    sin(theta) n = 2 e0 e (e = conj(quat) held) is smooth and even in the
+    quaternions' signs; its energy is stiffness (1 - cos theta)."""
+    a, b, c, d = quaternion_product((quat[0], -quat[1], -quat[2], -quat[3]), held)
+    norms = ((quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3])
+             * (held[0] * held[0] + held[1] * held[1] + held[2] * held[2] + held[3] * held[3]))
+    f = 2.0 * a / norms
+    return sub(scale(stiffness * f, (b, c, d)), scale(damping, w))
+
+
+@jit
+def hold(kind, p, value, u, quat, r, v, w):
+    """(force, moment) [N, N m], local, of a hold (rodmol.Hold) at a node of
+    pose (u, quat): held at p[0:3] + ``value`` (its rest position plus the
+    held displacement, global) and, for a clamp, at the orientation p[3:7]."""
+    gap = sub(u, add((p[0], p[1], p[2]), value))
+    f = pin_force(to_local(r, gap), v, p[P_STIFFNESS], p[P_DAMPING])
+    if kind != CLAMP:
+        return f, (0.0, 0.0, 0.0)
+    return f, clamp_moment(quat, (p[3], p[4], p[5], p[6]), w, p[P_TURN_STIFFNESS], p[P_TURN_DAMPING])
+
+
+@jit
 def load(kind, p, value, u, quat, v, w):
     """(force, moment) densities of one entry of ``kind``, local frame, before
     its weight; ``value`` is the entry's vector (in its own frame)."""
@@ -108,6 +146,8 @@ def load(kind, p, value, u, quat, v, w):
         return to_local(r, value), zero
     if kind == DEAD_MOMENT:
         return zero, to_local(r, value)
+    if kind in (PIN, CLAMP):
+        return hold(kind, p, value, u, quat, r, v, w)
     return contact(kind, p, u, r, v, w)
 
 
@@ -126,3 +166,17 @@ def contact_energy(kind, p, u):
     return p[P_STIFFNESS] * (h * h / 6.0 + 0.5 * (depth - h) * (depth + h) - 0.5 * h * (depth - h))
 
 
+@jit
+def hold_energy(kind, p, value, u, quat):
+    """Elastic energy [J] of a hold's penalty at a node of pose (u, quat):
+    stiffness |u - p|^2 / 2, plus for a clamp turning stiffness (1 - cos
+    theta), the potential of :func:`clamp_moment` (1 - cos theta = 2 sin^2(theta / 2),
+    from e = conj(quat) held: its vector part's squared norm over its own)."""
+    if kind != PIN and kind != CLAMP:
+        return 0.0
+    gap = sub(u, add((p[0], p[1], p[2]), value))
+    energy = 0.5 * p[P_STIFFNESS] * dot(gap, gap)
+    if kind == CLAMP:
+        a, b, c, d = quaternion_product((quat[0], -quat[1], -quat[2], -quat[3]), (p[3], p[4], p[5], p[6]))
+        energy += p[P_TURN_STIFFNESS] * 2.0 * (b * b + c * c + d * d) / (a * a + b * b + c * c + d * d)
+    return energy

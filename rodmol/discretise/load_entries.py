@@ -11,7 +11,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..loads import KERNELS, N_PARAMS
+from ..holds import HOLD_STIFFNESS_FACTOR
+from ..loads import (
+    KERNELS,
+    N_PARAMS,
+    P_DAMPING,
+    P_STIFFNESS,
+    P_TURN_DAMPING,
+    P_TURN_STIFFNESS,
+)
+from .layout import StateLayout
+from .rotations import from_matrix
+from .schemes import DEFAULT_SCHEME
+from .undeformed import undeformed_state
 
 
 @dataclass(frozen=True)
@@ -55,8 +67,54 @@ def node_shares(s, s_nodes):
     return np.array(nodes, dtype=int), np.array(weights)
 
 
-def _entries(load, s_nodes, radius):
+def hold_law(hold, axial_stiffness, mass, radius):
+    """(stiffness [N/m], damping [N s/m], turning stiffness [N m], turning
+    damping [N m s]) of ``hold`` (a :class:`rodmol.Hold`) at a node whose
+    element has the axial stiffness E A / ds ``axial_stiffness`` [N/m], of
+    ``mass`` [kg] and section ``radius`` [m]: the defaults where the hold
+    gives none, and the turning law the section's I / A = r^2 / 4 times it."""
+    k = HOLD_STIFFNESS_FACTOR * axial_stiffness if hold.stiffness is None else hold.stiffness
+    c = 2.0 * np.sqrt(k * mass) if hold.damping is None else hold.damping
+    arm2 = 0.25 * radius * radius
+    return k, c, k * arm2, c * arm2
+
+
+def _held_entries(load, s_nodes, rest):
+    """The one entry of a hold (a :class:`rodmol.Hold`): its node, weight
+    (the whole force at the node), parameter row and values (the held
+    displacement from the rest position, global: the equilibrium's
+    continuation ramps it as a load of its own); ``rest`` as from :func:`rest_nodes`."""
+    ds = s_nodes[1] - s_nodes[0]
+    node = int(round(load.s / ds))
+    row = np.zeros((1, N_PARAMS))
+    position, quat = rest["u"][node], rest["Q"][node]
+    if load.rotation is not None:
+        quat = from_matrix(load.rotation)
+    row[0, :3], row[0, 3:7] = position, quat
+    law = hold_law(load, rest["axial_stiffness"][node], rest["mass"][node], rest["radius"][node])
+    row[0, [P_STIFFNESS, P_DAMPING, P_TURN_STIFFNESS, P_TURN_DAMPING]] = law
+    shift = np.zeros((1, 3)) if load.position is None else (load.position - position)[None, :]
+    return np.array([node]), np.array([1.0 / ds]), row, lambda t: shift
+
+
+def rest_nodes(model, scheme=DEFAULT_SCHEME):
+    """What holds read at the nodes 0..N of ``model`` at rest in its rest shape
+    (on the cells of ``scheme``): the pose (``u`` [m], ``Q``, global), E A / ds
+    [N/m] (``axial_stiffness``), the node's mass rho A ds [kg] and the section
+    ``radius`` [m]."""
+    s, layout = model.s_nodes, StateLayout(model.n_elements)
+    y = undeformed_state(model, scheme)
+    u = layout.integrated_positions(y)
+    quat = layout.quaternions(y)
+    area = model.rod.area(s)
+    return {"u": u, "Q": quat, "axial_stiffness": model.rod.stiffness(s)[0][:, 0] / model.ds,
+            "mass": model.rod.material.rho * area * model.ds, "radius": model.rod.radius_at(s)}
+
+
+def _entries(load, s_nodes, radius, rest):
     """(nodes, weights, params, values(t) at those nodes, time-dependent) of one load."""
+    if load.spread == "node":
+        return _held_entries(load, s_nodes, rest)
     if load.spread == "point":
         nodes, weights = node_shares(load.s, s_nodes)
     else:
@@ -75,22 +133,25 @@ def _entries(load, s_nodes, radius):
 
 def count(load, s_nodes):
     """How many entries ``load`` has on the grid of nodes ``s_nodes`` [m]."""
+    if load.spread == "node":
+        return 1
     return len(node_shares(load.s, s_nodes)[0]) if load.spread == "point" else len(s_nodes) - 1
 
 
-def on_grid(loads, s_nodes, radius):
-    """All ``loads`` as one :class:`GridLoad`; ``radius`` [m] at ``s_nodes``."""
+def on_grid(loads, s_nodes, radius, rest=None):
+    """All ``loads`` as one :class:`GridLoad`; ``radius`` [m] at ``s_nodes``;
+    ``rest`` (:func:`rest_nodes`) is needed by holds only."""
     kind, node, weight, params, initial, concentrated, timed = [], [], [], [], [], [], []
     start = 0
     for load in loads:
-        nodes, weights, rows, at = _entries(load, s_nodes, radius)
+        nodes, weights, rows, at = _entries(load, s_nodes, radius, rest)
         n = len(nodes)
         kind.append(np.full(n, KERNELS[load.kernel].code))
         node.append(nodes)
         weight.append(weights)
         params.append(rows)
         initial.append(np.asarray(at(0.0), dtype=float).reshape(n, 3))
-        concentrated.append(np.full(n, load.spread == "point"))
+        concentrated.append(np.full(n, load.spread != "nodes"))
         if not load.constant:
             timed.append((slice(start, start + n), at))
         start += n
@@ -103,9 +164,11 @@ def on_grid(loads, s_nodes, radius):
                     timed)
 
 
-def of_model(model):
-    """The model's loads on its grid."""
-    return on_grid(model.loads, model.s_nodes, model.rod.radius_at(model.s_nodes))
+def of_model(model, scheme=DEFAULT_SCHEME):
+    """The model's loads on its grid (holds read its rest shape on the cells of ``scheme``)."""
+    held = any(load.spread == "node" for load in model.loads)
+    return on_grid(model.loads, model.s_nodes, model.rod.radius_at(model.s_nodes),
+                   rest_nodes(model, scheme) if held else None)
 
 
 def load_scale(model, t=0.0, tensions=None, grid=None):

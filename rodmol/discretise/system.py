@@ -21,6 +21,7 @@ from .physics import compile_signatures
 from .routing import CableRouting
 from .sampling import Sampled, cell_properties, rest_strains
 from .schemes import DEFAULT_SCHEME, get_scheme
+from .undeformed import undeformed_state
 
 #: Rate [1/s] at which the quaternion norm is pulled back to 1; the exact
 #: dynamics keep |Q| = 1, so this only damps integration drift (larger rates
@@ -39,33 +40,6 @@ def first_bending_frequency(model):
     rod = model.rod
     mat, r_base = rod.material, float(rod.radius_at(0.0))
     return 1.8751**2 * np.sqrt(mat.E * r_base**2 / (4.0 * mat.rho)) / rod.length**2
-
-
-def undeformed_state(model, scheme=DEFAULT_SCHEME):
-    """The unloaded rod at rest in its rest shape, for the spatial ``scheme``.
-
-    The strains are the rod's rest strains sampled at the scheme's cells (where
-    the stresses measure them from), the orientations follow from the base's
-    with the scheme's own kinematics, Q_{i+1} = Q_i exp(ds k*_i), and the
-    positions are the chords of ``physics.chord`` (as ``Result.positions``
-    rebuilds them): without loads every rate vanishes. A straight rod lies
-    along the base's local x axis, with positions s_i on it.
-    """
-    base, n = model.base, model.n_elements
-    position, rotation = np.asarray(base.position, dtype=float), np.asarray(base.rotation, dtype=float)
-    quat0 = rotations.from_matrix(base.rotation)
-    q, k = rest_strains(model, get_scheme(scheme).cell_points(model.s_nodes))
-    if model.rod.straight:  # in closed form: no round-off accumulated along the rod
-        u, quat = position + model.s_nodes[1:, None] * rotation[:, 0], np.tile(quat0, (n, 1))
-    else:
-        chain = np.empty((n + 1, 4))
-        chain[0] = quat0
-        for i, step in enumerate(rotations.from_rotation_vector(model.ds * k)):
-            chain[i + 1] = rotations.multiply(chain[i], step)
-        rotations.normalise(chain[None])
-        u, quat = centreline.positions(position, chain, q, k, model.ds)[1:], chain[1:]
-    zeros = np.zeros((n, 3))
-    return StateLayout(n).pack(position, quat0, u, quat, q, k, zeros, zeros)
 
 
 #: The undeformed state under its former name (the same function: straight unless the rod has rest strains).
@@ -256,7 +230,7 @@ class SemiDiscrete:
         self.read_held(0.0)
 
     def _setup_loads(self):
-        entries = load_entries.of_model(self.model)
+        entries = load_entries.of_model(self.model, self.scheme)
         self._kinds = np.ascontiguousarray(entries.kind, dtype=np.int64)
         self._nodes = np.ascontiguousarray(entries.node - 1, dtype=np.int64)  # element blocks
         # A point load's share of a node is spread over the node's own length.
@@ -264,6 +238,7 @@ class SemiDiscrete:
         self._entry_weights = np.ascontiguousarray(entries.weight * stretch, dtype=float)
         self._entry_params = np.ascontiguousarray(entries.params, dtype=float).reshape(-1, external.N_PARAMS)
         self.entry_values = np.ascontiguousarray(entries.initial, dtype=float).reshape(-1, 3)
+        self._hold_entries = np.isin(self._kinds, (external.PIN, external.CLAMP))  # rodmol.Hold
         self.grid_loads = entries
 
     @property
@@ -357,16 +332,20 @@ class SemiDiscrete:
         stencil.rhs(y, out, *self._args)
         return out
 
-    def rest_rates(self, t, y, out, load_factor=1.0, tensions=None):
+    def rest_rates(self, t, y, out, load_factor=1.0, tensions=None, held_factor=None):
         """dy/dt at (t, y) with every applied load (gravity, tensions, external
-        load values) scaled by ``load_factor``, for the equilibrium's
-        continuation. ``tensions`` (n_cables,) [N] replace the cables' inputs
-        (the equilibrium of a feedback law iterates on them)."""
+        load values) scaled by ``load_factor`` and the held points'
+        displacements from rest (rodmol.Hold) by ``held_factor`` (default:
+        ``load_factor``), for the equilibrium's continuation. ``tensions``
+        (n_cables,) [N] replace the cables' inputs (the equilibrium of a
+        feedback law iterates on them)."""
         self.update_inputs(t, y, tensions)
         scaled = (self.tension_values, self._consts[4:7], self.entry_values)  # views, in place
         saved = [inputs.copy() for inputs in scaled]
         for inputs in scaled:
             inputs *= load_factor
+        if held_factor is not None:  # a hold's value is its held displacement
+            self.entry_values[self._hold_entries] = saved[2][self._hold_entries] * held_factor
         try:
             stencil.rhs(y, out, *self._args)
         finally:

@@ -74,7 +74,7 @@ def build(data, ctx, default_name):
     try:
         model = build_model()
     except ParameterError as exc:
-        _model_problem(ctx, data, str(exc))
+        _model_problem(ctx, data, str(exc), loads)
         return None
     return RunSpec(name, description, ctx.source, model, t_end, solver, output)
 
@@ -92,8 +92,13 @@ def _check_lengths(ctx, length, cables, markers, loads):
                                         f"got {value(item)!r}")
 
 
-def _model_problem(ctx, data, message):
-    """Place a Model error (it names a cable or a marker) at that entry's table."""
+def _model_problem(ctx, data, message, loads=()):
+    """Place a Model error (it names a cable, a marker or a load) at that entry's table."""
+    for i, load in enumerate(loads):  # a load's message starts with its name (a hold off the grid)
+        if message.startswith(f"{load.name}: "):
+            key = re.search(r"`(\w+)`", message)
+            where = ("load", i) + ((key.group(1),) if key and key.group(1) in data["load"][i] else ())
+            return ctx.add(where, message)
     for kind in ("cable", "marker"):
         match = re.match(rf"{kind} '([^']*)'", message)
         entries = data.get(kind) if isinstance(data.get(kind), list) else []

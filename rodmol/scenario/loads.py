@@ -9,6 +9,7 @@ distributed loads take a constant 3-vector.
 from functools import partial
 
 from .. import loads as rodmol_loads
+from ..holds import HOLD_KINDS
 from . import readers as read
 from .arm import entries
 from .problems import FAILED, failed
@@ -30,6 +31,9 @@ _READERS = {
     "friction": read.number("non-negative"),
     "slip_speed": read.number("positive", "m/s"),
     "smoothing_depth": read.number("positive", "m"),
+    "kind": read.choice(HOLD_KINDS),
+    "position": read.vector(3, "m"),
+    "rotation": read.matrix3,
 }
 
 
@@ -65,6 +69,10 @@ def _load(ctx, path, entry):
     table = ctx.table(entry, path, ("type",) + keys, required=required, units=units,
                       hint=f" (for `type = {kind!r}`)")
     readers = dict(_READERS)
+    # A contact's law is per length of rod, a hold's at its node: the units come from the type.
+    for key, condition in (("stiffness", "positive"), ("damping", "non-negative")):
+        if key in keys:
+            readers[key] = read.number(condition, units[key])
     if point:
         readers[what] = read.vector_input(ctx.base_dir, what, units[what])
     elif what in keys:

@@ -16,13 +16,14 @@ the compiled Jacobian of the dynamics takes them), and it is factorised with
 import numpy as np
 from scipy.linalg import solve_banded
 
-from ..discretise import centreline, rotations
+from ..discretise import centreline, external, rotations
 from ..discretise.jacobian import BandedDifferences
 from ..discretise.layout import BlockLayout
 from ..discretise.load_entries import load_scale
 from ..discretise.schemes import DEFAULT_SCHEME
 from ..discretise.system import SemiDiscrete
 from ..errors import EquilibriumError, ParameterError
+from ..loads import P_STIFFNESS
 from ..model import Model
 from .watch import state_problem
 
@@ -30,6 +31,9 @@ from .watch import state_problem
 #: u -> position compatibility, Q -> orientation compatibility, q -> force
 #: balance, k -> torque balance.
 STATIC_FIELDS = {"u": 3, "Q": 4, "q": 3, "k": 3}
+#: Largest continuation step over the held points' displacements: a long jump
+#: from the sagging rod could land a slack one on another branch (an S-shape).
+HELD_STEP = 0.125
 _COMPATIBILITY = {"u": {-1: ("u", "Q"), 0: ("u", "q", "k")}, "Q": {-1: ("Q",), 0: ("Q", "k")}}
 
 
@@ -187,27 +191,41 @@ class RestEquations:
         self._mass, self._inertia = system.sampled.mass, system.sampled.inertia
         self.scale = load_scale(model, t, tensions, system.grid_loads)
         self.unloaded = self.scale == 0.0 and not model.loads
+        grid = system.grid_loads
+        moved = np.isin(grid.kind, (external.PIN, external.CLAMP)) & np.any(grid.initial != 0.0, axis=1)
+        self.holds_moved = bool(np.any(moved))
         self._force_scale = (self.scale or 1.0) / model.rod.length  # contact alone: forces of about 1 N
 
     def tolerance(self, tol):
-        """``tol`` raised to the round-off floor of the difference quotients:
-        differencing stresses of size EA * strain over ds loses digits as N grows."""
-        model = self.system.model
-        return max(tol, 10 * np.finfo(float).eps * np.max(self.system.sampled.kl) / (model.ds * self._force_scale))
+        """``tol`` raised to the round-off floor of the difference quotients, per
+        residual row: differencing stresses of size EA * strain over ds loses
+        digits as N grows; a hold's stiff penalty (rodmol.Hold) sees positions of
+        size L rounded, which raises the floor of its node's force rows only (the
+        compatibility rows keep theirs, or the positions would loosen with k)."""
+        model, grid = self.system.model, self.system.grid_loads
+        floor = 10 * np.finfo(float).eps / self._force_scale
+        elastic = max(tol, floor * np.max(self.system.sampled.kl) / model.ds)
+        out = self.static.blocks(np.full(self.static.size, elastic))
+        for e in np.flatnonzero(np.isin(grid.kind, (external.PIN, external.CLAMP))):
+            hold_density = grid.params[e, P_STIFFNESS] * grid.weight[e]
+            out[grid.node[e] - 1, self._sl["q"]] = max(elastic, floor * hold_density * model.rod.length)
+        return out.ravel()
 
     def unknowns(self, y):
         """The static unknowns z of a state vector ``y``."""
         return np.hstack([self.layout.field(y, f) for f in STATIC_FIELDS]).ravel()
 
-    def residual(self, z, lam=1.0, tensions=None):
-        """R(z) with the loads scaled by ``lam``, under ``tensions`` [N] (default: the equations' own)."""
+    def residual(self, z, lam=1.0, tensions=None, held=None):
+        """R(z) with the loads scaled by ``lam`` and the held points' displacements
+        from rest by ``held`` (default: ``lam``), under ``tensions`` [N] (default:
+        the equations' own)."""
         sl, state_sl, model = self._sl, self._state_sl, self.system.model
         ds = model.ds
         zb = self.static.blocks(z)
         for f in STATIC_FIELDS:
             self._y_blocks[:, state_sl[f]] = zb[:, sl[f]]
         tensions = self.tensions if tensions is None else tensions
-        self.system.rest_rates(self.t, self._y, self._rates, lam, tensions)
+        self.system.rest_rates(self.t, self._y, self._rates, lam, tensions, held)
         u, quat, q, k = (zb[:, sl[f]] for f in STATIC_FIELDS)
         u_prev = np.vstack([self._u0, u[:-1]])
         q_prev = np.vstack([self._quat0, quat[:-1]])
@@ -302,21 +320,32 @@ def _rest_state(system, t, tol, max_iter, tensions=None, start=None):
     z = equations.unknowns(y)
     tol = equations.tolerance(tol)
     residual, jacobian = equations.residual, equations.differences
+    # With held points moved off their rest positions the path has two legs: the
+    # other loads first (the rod sags as it would held where it rests), then the
+    # held displacements; pulled in at once, a slack rod could stay on the
+    # straight, compressed branch.
+    end = 2.0 if equations.holds_moved else 1.0
+
+    def at(x, lam):
+        return residual(x, min(lam, 1.0), held=max(lam - 1.0, 0.0) if end > 1.0 else None)
+
     lam, step = 0.0, 1.0
     if start is not None:
         z_warm = _newton(residual, equations.unknowns(start), tol, max_iter, jacobian)
         if z_warm is not None:
-            z, lam = z_warm, 1.0
-    while lam < 1.0:
-        target = min(1.0, lam + step)
-        z_new = _newton(lambda x, lam=target: residual(x, lam), z, tol, max_iter, jacobian)
+            z, lam = z_warm, end
+    while lam < end:
+        target = min(end, lam + step)
+        z_new = _newton(lambda x, lam=target: at(x, lam), z, tol, max_iter, jacobian)
         if z_new is not None:
-            z, lam, step = z_new, target, min(1.0, 2.0 * step)
+            z, lam, step = z_new, target, min(1.0 if target < 1.0 else HELD_STEP, 2.0 * step)
         else:
             step *= 0.5
             if step < 1e-4:
+                what = (f"{lam:.4g} of the loads" if lam < 1.0 else
+                        f"the loads and {lam - 1.0:.4g} of the held points' displacements")
                 raise EquilibriumError(
-                    f"no static equilibrium found beyond {lam:.4g} of the loads at t = {t} s "
+                    f"no static equilibrium found beyond {what} at t = {t} s "
                     "(the rod may buckle under these loads)")
     return equations.state(z)
 
@@ -327,7 +356,7 @@ def _newton(fun, z, tol, max_iter, jacobian):
     f = fun(z)
     norm = np.linalg.norm(f)
     for _ in range(max_iter):
-        if np.max(np.abs(f)) < tol:
+        if np.all(np.abs(f) < tol):
             return z
         try:
             dz = solve_banded(jacobian.bands, jacobian(fun, z, f), -f)
@@ -344,4 +373,4 @@ def _newton(fun, z, tol, max_iter, jacobian):
             if alpha < 1.0 / 256:
                 return None
         z, f, norm = z_try, f_try, norm_try
-    return z if np.max(np.abs(f)) < tol else None
+    return z if np.all(np.abs(f) < tol) else None

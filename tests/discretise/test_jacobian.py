@@ -40,6 +40,10 @@ CASES = {
     "plane contact": [rodmol.PlaneContact((0.0, -0.02, 0.0), (0.0, np.cos(0.3), np.sin(0.3)), **LAW)],
     "sphere contact": [rodmol.SphereContact((0.2, -0.05, 0.0), 0.03, **LAW)],
     "capsule contact": [rodmol.CapsuleContact((0.05, -0.04, -0.05), (0.35, -0.04, 0.06), 0.02, **LAW)],
+    # Holds at a modest stiffness: the generic state is far from their point, and the
+    # default penalty's forces there would swamp the difference quotients in round-off.
+    "pin": [rodmol.Hold(L, position=(0.9 * L, 0.02, -0.01), stiffness=1e3, damping=2.0)],
+    "clamp": [rodmol.Hold(L / 2, kind="clamp", stiffness=1e3, damping=2.0)],
 }
 
 

@@ -250,3 +250,48 @@ def test_bad_csv_rows_name_the_table_line(tmp_path):
 def test_load_must_be_an_array_of_tables():
     (problem,) = problems('load = "heavy"\n' + ARM)
     assert "`load` must be an array of tables `[[load]]`" in problem.message
+
+
+HOLDS = """
+[[load]]
+type = "hold"
+s = 0.3
+kind = "clamp"
+position = [0.28, 0.0, -0.05]
+rotation = [[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]
+stiffness = 5e3
+damping = 2.0
+name = "wall"
+
+[[load]]
+type = "hold"
+s = 0.15
+"""
+
+
+def test_hold_tables_give_the_python_holds():
+    """A [[load]] type = "hold" table builds the Hold the same keys give in
+    Python (the reader takes its keys and units from the load's record), and
+    the held model's rest state is the Python one's."""
+    spec = parse_scenario(ARM + HOLDS)
+    turned = np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])
+    ref = [rodmol.Hold(0.3, kind="clamp", position=(0.28, 0.0, -0.05), rotation=turned, stiffness=5e3,
+                       damping=2.0, name="wall"), rodmol.Hold(0.15)]
+    for ours, theirs in zip(spec.model.loads, ref, strict=True):
+        assert (ours.s, ours.kind, ours.stiffness, ours.damping, ours.name) == \
+            (theirs.s, theirs.kind, theirs.stiffness, theirs.damping, theirs.name)
+    np.testing.assert_array_equal(spec.model.loads[0].rotation, turned)
+    np.testing.assert_array_equal(spec.model.loads[0].position, (0.28, 0.0, -0.05))
+    assert spec.model.loads[1].position is None and spec.model.loads[1].rotation is None
+    rod = rodmol.Rod(0.3, 0.01, rodmol.Material(1e5, 0.5, 10.0, 1000.0))
+    y_ref = rodmol.equilibrium(rodmol.Model(rod, 20, loads=ref))
+    np.testing.assert_allclose(rodmol.equilibrium(spec.model), y_ref, rtol=0, atol=1e-12)
+    tip = rodmol.StateLayout(20).field(y_ref, "u")[-1]
+    np.testing.assert_allclose(tip, (0.28, 0.0, -0.05), atol=1e-3)  # the hold acts
+
+
+def test_a_hold_off_the_grid_is_reported_at_its_table():
+    text = ARM + HOLDS.replace("s = 0.15", "s = 0.16")
+    (problem,) = problems(text)
+    assert problem.table == "[[load]] #2" and "velocity node" in problem.message
+    assert problem.line == line_of(text, "s = 0.16")
