@@ -51,8 +51,8 @@ def test_kernel_codes_are_distinct_and_every_code_has_its_dependencies():
 @pytest.mark.parametrize("kind", list(loads.SCENARIO_TYPES))
 def test_every_scenario_key_with_a_unit_has_it(kind):
     table = tables.LOADS[kind]
-    assert set(table.required()) <= set(table.keys()) and "name" in table.keys()
-    assert set(table.units) == set(table.keys()) - {"type", "frame", "name"}
+    assert set(table.required()) <= set(table.names()) and "name" in table.names()
+    assert set(table.units) == set(table.names()) - {"type", "frame", "name"}
 
 
 def test_load_scale_adds_point_forces_and_moments_over_length():

@@ -128,8 +128,8 @@ def paper_cables(data, ctx, scenario):
         if failed(number, tension) or "tension" not in table or number is None:
             ok = False
             continue
-        cable = ctx.construct(path, lambda tension: Cable(CABLE_OFFSETS[number], 1.0, tension,
-                                                          name=f"cable {number}"), tension, given=table)
+        cable = ctx.construct(path, lambda tension, number=number: Cable(
+            CABLE_OFFSETS[number], 1.0, tension, name=f"cable {number}"), tension, given=table, keys=("tension",))
         ok = ok and not failed(cable)
         tensions[number] = getattr(cable, "tension", None)
     return tensions if ok else FAILED

@@ -9,7 +9,6 @@ import re
 from .. import _checks, scenarios
 from ..arm import LENGTH as PAPER_LENGTH
 from ..arm import paper_arm
-from ..discretise.layout import StateLayout
 from ..discretise.schemes import DEFAULT_SCHEME, get_scheme
 from ..errors import ParameterError
 from ..model import Model
@@ -143,12 +142,16 @@ def _solver(data, ctx, t_end_default):
 
 def _check_solver(ctx, solver, t_end, n_elements):
     """simulate's own checks of the [solver] values, each problem at its key;
-    FAILED if one fails. They need a Model: the paper's arm stands in (its
-    size only sizes the state, and ``n_elements`` is checked with the Model)."""
+    FAILED if one fails. They need a Model of the file's size (it sizes the
+    state): the paper's arm with as many elements stands in (a bad
+    ``n_elements`` is the file's Model's to report)."""
     path = ("solver",)
     table = ctx.data.get("solver", {}) if isinstance(ctx.data.get("solver"), dict) else {}
     options = {k: solver[k] for k in ("backend", "rtol", "atol", "initial", "max_wall_time") if k in solver}
-    stand_in = paper_arm(2)
+    try:
+        stand_in, sized = paper_arm(n_elements), True
+    except (ParameterError, TypeError):
+        stand_in, sized = paper_arm(2), False
     defaults = dict(backend=DEFAULT_BACKEND, rtol=None, atol=None, initial=INITIAL[0], max_wall_time=None)
     run = ctx.construct(path, lambda **kw: check_run(stand_in, t0=None, scheme=solver["scheme"], progress=None,
                                                     backend_options={}, **{**defaults, **kw}),
@@ -157,14 +160,10 @@ def _check_solver(ctx, solver, t_end, n_elements):
         return FAILED  # (recorded)
     t_end = ctx.read({"t_end": t_end}, path, "t_end", lambda v: _checks.positive("t_end", v, " s"))
     output_dt = ctx.read(solver, path, "output_dt", lambda v: _checks.positive("output_dt", v, " s"))
-    if failed(run, t_end, output_dt):
-        return FAILED
+    if failed(run, t_end, output_dt) or not sized:
+        return FAILED if failed(run, t_end, output_dt) else run
     try:
-        size = StateLayout(n_elements).size
-    except (ParameterError, TypeError, ValueError):
-        return run  # a bad n_elements is the Model's to report
-    try:
-        run_options.output_count(t_end, output_dt, size)
+        run_options.output_count(t_end, output_dt, run.layout.size)
     except ParameterError as exc:
         # The message opens with t_end: its line, unless only output_dt was written here.
         ctx.add(path + (("output_dt",) if "output_dt" in table and "t_end" not in table else ("t_end",)),

@@ -113,7 +113,7 @@ class Context:
         if not isinstance(data, dict):
             self.add(path, f"`{path[-1]}` must be a table, got {short(data)}")
             return {}
-        allowed = table.keys()
+        allowed = table.names()
         for key in data:
             if key not in allowed:
                 close = difflib.get_close_matches(key, allowed, n=1, cutoff=0.6)

@@ -77,7 +77,7 @@ class Table:
             out.update(source.parameters())
         return out
 
-    def keys(self):
+    def names(self):
         return tuple(self.own) + tuple(self.parameters())
 
     def required(self):
