@@ -68,12 +68,14 @@ def build(data, ctx, default_name):
         build_model = lambda n_elements, **kw: Model(rod, n_elements, medium=medium,  # noqa: E731
                                                      cables=cables, base=base, markers=markers,
                                                      loads=loads, **kw)
-    if ctx.problems or failed(*parts, gravity, n_elements, checked):
+    if failed(gravity, switches):
         return None
+    if ctx.problems or failed(*parts):
+        build_model = paper_arm  # a stand-in arm: the Model's own keys are still checked
     given = {"n_elements": n_elements, **gravity, **switches}
     model = ctx.construct((), build_model, given, keys=MODEL_KEYS,
                           where=lambda key, message: _model_problem(data, key, message))
-    if failed(model):
+    if ctx.problems or failed(model, checked):
         return None
     return RunSpec(name, description, ctx.source, model, t_end, solver, output)
 

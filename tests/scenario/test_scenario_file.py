@@ -240,3 +240,44 @@ s = 0.4
                 ("[[marker]] #1", lines.index("s = 0.4") + 1)]
     assert [(p.table, p.line) for p in found] == expected
     assert "`anchor` must lie within the rod" in found[0].message
+
+
+def test_bad_values_of_every_kind_of_table_are_reported_together():
+    """Constructors' checks (Material), the Model's (gravity, drag_law, n_elements,
+    checked on a stand-in arm when the file's arm is broken) and simulate's (backend):
+    all at once, each at its line."""
+    text = "gravity = [1, 2]\n" + MINIMAL.replace("E = 1e5", "E = -1").replace(
+        "[solver]", "[medium]\ndrag_law = 'quad'\n[discretization]\nn_elements = 1\n[solver]\nbackend = 'rk2'\n")
+    found = problems(text)
+    lines = text.splitlines()
+    at = {p.line: p.message for p in found}
+    assert len(found) == 5
+    assert "`gravity` must have three components" in at[1]
+    assert "`E` must be > 0 Pa" in at[lines.index("E = -1") + 1]
+    assert "unknown `drag_law` 'quad'" in at[lines.index("drag_law = 'quad'") + 1]
+    assert "`n_elements` must be >= 2" in at[lines.index("n_elements = 1") + 1]
+    assert "did you mean 'rk23'?" in at[lines.index("backend = 'rk2'") + 1]
+
+
+@pytest.mark.parametrize("table, line, python", [
+    ("[rod]", "length = -0.3", lambda m: rodmol.Rod(-0.3, 0.01, m)),
+    ("[material]", "mu = -10.0", lambda m: rodmol.Material(1e5, 0.5, -10.0, 1000.0)),
+    ("[[cable]]", "offset = [0.002, 0.0]\nanchor = 0.3\nfriction = -1.0",
+     lambda m: rodmol.Cable((0.002, 0.0), 0.3, name="cable 1", friction=-1.0)),
+    ("[[marker]]", "s = 0.1\noffset = [1.0]", lambda m: rodmol.Marker(0.1, (1.0,), name="marker 1")),
+    ("[output]", "every = 0", lambda m: rodmol.output.options.OutputOptions(every=0)),
+])
+def test_a_file_is_refused_with_the_constructors_own_message(table, line, python):
+    """Values are checked once, by the classes: the file's message is Python's."""
+    material = rodmol.Material(1e5, 0.5, 10.0, 1000.0)
+    key = line.split("\n")[-1].split(" =")[0]
+    if table in ("[rod]", "[material]"):
+        old = next(x for x in MINIMAL.splitlines() if x.startswith(key + " ="))
+        text = MINIMAL.replace(old, line)
+    else:
+        text = MINIMAL + f"\n{table}\n{line}\n"
+    (problem,) = problems(text)
+    with pytest.raises(rodmol.ParameterError) as expected:
+        python(material)
+    assert problem.message == str(expected.value) and problem.table.split(" #")[0] == table
+    assert problem.line == text.splitlines().index(line.split("\n")[-1]) + 1
