@@ -149,14 +149,14 @@ def _check_solver(ctx, solver, t_end, n_elements):
     ``n_elements`` is the file's Model's to report)."""
     path = ("solver",)
     table = ctx.data.get("solver", {}) if isinstance(ctx.data.get("solver"), dict) else {}
-    options = {k: solver[k] for k in ("backend", "rtol", "atol", "initial", "max_wall_time") if k in solver}
+    options = {k: v for k, v in solver.items() if k not in ("output_dt", "scheme")}
+    scheme = DEFAULT_SCHEME if failed(solver["scheme"]) else solver["scheme"]  # (recorded)
     try:
         stand_in, sized = paper_arm(n_elements), True
-    except (ParameterError, TypeError):
+    except ParameterError:
         stand_in, sized = paper_arm(2), False
-    defaults = dict(backend=DEFAULT_BACKEND, rtol=None, atol=None, initial=INITIAL[0], max_wall_time=None)
-    run = ctx.construct(path, lambda **kw: check_run(stand_in, t0=None, scheme=solver["scheme"], progress=None,
-                                                    backend_options={}, **{**defaults, **kw}),
+    run = ctx.construct(path, lambda **kw: check_run(stand_in, t0=None, scheme=scheme, progress=None,
+                                                    backend_options={}, **{"max_wall_time": None, **kw}),
                         options, given=table, keys=tuple(options))
     if t_end is None or t_end is FAILED:
         return FAILED  # (recorded)
