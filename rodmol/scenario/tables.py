@@ -63,8 +63,9 @@ class Source:
 
 @dataclass(frozen=True)
 class Table:
-    """One table of a scenario file: the parameters of its ``sources`` and
-    the file's own keys ``own`` (name -> meaning, for messages)."""
+    """One table of a scenario file: the parameters of its ``sources`` (their
+    defaults the constructors'), the file's own keys ``own`` (read by the
+    reader itself) and the ``units`` of its keys (default :data:`UNITS`)."""
 
     sources: tuple
     own: tuple = ()
@@ -78,9 +79,11 @@ class Table:
         return out
 
     def names(self):
+        """Every key the table allows, the file's own first."""
         return tuple(self.own) + tuple(self.parameters())
 
     def required(self):
+        """The keys without a default in their constructor."""
         return tuple(k for k, p in self.parameters().items() if p.default is p.empty)
 
     def default(self, key):
@@ -88,6 +91,7 @@ class Table:
         return self.parameters()[key].default
 
     def unit(self, key):
+        """The unit of ``key`` for messages and the reference, or None."""
         return (self.units or UNITS).get(key)
 
     def numbers(self):
