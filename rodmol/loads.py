@@ -76,7 +76,7 @@ P_TURN_STIFFNESS, P_TURN_DAMPING = 9, 10
 def _frame(frame, name):
     if not (isinstance(frame, str) and frame in FRAMES):
         raise ParameterError(f"{name}: `frame` must be 'global' (dead load) or 'local' "
-                             f"(follower load), got {_checks.short(frame)}")
+                             f"(follower load), got {_checks.short(frame)}{_checks.did_you_mean(frame, FRAMES)}")
     return frame
 
 
@@ -369,7 +369,7 @@ _CONTACT_UNITS = {"stiffness": "N/m^2", "damping": "N s/m^2", "friction": "-", "
 
 #: The ``[[load]]`` types of a scenario file: type -> (constructor, units of
 #: its keys). The keys are the constructor's arguments, those without a
-#: default required (:mod:`rodmol.scenario.schema` derives them from here).
+#: default required (:mod:`rodmol.scenario.tables` derives them from here).
 SCENARIO_TYPES = {
     "point_force": (PointForce, {"s": "m", "force": "N"}),
     "point_moment": (PointMoment, {"s": "m", "moment": "N m"}),

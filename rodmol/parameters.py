@@ -53,9 +53,11 @@ class Material:
             raise ParameterError("`rho` (density [kg/m^3]) is required")
         object.__setattr__(self, "rho", _checks.positive("rho", self.rho, " kg/m^3"))
         object.__setattr__(self, "mu", _checks.non_negative("mu", self.mu, " Pa s"))
-        if (self.nu is None) == (self.G is None):
-            raise ParameterError("give exactly one of `nu` (Poisson ratio) and `G` (shear modulus "
-                                 f"[Pa]), got nu={self.nu!r}, G={self.G!r}")
+        if self.nu is None and self.G is None:
+            raise ParameterError("missing `nu` (Poisson ratio [-]); or give the shear modulus `G` [Pa]")
+        if self.nu is not None and self.G is not None:
+            raise ParameterError(f"`G` = {self.G!r} Pa given with `nu` = {self.nu!r}: give either `nu` "
+                                 "(Poisson ratio) or `G` (shear modulus [Pa]), not both")
         if self.G is None:
             nu = _checks.finite("nu", self.nu)
             if not -1.0 < nu <= 0.5:
@@ -137,12 +139,7 @@ class Medium:
     @classmethod
     def preset(cls, name):
         """A named medium: ``"water"`` (the paper's Table III) or ``"air"``."""
-        try:
-            return MEDIA[name]
-        except (KeyError, TypeError):
-            raise ParameterError(
-                f"unknown `medium` {name!r}; valid presets are {sorted(MEDIA)}"
-            ) from None
+        return MEDIA[_checks.choice("medium", name, tuple(MEDIA))]
 
 
 #: The paper's water (Table III) and air, where fluid loads are neglected.

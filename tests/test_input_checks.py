@@ -104,7 +104,8 @@ def test_nul_byte_paths():
     ("max_wall_time = -2.0", r"`max_wall_time` must be > 0 s"),
     ("initial = \"equilibirum\"", r"did you mean 'equilibrium'\?"),
     ("rtool = 1e-6", r"unknown key `rtool`; did you mean `rtol`\?"),
-    ("atol = [" + ", ".join(["1.0"] * 100_000) + "]", r"`atol` must be a number"),
+    # an array: the state's size, as in Python (N = 100 here)
+    ("atol = [" + ", ".join(["1.0"] * 100_000) + "]", r"\[solver\] `atol` must have length \d+ \(the state size\)"),
 ])
 def test_scenario_solver_rules_match_python(extra, match):
     with pytest.raises(ScenarioError, match=match) as info:

@@ -12,7 +12,7 @@ import rodmol
 from rodmol import loads
 from rodmol.arm import paper_rod
 from rodmol.discretise import external, load_entries
-from rodmol.scenario import schema
+from rodmol.scenario import tables
 
 NOUNS = ("rod", "parameters", "cables", "cable_routing", "loads", "holds", "markers", "base_motion", "inputs",
          "model")
@@ -49,9 +49,9 @@ def test_kernel_codes_are_distinct_and_every_code_has_its_dependencies():
 
 @pytest.mark.parametrize("kind", list(loads.SCENARIO_TYPES))
 def test_every_scenario_key_with_a_unit_has_it(kind):
-    keys, required = schema.LOADS[kind]
-    assert set(required) <= set(keys) and "name" in keys
-    assert set(schema.LOAD_UNITS[kind]) == set(keys) - {"frame", "name"}
+    table = tables.LOADS[kind]
+    assert set(table.required()) <= set(table.names()) and "name" in table.names()
+    assert set(table.units) == set(table.names()) - {"type", "frame", "name"}
 
 
 def test_load_scale_adds_point_forces_and_moments_over_length():

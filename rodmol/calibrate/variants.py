@@ -3,13 +3,13 @@
 The keys are those of the scenario files (``docs/scenario-reference.md``),
 and they apply to the built run, so they also change the paper's fixed arm:
 
-* ``material.E``, ``material.nu``, ``material.G``, ``material.mu``,
-  ``material.rho`` (E keeps nu, so G = E / (2 (1 + nu)) follows it);
-* ``medium.rho``, ``medium.Cx``, ``medium.Cy``, ``medium.Cz``, ``medium.By``,
-  ``medium.Bz``; switches ``medium.drag``, ``medium.added_mass``,
-  ``medium.munk_moment`` (true/false);
-* ``discretization.n_elements``, ``discretization.scheme``; ``solver.t_end``, ``solver.rtol``,
-  ``solver.atol``, ``solver.output_dt``, ``solver.backend``, ``solver.initial``;
+* the numbers of ``[material]`` (``material.E``, ``material.nu``,
+  ``material.G``, ``material.mu``, ``material.rho``; E keeps nu, so
+  G = E / (2 (1 + nu)) follows it) and of ``[medium]`` (``medium.rho``,
+  ``medium.Cx`` ...), the switches of ``[medium]`` (``medium.drag`` ...,
+  true/false);
+* ``discretization.n_elements``, ``discretization.scheme``; the keys of
+  ``[solver]`` (``solver.t_end``, ``solver.rtol`` ...);
 * ``tension.<cable>``: a tension input (number, knots, CSV path, TimeInput);
   ``tension.<cable>.scale`` [-] and ``tension.<cable>.offset`` [N]: the
   cable's tension becomes max(0, scale T(t) + offset). ``<cable>`` is the
@@ -32,13 +32,16 @@ from ..model import Model
 from ..parameters import Material, Medium
 from ..rod import Rod
 from ..run_spec import RunSpec
+from ..scenario import tables
 
-MATERIAL = ("E", "nu", "G", "mu", "rho")
-MEDIUM = ("rho", "Cx", "Cy", "Cz", "By", "Bz")
-SWITCHES = ("drag", "added_mass", "munk_moment")
-SOLVER = ("t_end", "rtol", "atol", "output_dt", "backend", "initial")
+# The keys are the scenario file's (rodmol.scenario.tables): the numbers of
+# [material] and [medium], the switches of [medium], [discretization] and [solver].
+MATERIAL = tables.MATERIAL.numbers()
+MEDIUM = tables.MEDIUM.numbers()
+SWITCHES = tables.MEDIUM.switches()
+SOLVER = tables.SOLVER.names()
 KEYS = ([f"material.{k}" for k in MATERIAL] + [f"medium.{k}" for k in MEDIUM + SWITCHES]
-        + ["discretization.n_elements", "discretization.scheme"] + [f"solver.{k}" for k in SOLVER]
+        + [f"discretization.{k}" for k in tables.DISCRETIZATION.names()] + [f"solver.{k}" for k in SOLVER]
         + ["tension.<cable>", "tension.<cable>.scale", "tension.<cable>.offset"])
 
 

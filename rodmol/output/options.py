@@ -1,8 +1,11 @@
 """What a run writes: :class:`OutputOptions`."""
 
+import os
 from dataclasses import dataclass
 
-from .formats import DEFAULT
+from .. import _checks
+from ..errors import ParameterError
+from .formats import DEFAULT, FORMATS
 from .stream import CHUNK_FRAMES
 
 
@@ -21,3 +24,15 @@ class OutputOptions:
     npz: bool = True
     every: int = None
     chunk_frames: int = CHUNK_FRAMES
+
+    def __post_init__(self):
+        if self.directory is not None and not (isinstance(self.directory, (str, os.PathLike))
+                                               and "\0" not in os.fspath(self.directory)):
+            raise ParameterError(f"`directory` must be a path without NUL characters, got "
+                                 f"{_checks.short(self.directory)}")
+        _checks.choice("format", self.format, tuple(FORMATS))
+        _checks.flag("vtk", self.vtk)
+        _checks.flag("npz", self.npz)
+        if self.every is not None:
+            _checks.integer_at_least("every", self.every, 1)
+        _checks.integer_at_least("chunk_frames", self.chunk_frames, 1)

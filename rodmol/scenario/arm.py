@@ -1,37 +1,24 @@
 """The arm's tables of a scenario file: ``[rod]``, ``[material]``, ``[medium]``,
 ``[[cable]]``, ``[[marker]]`` and ``[base]``.
 
-Each reader returns the rodmol object (or the value) a table describes, or
+Each table's keys are its constructor's parameters (:mod:`rodmol.scenario.tables`),
+and its values are checked by that constructor. Each reader returns the rodmol
+object (or the value) a table describes, or
 :data:`~rodmol.scenario.problems.FAILED` once its problems are recorded.
 """
 
-from functools import partial
+from dataclasses import asdict
 
-import numpy as np
-
-from .. import scenarios
+from .. import _checks, scenarios
 from ..arm import CABLE_OFFSETS
 from ..base_motion import BaseMotion
 from ..cables import Cable
-from ..inputs import Constant
+from ..errors import ParameterError
 from ..markers import Marker
-from ..model import DRAG_LAWS
 from ..parameters import MEDIA, Material, Medium
 from ..rod import Rod
-from . import readers as read
+from . import tables
 from .problems import FAILED, failed
-from .schema import (
-    BASE,
-    CABLE,
-    COEFFICIENTS,
-    MARKER,
-    MATERIAL,
-    MATERIAL_REQUIRED,
-    MEDIUM,
-    PAPER_CABLE,
-    ROD,
-    SWITCHES,
-)
 
 
 def missing_table(data, ctx, key):
@@ -42,48 +29,40 @@ def missing_table(data, ctx, key):
     return True
 
 
-#: Stand-ins for the other values when a [material] value is checked alone.
-_PLACEHOLDER = {"E": 1.0, "nu": 0.0, "mu": 0.0, "rho": 1.0}
+def values(table, ctx, path, data, keys=None):
+    """The values of ``data`` for the constructor keys of ``table`` (or ``keys``),
+    as the constructors take them; FAILED if one cannot be converted."""
+    keys = table.parameters() if keys is None else keys
+    found = {k: ctx.read(data, path, k, lambda v, k=k: tables.convert(k, v, ctx.base_dir))
+             for k in keys if k in data}
+    return FAILED if failed(*found.values()) else found
 
 
-def material(data, ctx):
-    """``[material]``: E, mu, rho and exactly one of nu and G."""
-    if missing_table(data, ctx, "material"):
+def build_table(data, ctx, path, table, build, extra=None, hint=""):
+    """The object ``build`` makes of the table ``data``: keys checked against
+    ``table`` (``hint`` ends the message of an unknown key), values converted and
+    checked by ``build``; ``extra``: arguments that do not come from the file."""
+    if not isinstance(data, dict):
+        ctx.table(data, path, table)  # records that it is not a table
         return FAILED
-    path = ("material",)
-    table = ctx.table(data["material"], path, MATERIAL, required=MATERIAL_REQUIRED)
-    values = {k: ctx.read(table, path, k, read.component_viscosity if k == "viscosity" else read.number())
-              for k in MATERIAL if k in table}
-    elastic = [k for k in ("nu", "G") if k in table]
-    if not isinstance(data["material"], dict):
-        return FAILED  # recorded by ctx.table
-    if not elastic:
-        ctx.add(path, "missing required key `nu` (Poisson ratio [-]), or give the shear modulus `G` [Pa]")
-    elif len(elastic) == 2:
-        ctx.add(path + ("G",), "give either `nu` (Poisson ratio) or `G` (shear modulus [Pa]), not both")
-    complete = all(k in values for k in MATERIAL_REQUIRED) and len(elastic) == 1
-    if not complete or failed(*values.values()):
-        # Check each given value alone (the others set to placeholders) to report them all.
-        for key, value in values.items():
-            if value is not FAILED:
-                others = {k: v for k, v in _PLACEHOLDER.items() if not (key == "G" and k == "nu")}
-                ctx.construct(path, {key: value}, partial(Material, **{**others, key: value}))
+    ctx.table(data, path, table, hint=hint)
+    given = values(table, ctx, path, data)
+    if given is FAILED:
         return FAILED
-    return ctx.construct(path, table, lambda: Material(**values))
+    missing = [k for k in table.required() if k not in data]
+    return ctx.construct(path, build, {**given, **(extra or {})}, given=data, missing=missing)
 
 
 def rod(data, ctx):
     """``[rod]`` with its ``[material]``."""
-    body = material(data, ctx)
-    path = ("rod",)
+    body = FAILED if missing_table(data, ctx, "material") else build_table(
+        data["material"], ctx, ("material",), tables.MATERIAL, Material)
     if missing_table(data, ctx, "rod"):
         return FAILED
-    table = ctx.table(data["rod"], path, ROD, required=ROD)
-    length = ctx.read(table, path, "length", read.number("positive", "m"))
-    radius = ctx.read(table, path, "radius", read.radius(length))
-    if failed(body, length, radius) or length is None or radius is None:
-        return FAILED
-    return ctx.construct(path, table, lambda: Rod(length, radius, body))
+    # An unusable material still lets the rod's own values be checked.
+    stand_in = body if body is not FAILED else Material(1.0, 0.0, rho=1.0)
+    built = build_table(data["rod"], ctx, ("rod",), tables.ROD, Rod, extra={"material": stand_in})
+    return FAILED if failed(body) else built
 
 
 def medium(data, ctx, default):
@@ -91,20 +70,14 @@ def medium(data, ctx, default):
     value = data.get("medium", default)
     path = ("medium",)
     if isinstance(value, str):
-        return ctx.read({"medium": value}, (), "medium", lambda v: read.choice(tuple(MEDIA))(v)), {}
-    table = ctx.table(value, path, MEDIUM)
-    preset = ctx.read(table, path, "preset", read.choice(tuple(MEDIA)), "air")
-    coefficients = {k: ctx.read(table, path, k, read.number("non-negative"))
-                    for k in COEFFICIENTS if k in table}
-    switches = {k: ctx.read(table, path, k, read.boolean) for k in SWITCHES if k in table}
-    if "drag_law" in table:
-        switches["drag_law"] = ctx.read(table, path, "drag_law", read.choice(DRAG_LAWS))
-    if "drag_coefficients" in table:
-        switches["drag_coefficients"] = ctx.read(table, path, "drag_coefficients", read.vector(3, "kg/m^2"))
-    if failed(preset, *coefficients.values(), *switches.values()) or not isinstance(value, dict):
+        return ctx.read({"medium": value}, (), "medium", Medium.preset), {}
+    table = ctx.table(value, path, tables.MEDIUM)
+    preset = ctx.read(table, path, "preset", Medium.preset, MEDIA["air"])
+    coefficients = values(tables.MEDIUM, ctx, path, table, keys=tables.Source(Medium).parameters())
+    switches = values(tables.MEDIUM, ctx, path, table, keys=tables.MODEL_SWITCHES)
+    if failed(preset, coefficients, switches) or not isinstance(value, dict):
         return FAILED, {}
-    start = {k: getattr(MEDIA[preset], k) for k in COEFFICIENTS}
-    fluid = ctx.construct(path, table, lambda: Medium(**{**start, **coefficients}))
+    fluid = ctx.construct(path, Medium, {**asdict(preset), **coefficients}, given=table)
     return fluid, switches
 
 
@@ -117,99 +90,65 @@ def entries(data, ctx, kind):
     return found
 
 
-def cables(data, ctx):
-    """The ``[[cable]]`` tables of an arm written out in full."""
-    tables = entries(data, ctx, "cable")
-    if tables is FAILED:
+def numbered(data, ctx, kind, table, build):
+    """The objects of the ``[[kind]]`` tables; a nameless one is ``"kind K"``."""
+    found = entries(data, ctx, kind)
+    if found is FAILED:
         return FAILED
-    built, names = [], {}
-    for i, entry in enumerate(tables):
-        path = ("cable", i)
-        table = ctx.table(entry, path, CABLE, required=("offset", "anchor"))
-        name = ctx.read(table, path, "name", read.string, f"cable {i + 1}")
-        if name in names:
-            ctx.add(path + ("name",), f"`name` {name!r} is already used by [[cable]] #{names[name] + 1}")
-        names.setdefault(name, i)
-        offset = ctx.read(table, path, "offset", read.offset)
-        anchor = ctx.read(table, path, "anchor", read.number("positive", "m"))
-        tension = ctx.read(table, path, "tension", read.tension(ctx.base_dir, name))
-        options = {k: ctx.read(table, path, k, reader) for k, reader in _cable_options(ctx, name).items()
-                   if k in table}
-        if failed(name, offset, anchor, tension, *options.values()) or offset is None or anchor is None:
-            built.append(FAILED)
-            continue
-        built.append(ctx.construct(path, table, partial(Cable, offset, anchor, tension, name=name, **options)))
+    built = []
+    for i, entry in enumerate(found):
+        name = {} if isinstance(entry, dict) and "name" in entry else {"name": f"{kind} {i + 1}"}
+        built.append(build_table(entry, ctx, (kind, i), table, build, extra=name))
     return FAILED if failed(*built) else built
 
 
-def _cable_options(ctx, name):
-    """Readers of the optional [[cable]] keys (routing on spacer disks,
-    displacement control, friction)."""
-    return {"outside_body": read.boolean, "displacement": read.displacement(ctx.base_dir, name),
-            "compliance": read.number("positive", "1/N"), "base_to_actuator": read.number("non-negative", "m"),
-            "rest_length": read.number("positive", "m"), "friction": read.number("non-negative"),
-            "slip_speed": read.number("positive", "m/s")}
+def cables(data, ctx):
+    """The ``[[cable]]`` tables of an arm written out in full."""
+    return numbered(data, ctx, "cable", tables.CABLE, Cable)
+
+
+def markers(data, ctx):
+    """The ``[[marker]]`` tables."""
+    return numbered(data, ctx, "marker", tables.MARKER, Marker)
 
 
 def paper_cables(data, ctx, scenario):
     """Tensions by cable number: the scenario's, replaced by the ``[[cable]]`` entries."""
     tensions = dict(scenarios.get(scenario).tensions) if scenario not in (None, FAILED) else {}
-    tables = entries(data, ctx, "cable")
-    if tables is FAILED:
+    found = entries(data, ctx, "cable")
+    if found is FAILED:
         return FAILED
     hint = " (with `arm = \"paper\"`, a [[cable]] only sets the `tension` of cable `number` 1-12)"
     ok = True
-    for i, entry in enumerate(tables):
+    for i, entry in enumerate(found):
         path = ("cable", i)
-        table = ctx.table(entry, path, PAPER_CABLE, required=PAPER_CABLE, hint=hint)
-        number = ctx.read(table, path, "number", read.integer(1, maximum=len(CABLE_OFFSETS)))
-        tension = ctx.read(table, path, "tension", read.tension(ctx.base_dir, f"cable {number}"))
-        if failed(number, tension) or number is None or tension is None:
+        table = ctx.table(entry, path, tables.PAPER_CABLE, required=("number", "tension"), hint=hint)
+        number = ctx.read(table, path, "number", _cable_number)
+        tension = values(tables.PAPER_CABLE, ctx, path, table)
+        if failed(number, tension) or "tension" not in table or number is None:
             ok = False
-        else:
-            tensions[number] = tension
+            continue
+        cable = ctx.construct(path, lambda tension, number=number: Cable(
+            CABLE_OFFSETS[number], 1.0, tension, name=f"cable {number}"), tension, given=table, keys=("tension",))
+        ok = ok and not failed(cable)
+        tensions[number] = getattr(cable, "tension", None)
     return tensions if ok else FAILED
 
 
-def markers(data, ctx):
-    """The ``[[marker]]`` tables."""
-    tables = entries(data, ctx, "marker")
-    if tables is FAILED:
-        return FAILED
-    built = []
-    for i, entry in enumerate(tables):
-        path = ("marker", i)
-        table = ctx.table(entry, path, MARKER, required=("s",))
-        name = ctx.read(table, path, "name", read.string, f"marker {i + 1}")
-        s = ctx.read(table, path, "s", read.number("non-negative", "m"))
-        offset = ctx.read(table, path, "offset", read.vector(2, "m"))
-        if failed(name, s, offset) or s is None:
-            built.append(FAILED)
-            continue
-        built.append(ctx.construct(path, table, partial(Marker, s, offset, name)))
-    return FAILED if failed(*built) else built
-
-
-def _constant(vector):
-    # A bound method of a constant input, not a closure, so that the model pickles.
-    return Constant(vector, 3).value
+def _cable_number(value):
+    _checks.integer_at_least("number", value, 1)
+    if value > len(CABLE_OFFSETS):
+        raise ParameterError(f"`number` must be <= {len(CABLE_OFFSETS)}, got {value!r}")
+    return value
 
 
 def base(data, ctx):
-    """``[base]``: a clamp, fixed or moving at constant velocities."""
-    path = ("base",)
-    table = ctx.table(data.get("base", {}), path, BASE)
-    fixed = ctx.read(table, path, "fixed", read.boolean, False)
-    position = ctx.read(table, path, "position", read.vector(3, "m"), (0.0, 0.0, 0.0))
-    rotation = ctx.read(table, path, "rotation", read.matrix3, tuple(map(tuple, np.eye(3))))
-    velocity = ctx.read(table, path, "velocity", read.vector(3, "m/s"))
-    angular = ctx.read(table, path, "angular_velocity", read.vector(3, "rad/s"))
-    if fixed is True and (velocity is not None or angular is not None):
+    """``[base]``: a clamp, fixed or moving."""
+    path, table = ("base",), data.get("base", {})
+    fixed = ctx.read(table, path, "fixed", lambda v: _checks.flag("fixed", v), False) \
+        if isinstance(table, dict) else False
+    if fixed is True and ("velocity" in table or "angular_velocity" in table):
         ctx.add(path + ("fixed",), "`fixed = true` cannot be combined with `velocity` or "
                                    "`angular_velocity`")
-        return FAILED
-    if failed(fixed, position, rotation, velocity, angular):
-        return FAILED
-    return ctx.construct(path, table, lambda: BaseMotion(
-        None if velocity is None else _constant(np.array(velocity)),
-        None if angular is None else _constant(np.array(angular)), position, rotation))
+    built = build_table(table, ctx, path, tables.BASE, BaseMotion)
+    return FAILED if failed(fixed, built) or (fixed is True and not built.fixed) else built

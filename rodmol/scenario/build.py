@@ -1,50 +1,49 @@
 """From the tables of a parsed scenario file to a :class:`RunSpec`: the top
 level, ``[discretization]``, ``[solver]``, ``[output]``, and the Model built
 from the arm's tables (:mod:`rodmol.scenario.arm`) and the loads
-(:mod:`rodmol.scenario.loads`)."""
+(:mod:`rodmol.scenario.loads`). Values are checked by the constructors and by
+:func:`rodmol.simulate`'s own checks (:func:`rodmol.simulate.check_run`)."""
 
-import os
 import re
-from pathlib import Path
 
-from .. import scenarios
+from .. import _checks, scenarios
 from ..arm import LENGTH as PAPER_LENGTH
 from ..arm import paper_arm
-from ..discretise.layout import StateLayout
-from ..discretise.schemes import DEFAULT_SCHEME, SCHEMES
+from ..discretise.schemes import DEFAULT_SCHEME, get_scheme
 from ..errors import ParameterError
-from ..model import MAX_ELEMENTS, Model
-from ..output.formats import DEFAULT, FORMATS
+from ..model import Model
 from ..output.options import OutputOptions
-from ..output.stream import CHUNK_FRAMES
 from ..run_spec import RunSpec
+from ..simulate import DEFAULT_BACKEND, INITIAL, OUTPUT_DT, check_run
 from ..solve import options as run_options
-from ..solve.backends import BACKENDS
 from . import arm as arm_tables
-from . import readers as read
+from . import tables
 from .loads import loads as load_tables
 from .problems import FAILED, failed
-from .schema import ARMS, DISCRETIZATION, INITIAL, OUTPUT, SOLVER, TOP
+
+#: The Model's keys a file sets (in the top level, [discretization] and [medium]).
+MODEL_KEYS = ("n_elements", "gravity") + tables.MODEL_SWITCHES
 
 
 def build(data, ctx, default_name):
     """The RunSpec of the parsed file ``data``, or None if ``ctx`` recorded problems."""
-    ctx.table(data, (), TOP)
-    name = ctx.read(data, (), "name", read.string, default_name)
-    description = ctx.read(data, (), "description", read.string, "")
-    arm = ctx.read(data, (), "arm", read.choice(ARMS))
-    scenario = ctx.read(data, (), "scenario", read.choice(tuple(scenarios.SCENARIOS)))
+    ctx.table(data, (), tables.TOP)
+    name = ctx.read(data, (), "name", lambda v: _string("name", v), default_name)
+    description = ctx.read(data, (), "description", lambda v: _string("description", v), "")
+    arm = ctx.read(data, (), "arm", lambda v: _checks.choice("arm", v, tables.ARMS))
+    scenario = ctx.read(data, (), "scenario", lambda v: _checks.choice("scenario", v, tuple(scenarios.SCENARIOS)))
     if scenario not in (None, FAILED) and arm is None:
         ctx.add(("scenario",), f"`scenario = {scenario!r}` drives the paper's cables: add `arm = \"paper\"`")
-    gravity = ctx.read(data, (), "gravity", read.vector(3, "m/s^2"), (0.0, -9.81, 0.0))
     n_elements, scheme = _discretization(data, ctx)
     medium, switches = arm_tables.medium(data, ctx, default="water" if arm == "paper" else "air")
     base = arm_tables.base(data, ctx)
     t_end_default = scenarios.get(scenario).t_end if scenario not in (None, FAILED) else scenario
-    solver, t_end = _solver(data, ctx, t_end_default, n_elements)
+    solver, t_end = _solver(data, ctx, t_end_default)
     solver["scheme"] = scheme
+    checked = _check_solver(ctx, solver, t_end, n_elements)
     output = _output(data, ctx)
     loads = load_tables(data, ctx)
+    gravity = arm_tables.values(tables.TOP, ctx, (), data, keys=("gravity",))
 
     if arm is FAILED:
         return None  # which arm is meant is unknown: its tables cannot be checked
@@ -54,29 +53,37 @@ def build(data, ctx, default_name):
                 ctx.add((key,), f"`{key}` cannot be changed with `arm = \"paper\"` (the paper's arm "
                                 "is fixed); write the arm out in full instead (see examples/bending.toml)")
         tensions = arm_tables.paper_cables(data, ctx, scenario)
-        parts = (gravity, n_elements, scheme, medium, base, tensions, loads)
+        parts = (medium, base, tensions, loads)
         if not failed(loads):
             _check_lengths(ctx, PAPER_LENGTH, [], [], loads)
-        build_model = lambda: paper_arm(n_elements, medium=medium, tensions=tensions,  # noqa: E731
-                                        gravity=gravity, base=base, loads=loads, **switches)
+        build_model = lambda **kw: paper_arm(medium=medium, tensions=tensions,  # noqa: E731
+                                             base=base, loads=loads, **kw)
     else:
         rod = arm_tables.rod(data, ctx)
         cables = arm_tables.cables(data, ctx)
         markers = arm_tables.markers(data, ctx)
-        parts = (gravity, n_elements, scheme, medium, base, rod, cables, markers, loads)
+        parts = (medium, base, rod, cables, markers, loads)
         if not failed(rod, cables, markers, loads):
             _check_lengths(ctx, rod.length, cables, markers, loads)
-        build_model = lambda: Model(rod, n_elements, gravity=gravity, medium=medium,  # noqa: E731
-                                    cables=cables, base=base, markers=markers, loads=loads,
-                                    **switches)
-    if ctx.problems or failed(*parts):
+        build_model = lambda n_elements, **kw: Model(rod, n_elements, medium=medium,  # noqa: E731
+                                                     cables=cables, base=base, markers=markers,
+                                                     loads=loads, **kw)
+    if failed(gravity, switches):
         return None
-    try:
-        model = build_model()
-    except ParameterError as exc:
-        _model_problem(ctx, data, str(exc), loads)
+    if ctx.problems or failed(*parts):
+        build_model = paper_arm  # a stand-in arm: the Model's own keys are still checked
+    given = {"n_elements": n_elements, **gravity, **switches}
+    model = ctx.construct((), build_model, given, keys=MODEL_KEYS,
+                          where=lambda key, message: _model_problem(data, key, message))
+    if ctx.problems or failed(model, checked):
         return None
     return RunSpec(name, description, ctx.source, model, t_end, solver, output)
+
+
+def _string(key, value):
+    if not isinstance(value, str):
+        raise ParameterError(f"`{key}` must be a string, got {_checks.short(value)}")
+    return value
 
 
 def _check_lengths(ctx, length, cables, markers, loads):
@@ -92,74 +99,87 @@ def _check_lengths(ctx, length, cables, markers, loads):
                                         f"got {value(item)!r}")
 
 
-def _model_problem(ctx, data, message, loads=()):
-    """Place a Model error (it names a cable, a marker or a load) at that entry's table."""
-    for i, load in enumerate(loads):  # a load's message starts with its name (a hold off the grid)
-        if message.startswith(f"{load.name}: "):
-            key = re.search(r"`(\w+)`", message)
-            where = ("load", i) + ((key.group(1),) if key and key.group(1) in data["load"][i] else ())
-            return ctx.add(where, message)
-    for kind in ("cable", "marker"):
-        match = re.match(rf"{kind} '([^']*)'", message)
+def _model_problem(data, key, message):
+    """Where a Model error belongs: the table of the key it names, or the
+    [[cable]], [[marker]] or [[load]] entry whose name it quotes or starts with
+    (a load's messages begin "name: "; the last one: a name used twice is the
+    second's fault), or [rod]."""
+    if key is not None:
+        return tables.table_of(key) + (key,)
+    found = None
+    for kind in tables.ARRAYS:
         entries = data.get(kind) if isinstance(data.get(kind), list) else []
         for i, entry in enumerate(entries):
-            if match and isinstance(entry, dict) and _entry_name(kind, i, entry) == match.group(1):
-                key = re.search(r"`(\w+)`", message)
-                where = (kind, i) + ((key.group(1),) if key and key.group(1) in entry else ())
-                return ctx.add(where, message)
-    ctx.add(("rod",) if "rod" in data else (), message)
+            name = _entry_name(kind, i, entry) if isinstance(entry, dict) else None
+            if name is not None and (repr(name) in message or message.startswith(f"{name}: ")):
+                named = re.search(r"`(\w+)`", message)
+                found = (kind, i) + ((named.group(1),) if named and named.group(1) in entry else ())
+    return found or (("rod",) if "rod" in data else ())
 
 
 def _entry_name(kind, index, entry):
+    """The name the built object carries: the table's, else its class's default."""
     name = entry.get("name")
-    return name if isinstance(name, str) else f"{kind} {index + 1}"
+    if isinstance(name, str):
+        return name
+    table = tables.LOADS.get(entry.get("type")) if kind == "load" else None
+    default = table.default("name") if table is not None and "name" in table.parameters() else None
+    return default if isinstance(default, str) else f"{kind} {index + 1}"
 
 
 def _discretization(data, ctx):
     path = ("discretization",)
-    table = ctx.table(data.get("discretization", {}), path, DISCRETIZATION)
-    return (ctx.read(table, path, "n_elements", read.integer(2, MAX_ELEMENTS), 100),
-            ctx.read(table, path, "scheme", read.choice(tuple(SCHEMES)), DEFAULT_SCHEME))
+    table = ctx.table(data.get("discretization", {}), path, tables.DISCRETIZATION)
+    scheme = ctx.read(table, path, "scheme", lambda v: get_scheme(v).name, DEFAULT_SCHEME)
+    return table.get("n_elements", tables.DISCRETIZATION.default("n_elements")), scheme
 
 
-def _solver(data, ctx, t_end_default, n_elements):
-    """simulate's options and t_end, checked by the same rules as in Python
-    (:mod:`rodmol.solve.options`)."""
+def _solver(data, ctx, t_end_default):
+    """The [solver] values as simulate takes them (checked with the model, by
+    :func:`_check_solver`), and t_end."""
     path = ("solver",)
-    table = ctx.table(data.get("solver", {}), path, SOLVER)
-    options = dict(
-        backend=ctx.read(table, path, "backend", read.choice(tuple(BACKENDS)), "cvode"),
-        rtol=ctx.read(table, path, "rtol", lambda v: run_options.rtol(read.number()(v))),
-        atol=ctx.read(table, path, "atol", read.number("positive")),
-        output_dt=ctx.read(table, path, "output_dt", read.number("positive", "s"), 0.01),
-        initial=ctx.read(table, path, "initial", read.choice(INITIAL), "equilibrium"),
-    )
+    table = ctx.table(data.get("solver", {}), path, tables.SOLVER, required=())  # t_end: below
+    defaults = dict(backend=DEFAULT_BACKEND, rtol=None, atol=None, output_dt=OUTPUT_DT, initial=INITIAL[0])
+    options = {key: tables.convert(key, table.get(key, default), ctx.base_dir) for key, default in defaults.items()}
     if "max_wall_time" in table:
-        options["max_wall_time"] = ctx.read(table, path, "max_wall_time", read.number("positive", "s"))
-    t_end = ctx.read(table, path, "t_end", read.number("positive", "s"), t_end_default)
+        options["max_wall_time"] = table["max_wall_time"]
+    t_end = table.get("t_end", t_end_default)
     if t_end is None:  # (FAILED if the scenario that would give it is wrong)
         ctx.add(path, "missing required key `t_end` [s] (only `scenario = ...` gives a default)")
-    elif not failed(t_end, options["output_dt"], n_elements):
-        try:
-            run_options.output_count(t_end, options["output_dt"], StateLayout(n_elements).size)
-        except ParameterError as exc:
-            # The message opens with t_end: its line, unless only output_dt was written here.
-            ctx.add(path + (("output_dt",) if "output_dt" in table and "t_end" not in table else ("t_end",)),
-                    str(exc))
     return options, t_end
 
 
+def _check_solver(ctx, solver, t_end, n_elements):
+    """simulate's own checks of the [solver] values, each problem at its key;
+    FAILED if one fails. They need a Model of the file's size (it sizes the
+    state): the paper's arm with as many elements stands in (a bad
+    ``n_elements`` is the file's Model's to report)."""
+    path = ("solver",)
+    table = ctx.data.get("solver", {}) if isinstance(ctx.data.get("solver"), dict) else {}
+    options = {k: v for k, v in solver.items() if k not in ("output_dt", "scheme")}
+    scheme = DEFAULT_SCHEME if failed(solver["scheme"]) else solver["scheme"]  # (recorded)
+    try:
+        stand_in, sized = paper_arm(n_elements), True
+    except ParameterError:
+        stand_in, sized = paper_arm(2), False
+    run = ctx.construct(path, lambda **kw: check_run(stand_in, t0=None, scheme=scheme, progress=None,
+                                                    backend_options={}, **{"max_wall_time": None, **kw}),
+                        options, given=table, keys=tuple(options))
+    if t_end is None or t_end is FAILED:
+        return FAILED  # (recorded)
+    t_end = ctx.read({"t_end": t_end}, path, "t_end", lambda v: _checks.positive("t_end", v, " s"))
+    output_dt = ctx.read(solver, path, "output_dt", lambda v: _checks.positive("output_dt", v, " s"))
+    if failed(run, t_end, output_dt) or not sized:
+        return FAILED if failed(run, t_end, output_dt) else run
+    try:
+        run_options.output_count(t_end, output_dt, run.layout.size)
+    except ParameterError as exc:
+        # The message opens with t_end: its line, unless only output_dt was written here.
+        ctx.add(path + (("output_dt",) if "output_dt" in table and "t_end" not in table else ("t_end",)),
+                str(exc))
+        return FAILED
+    return run
+
+
 def _output(data, ctx):
-    path = ("output",)
-    table = ctx.table(data.get("output", {}), path, OUTPUT)
-    directory = ctx.read(table, path, "directory", read.path)
-    values = dict(format=ctx.read(table, path, "format", read.choice(tuple(FORMATS)), DEFAULT),
-                  vtk=ctx.read(table, path, "vtk", read.boolean, True),
-                  npz=ctx.read(table, path, "npz", read.boolean, True),
-                  every=ctx.read(table, path, "every", read.integer(1), None),
-                  chunk_frames=ctx.read(table, path, "chunk_frames", read.integer(1), CHUNK_FRAMES))
-    if failed(directory, *values.values()):
-        return None
-    if directory is not None:
-        directory = Path(os.path.normpath(ctx.base_dir / directory))
-    return OutputOptions(directory, **values)
+    return arm_tables.build_table(data.get("output", {}), ctx, ("output",), tables.OUTPUT, OutputOptions)

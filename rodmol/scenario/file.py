@@ -7,9 +7,9 @@ in the file is reported at once, each with its line number and table, in one
 ``docs/scenario-reference.md``; relative paths are relative to the file.
 
 The work is shared by
-:mod:`~rodmol.scenario.schema` (tables, keys, units),
+:mod:`~rodmol.scenario.tables` (the tables, their keys derived from the
+constructors' signatures, units, TOML conversions),
 :mod:`~rodmol.scenario.problems` (collecting problems with their lines),
-:mod:`~rodmol.scenario.readers` (one value each),
 :mod:`~rodmol.scenario.arm` (rod, material, medium, cables, markers, base),
 :mod:`~rodmol.scenario.loads` (``[[load]]``),
 :mod:`~rodmol.scenario.build` (solver, output, the Model); what a checked
@@ -27,10 +27,9 @@ except ModuleNotFoundError:  # Python 3.10
 
 from .build import build
 from .problems import Context, Override, Problem, ScenarioError
-from .readers import RadiusProfile
 from .toml_lines import KeyLines, deepest_line
 
-__all__ = ["Override", "Problem", "RadiusProfile", "ScenarioError", "load_scenario", "parse_scenario"]
+__all__ = ["Override", "Problem", "ScenarioError", "load_scenario", "parse_scenario"]
 
 
 def load_scenario(path, overrides=None):

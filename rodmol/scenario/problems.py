@@ -1,18 +1,19 @@
 """Problems of a scenario file: each with its line and table, all collected at once.
 
-A :class:`Context` walks the parsed file with the field readers of
-:mod:`rodmol.scenario.readers`; every problem it meets is recorded (with
+A :class:`Context` walks the parsed file and hands its values to the rodmol
+constructors, which check them; every problem it meets is recorded (with
 the line number :class:`rodmol.scenario.toml_lines.KeyLines` finds) rather than
 raised, and :class:`ScenarioError` reports them all together.
 """
 
 import difflib
+import inspect
+import os
 import re
 from dataclasses import dataclass
 
 from .._checks import short
 from ..errors import ParameterError
-from .schema import UNITS
 
 
 class ScenarioError(ParameterError):
@@ -40,10 +41,6 @@ class Problem:
         return f"{where}: {self.table} {self.message}" if self.table else f"{where}: {self.message}"
 
 
-class Bad(Exception):
-    """A value problem found by a field reader (message without location)."""
-
-
 #: A value that could not be read; its problem is already recorded.
 FAILED = object()
 
@@ -53,13 +50,13 @@ def failed(*values):
     return any(v is FAILED for v in values)
 
 
-
 @dataclass(frozen=True)
 class Override:
     """A value given on the command line, with the option's name for messages."""
 
     value: object
     label: str
+
 
 def table_label(path):
     """How a table is named in messages: ``[rod]``, ``[[cable]] #2``."""
@@ -110,41 +107,93 @@ class Context:
         line = self.overridden.get(path) or self.lines.find(path)
         self.problems.append(Problem(self.source, line, table_label(table), message))
 
-    def table(self, data, path, allowed, required=(), hint="", units=UNITS):
-        """Check a table's keys; return it (an empty dict if it is not a table)."""
+    def table(self, data, path, table, required=None, hint=""):
+        """Check a table's keys against ``table`` (a :class:`~rodmol.scenario.tables.Table`);
+        return it (an empty dict if it is not a table)."""
         if not isinstance(data, dict):
             self.add(path, f"`{path[-1]}` must be a table, got {short(data)}")
             return {}
+        allowed = table.names()
         for key in data:
             if key not in allowed:
                 close = difflib.get_close_matches(key, allowed, n=1, cutoff=0.6)
                 tip = f"; did you mean `{close[0]}`?" if close else f"; valid keys: {', '.join(allowed)}"
                 self.add(path + (key,), f"unknown key `{key}`{tip}{hint}", table=path)
-        for key in required:
+        for key in table.required() if required is None else required:
             if key not in data:
-                unit = f" [{units[key]}]" if key in units else ""
+                unit = f" [{table.unit(key)}]" if table.unit(key) else ""
                 self.add(path, f"missing required key `{key}`{unit}")
         return data
 
-    def read(self, table, path, key, reader, default=None):
-        """``reader(value)`` of ``table[key]`` (``default`` if absent); on a problem, record it."""
+    def read(self, table, path, key, check, default=None):
+        """``check(value)`` of ``table[key]`` (``default`` if absent); a ParameterError is
+        recorded at the key."""
         if key not in table:
             return default
         try:
-            return reader(table[key])
-        except Bad as exc:
-            self.add(path + (key,), f"`{key}` {exc}")
+            return check(table[key])
         except ParameterError as exc:
             self.add(path + (key,), str(exc))
         return FAILED
 
-    def construct(self, path, table, build):
-        """Call a rodmol constructor; a ParameterError is recorded at the key it names."""
-        try:
-            return build()
-        except ParameterError as exc:
-            message = str(exc)
-            named = [w for quoted in re.findall(r"`([^`]+)`", message)
-                     for w in re.findall(r"[A-Za-z_]+", quoted) if w in table]
-            self.add(path + ((named[0],) if named else ()), message)
-            return FAILED
+    def construct(self, path, build, values, given=None, missing=(), where=None, keys=None):
+        """``build(**values)``: the constructor checks the values. Each ParameterError is
+        recorded at the key it names (or at the path ``where(key, message)`` gives); that
+        key then takes a stand-in value (:data:`STAND_INS`, or its default) and ``build``
+        is tried again, so that every bad value is reported at once. ``given``: the
+        file's keys (those with a line); ``missing``: required keys already reported
+        absent (they take stand-ins); ``keys``: those a message may name (default:
+        ``build``'s parameters). Returns the object, or FAILED."""
+        values, given = dict(values), set(values if given is None else given)
+        keys = tuple(inspect.signature(build).parameters) if keys is None else keys
+        reported, left = list(missing), {k: list(STAND_INS) for k in missing}
+        values.update({k: left[k].pop(0) for k in missing})
+        while True:
+            try:
+                built = build(**values)
+                return FAILED if reported else built
+            except TypeError:
+                if not reported:
+                    raise
+                return FAILED  # a stand-in left out a required argument: no more to find
+            except ParameterError as exc:
+                message = str(exc)
+                key = named_key(message, keys) or quoted_value(message, values, given)
+                if key is None or key not in reported:
+                    place = where(key, message) if where else None
+                    self.add(place or path + ((key,) if key in given else ()), message)
+                if key is None:
+                    return FAILED
+                if key not in reported:
+                    reported.append(key)
+                    left[key] = list(STAND_INS) + ([DROP] if key in values else [])
+                if not left[key]:
+                    return FAILED
+                stand_in = left[key].pop(0)
+                if stand_in is DROP:
+                    del values[key]
+                else:
+                    values[key] = stand_in
+
+
+#: Values tried in place of a bad one, to find the table's other problems
+#: (never built into a model): a number, a zero, a 3-vector, a 2-vector, a count.
+STAND_INS = (1.0, 0.0, (1.0, 0.0, 0.0), (0.0, 0.0), 2)
+#: Stand-in "leave it out": the constructor's default.
+DROP = object()
+
+
+def quoted_value(message, values, given):
+    """The key of ``given`` whose text value the message quotes (a CSV file's name), or None."""
+    return next((k for k in given if isinstance(values.get(k), (str, os.PathLike))
+                 and os.fspath(values[k]) in message), None)
+
+
+def named_key(message, keys):
+    """The key of ``keys`` a constructor's message is about: the last word of
+    its first back-quoted name that is a key (```cable 'a' anchor``` -> anchor)."""
+    for quoted in re.findall(r"`([^`]+)`", message):
+        words = [w for w in re.findall(r"[A-Za-z_]+", quoted) if w in keys]
+        if words:
+            return words[-1]
+    return None

@@ -6,7 +6,7 @@ times reached. A backend sees only the system's narrow interface (see
 :mod:`rodmol.discretise.system`).
 """
 
-from ..errors import ParameterError
+from .. import _checks
 from .cvode import cvode
 from .galpha import generalized_alpha
 from .rk23 import rk23
@@ -16,7 +16,5 @@ BACKENDS = {"cvode": cvode, "rk23": rk23, "galpha": generalized_alpha}
 
 
 def get_backend(name):
-    try:
-        return BACKENDS[name]
-    except (KeyError, TypeError):
-        raise ParameterError(f"unknown `backend` {name!r}; valid backends are {sorted(BACKENDS)}") from None
+    """The backend called ``name`` (a near miss gets a did-you-mean)."""
+    return BACKENDS[_checks.choice("backend", name, tuple(BACKENDS))]

@@ -85,7 +85,7 @@ every = 0
     assert "unknown key `ancor`; did you mean `anchor`?" in by_line[line_of("ancor")]
     assert "[[cable]] #1" in by_line[line_of("ancor")]
     assert "`every` must be >= 1" in by_line[line_of("every")]
-    assert any("missing required key `nu`" in str(p) for p in found)
+    assert any("missing `nu`" in str(p) for p in found)
     assert any("missing required key `anchor`" in str(p) for p in found)
     message = str(ScenarioError("s.toml", found))
     assert message.startswith(f"s.toml: {len(found)} problems:")
@@ -144,13 +144,29 @@ def test_radius_forms(radius, at_half):
 @pytest.mark.parametrize("radius, needle", [
     ("[[0.0, 0.02], [0.2, 0.01]]", "span s = 0 to the length 0.3 m"),
     ("[[0.0, 0.02], [0.2, 0.01], [0.1, 0.01], [0.3, 0.01]]", "increasing s"),
-    ("[[0.0, 0.02], [0.3, -0.01]]", "must be > 0 m"),
-    ("[0.01, 0.02, 0.03]", "a [base, tip] pair"),
-    ('"thick"', "a [base, tip] pair"),
+    ("[[0.0, 0.02], [0.3, -0.01]]", "must be finite and > 0 m"),
+    ("[0.01, 0.02, 0.03]", "a (base, tip) pair"),
+    ('"thick"', "a (base, tip) pair"),
 ])
 def test_bad_radius(radius, needle):
     (problem,) = problems(MINIMAL.replace("radius = 0.01", f"radius = {radius}"))
     assert needle in problem.message and problem.table == "[rod]" and problem.line == 4
+
+
+def test_rest_strains_as_in_python():
+    """`rest_curvature` and `rest_stretch` in [rod]: a 3-vector or [s, x, y, z] points, the same Rod
+    as the Python constructor; a bad one is reported at its line, naming the key."""
+    text = MINIMAL.replace("radius = 0.01", "radius = 0.01\nrest_curvature = [0.0, 0.0, 5.0]\n"
+                           "rest_stretch = [[0.0, 1.0, 0.0, 0.0], [0.3, 1.1, 0.01, 0.0]]")
+    rod = parse_scenario(text).model.rod
+    python = rodmol.Rod(0.3, 0.01, rod.material, rest_curvature=(0.0, 0.0, 5.0),
+                        rest_stretch=[(0.0, 1.0, 0.0, 0.0), (0.3, 1.1, 0.01, 0.0)])
+    assert rod == python and not rod.straight
+    for value, needle in (("[0.0, 5.0]", "must be a 3-vector (local frame)"),
+                          ("[[0.0, 0.0, 0.0, 5.0], [0.2, 0.0, 0.0, 5.0]]", "span s = 0 to the length 0.3 m")):
+        (problem,) = problems(MINIMAL.replace("radius = 0.01", f"radius = 0.01\nrest_curvature = {value}"))
+        assert needle in problem.message and "rest_curvature" in problem.message and problem.line == 5
+        assert problem.table == "[rod]"
 
 
 def test_csv_path_is_relative_to_the_file(tmp_path):
@@ -240,3 +256,44 @@ s = 0.4
                 ("[[marker]] #1", lines.index("s = 0.4") + 1)]
     assert [(p.table, p.line) for p in found] == expected
     assert "`anchor` must lie within the rod" in found[0].message
+
+
+def test_bad_values_of_every_kind_of_table_are_reported_together():
+    """Constructors' checks (Material), the Model's (gravity, drag_law, n_elements,
+    checked on a stand-in arm when the file's arm is broken) and simulate's (backend):
+    all at once, each at its line."""
+    text = "gravity = [1, 2]\n" + MINIMAL.replace("E = 1e5", "E = -1").replace(
+        "[solver]", "[medium]\ndrag_law = 'quad'\n[discretization]\nn_elements = 1\n[solver]\nbackend = 'rk2'\n")
+    found = problems(text)
+    lines = text.splitlines()
+    at = {p.line: p.message for p in found}
+    assert len(found) == 5
+    assert "`gravity` must have three components" in at[1]
+    assert "`E` must be > 0 Pa" in at[lines.index("E = -1") + 1]
+    assert "unknown `drag_law` 'quad'" in at[lines.index("drag_law = 'quad'") + 1]
+    assert "`n_elements` must be >= 2" in at[lines.index("n_elements = 1") + 1]
+    assert "did you mean 'rk23'?" in at[lines.index("backend = 'rk2'") + 1]
+
+
+@pytest.mark.parametrize("table, line, python", [
+    ("[rod]", "length = -0.3", lambda m: rodmol.Rod(-0.3, 0.01, m)),
+    ("[material]", "mu = -10.0", lambda m: rodmol.Material(1e5, 0.5, -10.0, 1000.0)),
+    ("[[cable]]", "offset = [0.002, 0.0]\nanchor = 0.3\nfriction = -1.0",
+     lambda m: rodmol.Cable((0.002, 0.0), 0.3, name="cable 1", friction=-1.0)),
+    ("[[marker]]", "s = 0.1\noffset = [1.0]", lambda m: rodmol.Marker(0.1, (1.0,), name="marker 1")),
+    ("[output]", "every = 0", lambda m: rodmol.output.options.OutputOptions(every=0)),
+])
+def test_a_file_is_refused_with_the_constructors_own_message(table, line, python):
+    """Values are checked once, by the classes: the file's message is Python's."""
+    material = rodmol.Material(1e5, 0.5, 10.0, 1000.0)
+    key = line.split("\n")[-1].split(" =")[0]
+    if table in ("[rod]", "[material]"):
+        old = next(x for x in MINIMAL.splitlines() if x.startswith(key + " ="))
+        text = MINIMAL.replace(old, line)
+    else:
+        text = MINIMAL + f"\n{table}\n{line}\n"
+    (problem,) = problems(text)
+    with pytest.raises(rodmol.ParameterError) as expected:
+        python(material)
+    assert problem.message == str(expected.value) and problem.table.split(" #")[0] == table
+    assert problem.line == text.splitlines().index(line.split("\n")[-1]) + 1

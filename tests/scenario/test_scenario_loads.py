@@ -154,7 +154,7 @@ def test_exactly_one_of_nu_and_g():
     assert "either `nu`" in problem.message and "not both" in problem.message
     neither = ARM.replace("nu = 0.5\n", "")
     (problem,) = problems(neither)
-    assert problem.line == line_of(neither, "[material]") and "missing required key `nu`" in problem.message
+    assert problem.line == line_of(neither, "[material]") and "missing `nu`" in problem.message
     assert "`G`" in problem.message
     bad = ARM.replace("nu = 0.5", "G = -3.0").replace("E = 1e5", "E = 0").replace("rho = 1000.0\n", "")
     texts = {p.line: p.message for p in problems(bad)}  # each value checked alone, all reported
@@ -213,15 +213,17 @@ force = "missing.csv"
         line = line_of(text, fragment, after=header) if after_header else header
         return at[(f"[[load]] #{number}", line)]
 
-    assert "is 'point_forse': did you mean 'point_force'?" in message(1, "type")
+    assert "`type` 'point_forse'; did you mean 'point_force'?" in message(1, "type")
     assert "'plane_contact'" in message(1, "type") and "'capsule_contact'" in message(1, "type")
     assert "unknown key `forse`; did you mean `force`?" in message(2, "forse")
     assert "missing required key `force` [N]" in message(2, "", after_header=False)
-    assert "`frame` is 'lokal': did you mean 'local'?" in message(2, "frame")
-    assert "`point` must be 3 numbers [m]" in message(3, "point")
-    assert "`stiffness` must be > 0 N/m^2" in message(3, "stiffness")
-    assert "`friction` must be a number" in message(3, "friction")
-    assert "`force` must be 3 numbers [N/m] (a constant" in message(4, "force")
+    assert "`frame` must be 'global' (dead load) or 'local' (follower load), got 'lokal'; did you mean 'local'?" \
+        in message(2, "frame")
+    # Each value checked by the load's class, all of a table's reported, each at its line
+    assert "`plane contact point` must have three components" in message(3, "point")
+    assert "`plane contact stiffness` must be > 0 N/m^2" in message(3, "stiffness")
+    assert "`plane contact friction` must be a number" in message(3, "friction")
+    assert "`distributed force force` must have three components" in message(4, "force")
     assert "missing required key `type`; valid types: point_force, point_moment" in message(5, "", False)
     assert "knot times must increase" in message(6, "moment")
     assert "unknown key `normal`" in message(7, "normal") and "sphere_contact" in message(7, "normal")
