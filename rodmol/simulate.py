@@ -149,13 +149,7 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
     if t_end <= args.t0:
         raise ParameterError(f"`t_end` must be after the start t0 = {args.t0!r} s, got {t_end!r} s")
     output_dt = _checks.positive("output_dt", OUTPUT_DT if output_dt is None else output_dt, " s")
-    progress = args.progress
-    if progress is True:
-        from ._progress import Progress
-
-        progress = Progress()
-    timings = {}
-    system = build_system(model, args, progress, timings)  # the one system of this run: all below reads it
+    system = SemiDiscrete(model, args.scheme)  # the one system of this run (no compiling): all below reads it
     if recorded:
         _settings.check_grid(recorded, system, _where(sink))
     args = fit(args, system)
@@ -176,8 +170,13 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
     else:  # after every check: with `overwrite`, making the sink clears the earlier run
         sink = _sink(out, resume, overwrite)
     getattr(sink, "record_settings", lambda settings, forced: None)(settings, forced)
+    progress = args.progress
+    if progress is True:
+        from ._progress import Progress
+
+        progress = Progress()
     try:
-        y0 = prepare_run(system, args, progress, timings, sink)
+        y0, timings = prepare_run(system, args, progress, sink)
         solver = dict(rtol=args.rtol, atol=args.atol, progress=progress, max_wall_time=args.max_wall_time,
                       **args.backend_options)
         if sink is None:
@@ -245,14 +244,6 @@ def check_run(*, initial, t0, scheme, backend, rtol, atol, progress, max_wall_ti
                         backend_options)
 
 
-def build_system(model, args, progress, timings):
-    """The system of ``model`` with the scheme of ``args``; its build (the first of a process
-    waits for the compiler) announced through ``progress`` and timed into ``timings`` [s]."""
-    with _stage(progress, "building the system", timings, "prepare_s",
-                kernels.ready(args.run, args.backend_options)):
-        return SemiDiscrete(model, args.scheme)
-
-
 def fit(args, system):
     """``args`` with ``initial`` and ``atol`` checked against the state of ``system`` (its
     layout): an ``initial`` Result gives its last state, ``atol=None`` the system's
@@ -267,9 +258,10 @@ def fit(args, system):
                    atol=args.rtol * system.atol_scale() if atol is None else atol)
 
 
-def prepare_run(system, args, progress, timings, sink=None):
+def prepare_run(system, args, progress, sink=None):
     """The compiled kernels of ``system`` made ready and the initial state, each stage
-    announced through ``progress`` and timed into ``timings`` [s]: returns y0."""
+    announced through ``progress``: returns (y0, timings [s])."""
+    timings = {}
     with _stage(progress, "preparing the compiled kernels", timings, "prepare_s",
                 kernels.ready(args.run, args.backend_options)):
         check_scales(system, args.t0, args.atol)  # before the kernels' first run, which would fail on them
@@ -280,18 +272,17 @@ def prepare_run(system, args, progress, timings, sink=None):
     with _stage(progress, f"solving the initial equilibrium at t = {args.t0:g} s", timings, "equilibrium_s",
                 not (isinstance(initial, str) and initial == "equilibrium")):
         y0 = _initial_state(system, initial, args.t0)
-    return y0
+    return y0, timings
 
 
 @contextmanager
 def _stage(progress, text, timings, key, silent=False):
-    """Time a stage into ``timings[key]`` [s] (added to what it holds), announced
-    through ``progress.stage``."""
+    """Time a stage into ``timings[key]`` [s], announced through ``progress.stage``."""
     start = time.perf_counter()
     announce = getattr(progress, "stage", None)
     with nullcontext() if silent or announce is None else announce(text):
         yield
-    timings[key] = timings.get(key, 0.0) + time.perf_counter() - start
+    timings[key] = time.perf_counter() - start
 
 
 def _sink(out, resume, overwrite):

@@ -15,7 +15,7 @@ from ..discretise.schemes import DEFAULT_SCHEME
 from ..discretise.system import SemiDiscrete
 from ..errors import IntegrationError, ParameterError
 from ..result import from_states
-from ..simulate import _sink, build_system, check_model, check_run, fit, prepare_run
+from ..simulate import _sink, check_model, check_run, fit, prepare_run
 from ..solve.stepping import Stepper
 from .held import HeldInputs
 
@@ -93,17 +93,16 @@ class Simulator:
         self._row = self._inputs.initial_row(args.t0)
         live, self._held = self._inputs.live(self._row)
         self.max_wall_time, self._scheme = args.max_wall_time, args.scheme
+        self._system = SemiDiscrete(live, args.scheme)
+        args = fit(args, self._system)
+        self._sink = _sink(out, False, overwrite)  # after every check: `overwrite` clears the earlier run
         announce = args.progress
         if announce is True:
             from .._progress import Progress
 
             announce = Progress()
-        self._timings = {}
         try:
-            self._system = build_system(live, args, announce, self._timings)
-            args = fit(args, self._system)
-            self._sink = _sink(out, False, overwrite)  # after every check: `overwrite` clears the earlier run
-            y0 = prepare_run(self._system, args, announce, self._timings, self._sink)
+            y0, self._timings = prepare_run(self._system, args, announce, self._sink)
         finally:
             if args.progress is True:
                 announce.close()

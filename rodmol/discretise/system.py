@@ -166,7 +166,6 @@ class SemiDiscrete:
     """
 
     def __init__(self, model, scheme=DEFAULT_SCHEME):
-        compile_signatures()  # the first system of a process waits for the compiler
         self.model = model
         self.scheme = get_scheme(scheme)
         self.layout = StateLayout(model.n_elements)
@@ -314,7 +313,11 @@ class SemiDiscrete:
 
     def kernel_arguments(self):
         """Arguments of :func:`rodmol.discretise.stencil.rhs` after (y, out):
-        the packed model, the inputs :meth:`update_inputs` refreshes, scratch."""
+        the packed model, the inputs :meth:`update_inputs` refreshes, scratch.
+        The first call of a process waits for the compiler (or its disk cache):
+        building a system compiles nothing, so arguments are checked against it
+        first (``rodmol.simulate``)."""
+        compile_signatures()
         return self._args
 
     # ------------------------------------------------------------------ evaluation
@@ -325,7 +328,7 @@ class SemiDiscrete:
             out = np.empty(self.size)
         if self._inputs_vary:
             self.update_inputs(t, y)
-        stencil.rhs(y, out, *self._args)
+        stencil.rhs(y, out, *self.kernel_arguments())
         return out
 
     def rest_rates(self, t, y, out, load_factor=1.0, tensions=None):
@@ -339,7 +342,7 @@ class SemiDiscrete:
         for inputs in scaled:
             inputs *= load_factor
         try:
-            stencil.rhs(y, out, *self._args)
+            stencil.rhs(y, out, *self.kernel_arguments())
         finally:
             for inputs, value in zip(scaled, saved):
                 inputs[:] = value
