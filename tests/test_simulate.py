@@ -1,8 +1,10 @@
 """simulate builds one system and takes its sizes and default tolerances from it."""
 
 import numpy as np
+import pytest
 
 import rodmol
+from rodmol.discretise.layout import BLOCK, FIELDS, HEADER
 from rodmol.discretise.system import SemiDiscrete
 
 
@@ -22,3 +24,35 @@ def test_default_atol_is_the_systems_scale_times_rtol_and_simulates_as_the_defau
     given = rodmol.simulate(model, 0.02, rtol=1e-5, atol=rodmol.default_atol(model, 1e-5))
     np.testing.assert_array_equal(by_default.states, given.states)
     assert by_default.stats["steps"] == given.stats["steps"]
+
+
+def test_simulate_builds_one_system_and_hands_it_on(monkeypatch):
+    model = rodmol.scenarios.get("bending").model(6)
+    rodmol.simulate(model, 0.01)  # the kernels made ready: the run below builds only its own
+    built, seen = [], []
+    init, solve = SemiDiscrete.__init__, rodmol.simulate.__globals__["equilibrium"]
+
+    def counting(self, *args, **kwargs):
+        built.append(self)
+        init(self, *args, **kwargs)
+
+    def spying(system, t):
+        seen.append(system)
+        return solve(system, t)
+
+    monkeypatch.setattr(SemiDiscrete, "__init__", counting)
+    monkeypatch.setitem(rodmol.simulate.__globals__, "equilibrium", spying)
+    result = rodmol.simulate(model, 0.02)
+    assert result.success and len(built) == 1 and seen == built
+
+
+def test_a_state_sized_argument_is_sized_by_the_systems_layout():
+    model = rodmol.scenarios.get("bending").model(6)
+    size = SemiDiscrete(model).size
+    with pytest.raises(rodmol.ParameterError, match=rf"`atol` must have length {size} \(the state size\)"):
+        rodmol.simulate(model, 0.01, atol=np.ones(size + 1))
+    bad = np.ones(size)
+    index = HEADER + BLOCK * 2 + FIELDS["q"].start
+    bad[index] = -1.0
+    with pytest.raises(rodmol.ParameterError, match=rf"-1.0 at entry {index} \(q\[0\] of element 2\)"):
+        rodmol.simulate(model, 0.01, atol=bad)
