@@ -168,6 +168,7 @@ class SemiDiscrete:
     def __init__(self, model, scheme=DEFAULT_SCHEME):
         self.model = model
         self.scheme = get_scheme(scheme)
+        self.lightly_damped = grid_damping_ratio(model) < 1.0
         self.layout = StateLayout(model.n_elements)
         self.size = self.layout.size
         # Feedback and displacement-controlled tensions and friction read the whole state.
@@ -175,10 +176,9 @@ class SemiDiscrete:
         self.global_coupling = model.feedback or self._friction
         m = model
         s_cells = self.scheme.cell_points(m.s_nodes)
+        self.node_lengths = self.scheme.node_lengths(m.n_elements, m.ds)
         self.sampled = sampled = Sampled(m)
         self.cells = cell_properties(m, s_cells)
-        self.node_lengths = self.scheme.node_lengths(m.n_elements, m.ds)
-        self.lightly_damped = grid_damping_ratio(m) < 1.0
         self._params = stencil.pack_params(*self.cells, sampled.mass, sampled.inertia, sampled.net_mass,
                                            sampled.drag_coefficient, sampled.added)
         self._consts = np.zeros(stencil.N_CONSTS)
