@@ -1,5 +1,7 @@
 """simulate builds one system and takes its sizes and default tolerances from it."""
 
+import sys
+
 import numpy as np
 import pytest
 
@@ -30,7 +32,8 @@ def test_simulate_builds_one_system_and_hands_it_on(monkeypatch):
     model = rodmol.scenarios.get("bending").model(6)
     rodmol.simulate(model, 0.01)  # the kernels made ready: the run below builds only its own
     built, seen = [], []
-    init, solve = SemiDiscrete.__init__, rodmol.simulate.__globals__["equilibrium"]
+    module = sys.modules["rodmol.simulate"]
+    init, solve = SemiDiscrete.__init__, module.equilibrium
 
     def counting(self, *args, **kwargs):
         built.append(self)
@@ -41,7 +44,7 @@ def test_simulate_builds_one_system_and_hands_it_on(monkeypatch):
         return solve(system, t)
 
     monkeypatch.setattr(SemiDiscrete, "__init__", counting)
-    monkeypatch.setitem(rodmol.simulate.__globals__, "equilibrium", spying)
+    monkeypatch.setattr(module, "equilibrium", spying)
     result = rodmol.simulate(model, 0.02)
     assert result.success and len(built) == 1 and seen == built
 
