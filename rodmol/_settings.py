@@ -5,7 +5,8 @@ A resumed run continues with the recorded settings wherever the call gives
 none, and is refused (:func:`check`) when the call or the scenario asks for
 another value, unless it forces the resume (``resume="force"``, the command
 line's ``--resume-anyway``). The grid and the output times cannot be
-forced: the frames kept fix them.
+forced: the frames kept fix them (the grid is :func:`check_grid`'s, checked
+once, before anything is sized by it). Each takes what the run's system owns.
 """
 
 import json
