@@ -1,5 +1,6 @@
 """simulate builds one system and takes its sizes and default tolerances from it."""
 
+import subprocess
 import sys
 
 import numpy as np
@@ -59,3 +60,24 @@ def test_a_state_sized_argument_is_sized_by_the_systems_layout():
     bad[index] = -1.0
     with pytest.raises(rodmol.ParameterError, match=rf"-1.0 at entry {index} \(q\[0\] of element 2\)"):
         rodmol.simulate(model, 0.01, atol=bad)
+
+
+@pytest.mark.subprocess
+def test_a_state_sized_argument_is_refused_before_compiling_and_a_system_compiles_when_first_evaluated():
+    """Building the system compiles nothing, so simulate checks ``atol`` against it before
+    any work; its first evaluation waits for the compiler (a fresh process sees both)."""
+    code = ("import rodmol\n"
+            "from rodmol.discretise import physics\n"
+            "model = rodmol.scenarios.get('bending').model(6)\n"
+            "try:\n"
+            "    rodmol.simulate(model, 1.0, atol=[1.0, 2.0])\n"
+            "except rodmol.ParameterError as error:\n"
+            "    print('refused' if 'atol' in str(error) else error)\n"
+            "print(len(physics._UNCOMPILED))\n"
+            "system = rodmol.SemiDiscrete(model)\n"
+            "print(len(physics._UNCOMPILED))\n"
+            "system(0.0, rodmol.straight_state(model))\n"
+            "print(len(physics._UNCOMPILED))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, check=False)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["refused", "1", "1", "0"]
