@@ -72,7 +72,7 @@ def main():
     print(f"tendon tension: static {result.tensions[0, 0]:.3f} N, max {result.tensions[:, 0].max():.3f} N")
     if result.t[-1] >= 10.0:
         system = rodmol.SemiDiscrete(robot)
-        held = rodmol.equilibrium(robot, 10.0, system=system)
+        held = rodmol.equilibrium(system, 10.0)
         print(f"held pose (equilibrium with the motor at z = -16.19 mm): tip x "
               f"{system.state_view(10.0, held).tip[1]:.5f} m")
     if args.csv:

@@ -5,7 +5,8 @@ A resumed run continues with the recorded settings wherever the call gives
 none, and is refused (:func:`check`) when the call or the scenario asks for
 another value, unless it forces the resume (``resume="force"``, the command
 line's ``--resume-anyway``). The grid and the output times cannot be
-forced: the frames kept fix them.
+forced: the frames kept fix them (the grid is :func:`check_grid`'s, checked
+once, before anything is sized by it). Each takes what the run's system owns.
 """
 
 import json
@@ -21,11 +22,12 @@ NAMES = {"n_elements": "number of elements N (the grid)", "model": "model (finge
          "backend_options": "backend options", "initial": "initial state"}
 
 
-def record(model, *, scheme, backend, rtol, atol, backend_options, initial):
-    """The settings of a run (JSON values): ``scheme`` a scheme's name, ``atol`` None for
-    :func:`rodmol.simulate.default_atol` or the per-entry array, ``initial`` a name or the
-    state vector (recorded as its fingerprint)."""
-    return dict(n_elements=int(model.n_elements), model=model_fingerprint(model), scheme=str(scheme),
+def record(system, *, backend, rtol, atol, backend_options, initial):
+    """The settings of a run of ``system`` (a ``SemiDiscrete``: its grid, model and scheme),
+    as JSON values: ``atol`` None for :func:`rodmol.simulate.default_atol` or the per-entry
+    array, ``initial`` a name or the state vector (recorded as its fingerprint)."""
+    return dict(n_elements=int(system.layout.n_blocks), model=model_fingerprint(system.model),
+                scheme=str(system.scheme.name),
                 backend=str(backend), rtol=float(rtol),
                 atol=None if atol is None else np.asarray(atol, dtype=float).tolist(),
                 backend_options=json.loads(json.dumps(dict(backend_options), default=repr)),
@@ -49,8 +51,10 @@ def differences(recorded, current):
     return found
 
 
-def check_grid(recorded, n_elements, where):
-    """Refuse to resume the run in ``where`` on another grid than its recorded one."""
+def check_grid(recorded, system, where):
+    """Refuse to resume the run in ``where`` on another grid than its recorded one (the
+    grid of ``system``, a ``SemiDiscrete``); before anything is sized by that grid."""
+    n_elements = int(system.layout.n_blocks)
     run = recorded.get("n_elements", n_elements)
     if run != n_elements:
         raise ParameterError(f"cannot resume the run in {where}: {NAMES['n_elements']}: the run {run!r}, this "
@@ -60,9 +64,8 @@ def check_grid(recorded, n_elements, where):
 
 def check(recorded, current, force, where):
     """Refuse (ParameterError) to resume the run in ``where`` with ``current`` settings other
-    than ``recorded``, unless ``force`` (then the grid still must match); returns the
-    differences, described (for the record of a forced resume)."""
-    check_grid(recorded, current["n_elements"], where)
+    than ``recorded``, unless ``force``; returns the differences, described (for the record
+    of a forced resume). The grid, which cannot be forced, is :func:`check_grid`'s."""
     found = differences(recorded, current)
     said = [f"{NAMES[key]}: the run {_show(key, run)}, this call {_show(key, now)}" for key, run, now in found]
     if found and not force:

@@ -8,7 +8,6 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from . import _checks, _settings, run_sinks
-from .discretise.layout import StateLayout
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
 from .discretise.system import SemiDiscrete
 from .errors import ParameterError
@@ -136,17 +135,15 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
                                atol=atol, output_dt=output_dt, output_times=output_times, t0=t0,
                                progress=progress, max_wall_time=max_wall_time, out=out, resume=resume,
                                overwrite=overwrite, **backend_options)
-    if not isinstance(model, Model):
-        raise ParameterError(f"`model` must be a rodmol.Model or rodmol.System, got {model!r}")
+    check_model(model)
     if not (resume is True or resume is False or (isinstance(resume, str) and resume in RESUME)):
         raise ParameterError(f"`resume` must be False, True or 'force', got {_checks.short(resume)}")
-    sink, first, plan, recorded = None, 0, None, None
-    asked_plan = (t0, output_dt, output_times)
+    sink, first, plan, recorded, kept = None, 0, None, {}, None
+    asked_plan, asked_initial = (t0, output_dt, output_times), initial
     if resume:  # the run's directory first: its settings fill in what the call leaves out
         sink = _sink(out, resume, overwrite)
         plan, first, kept = sink.resume_point()
         recorded = getattr(sink, "settings", None) or {}
-        _settings.check_grid(recorded, model.n_elements, _where(sink))
         t0 = float(plan[first])
         scheme = recorded.get("scheme") if scheme is None else scheme
         backend = recorded.get("backend") if backend is None else backend
@@ -154,58 +151,56 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         atol = recorded.get("atol") if atol is None else atol
         if not backend_options and backend == recorded.get("backend"):  # (another backend: its own)
             backend_options = recorded.get("backend_options") or {}
-    run_args = check_run(model, initial=INITIAL[0] if initial is None else initial, t0=t0,
-                         scheme=DEFAULT_SCHEME if scheme is None else scheme,
-                         backend=DEFAULT_BACKEND if backend is None else backend, rtol=rtol,
-                         atol=atol, progress=progress, max_wall_time=max_wall_time,
-                         backend_options=backend_options)
-    t0, run, backend, backend_options = run_args.t0, run_args.run, run_args.backend, run_args.backend_options
-    rtol, atol, max_wall_time = run_args.rtol, run_args.atol, run_args.max_wall_time
+    args = check_run(initial=INITIAL[0] if initial is None else initial, t0=t0,
+                     scheme=DEFAULT_SCHEME if scheme is None else scheme,
+                     backend=DEFAULT_BACKEND if backend is None else backend, rtol=rtol, atol=atol,
+                     progress=progress, max_wall_time=max_wall_time, backend_options=backend_options)
     t_end = _checks.positive("t_end", t_end, " s")
-    if t_end <= t0:
-        raise ParameterError(f"`t_end` must be after the start t0 = {t0!r} s, got {t_end!r} s")
+    if t_end <= args.t0:
+        raise ParameterError(f"`t_end` must be after the start t0 = {args.t0!r} s, got {t_end!r} s")
     output_dt = _checks.positive("output_dt", OUTPUT_DT if output_dt is None else output_dt, " s")
-    size = run_args.layout.size
+    system = SemiDiscrete(model, args.scheme)  # the one system of this run (no compiling): all below reads it
+    if recorded:
+        _settings.check_grid(recorded, system, _where(sink))
+    args = fit(args, system)
     if plan is None:
-        t_out = options.output_times(t0, t_end, output_dt, output_times, size)
+        t_out = options.output_times(args.t0, t_end, output_dt, output_times, system.size)
     else:  # the run's own output times, from where it stopped
         if t_end != plan[-1]:
             raise ParameterError(f"`t_end` = {t_end!r} s: the run being resumed ends at {float(plan[-1])!r} s")
-        _check_plan(plan, asked_plan, t_end, size, sink)
+        _check_plan(plan, asked_plan, t_end, system.size, sink)
         t_out = plan
-    if not resume:  # after every check: with `overwrite`, making the sink clears the earlier run
-        sink = _sink(out, resume, overwrite)
-    settings = _settings.record(model, scheme=run_args.scheme.name, backend=backend, rtol=rtol,
-                                atol=atol, backend_options=backend_options,  # None: the default
-                                initial=(recorded.get("initial") or "unknown") if resume and initial is None
-                                else run_args.initial)
+    settings = _settings.record(system, backend=args.backend, rtol=args.rtol, atol=args.asked_atol,
+                                backend_options=args.backend_options,  # asked_atol None: the default
+                                initial=(recorded.get("initial") or "unknown") if resume and asked_initial is None
+                                else args.initial)
     forced = _settings.check(recorded, settings, resume == "force", _where(sink)) if recorded else []
     if resume:
-        run_args = replace(run_args, initial=kept)
+        args = replace(args, initial=kept)
+    else:  # after every check: with `overwrite`, making the sink clears the earlier run
+        sink = _sink(out, resume, overwrite)
     getattr(sink, "record_settings", lambda settings, forced: None)(settings, forced)
-    progress = run_args.progress
-    owned = progress is True
-    if owned:
+    progress = args.progress
+    if progress is True:
         from ._progress import Progress
 
         progress = Progress()
-    system, y0, timings, run_args = prepare_run(model, run_args, progress, sink)
-    atol = run_args.atol
-
-    solver = dict(rtol=rtol, atol=atol, progress=progress, max_wall_time=max_wall_time, **backend_options)
     try:
+        y0, timings = prepare_run(system, args, progress, sink)
+        solver = dict(rtol=args.rtol, atol=args.atol, progress=progress, max_wall_time=args.max_wall_time,
+                      **args.backend_options)
         if sink is None:
-            raw = keep_before_failure(run, system, y0, t_out, **solver)
+            raw = keep_before_failure(args.run, system, y0, t_out, **solver)
             success, message, stats, error = raw.success, raw.message, raw.stats, raw.error
         else:  # in chunks into the sink, whose Result it is
-            success, message, stats, error = run_chunked(run, system, y0, t_out, sink, first, **solver)
-            stats.update(timings, backend=backend)
+            success, message, stats, error = run_chunked(args.run, system, y0, t_out, sink, first, **solver)
+            stats.update(timings, backend=args.backend)
             result = sink.end(success, message, stats)
     finally:
-        if owned:
+        if args.progress is True:
             progress.close()
     if sink is None:
-        stats.update(timings, backend=backend)
+        stats.update(timings, backend=args.backend)
         result = from_states(system, raw.t, raw.y, success, message, stats)
     result.error = error
     if not success:
@@ -216,31 +211,38 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
 @dataclass(frozen=True)
 class RunArguments:
     """The checked arguments a run of :func:`simulate` shares with the stepping
-    simulator (:class:`rodmol.control.Simulator`); see :func:`check_run`."""
+    simulator (:class:`rodmol.control.Simulator`): :func:`check_run` checks what
+    needs no system, :func:`fit` sizes ``initial`` and ``atol`` by the system's layout."""
 
-    initial: object  # "equilibrium", "straight" or a checked state vector
+    initial: object  # "equilibrium", "straight", a Result or a state vector (checked by fit)
     t0: float
     scheme: object
     rtol: float
-    atol: np.ndarray  # None: the default, the system's atol_scale() times rtol (prepare_run)
+    atol: object  # as given (None: the default); an array of the state's size after fit
     progress: object  # None, True or a callable
     max_wall_time: float | None
     backend: str
     run: object
     backend_options: dict
-    layout: StateLayout  # the state's, which sized ``initial`` and ``atol`` before the system exists
+    asked_atol: object = None  # after fit: the checked array the call gave, or None for the default
 
 
-def check_run(model, *, initial, t0, scheme, backend, rtol, atol, progress, max_wall_time,
-              backend_options):
-    """Check the arguments every run takes (see :func:`simulate`), before any work;
-    an ``initial`` Result gives its last state and, unless ``t0`` is given, its last time.
-    Building the system is work: the state's size comes from its layout, built once here."""
+def check_model(model):
+    """Refuse anything but a :class:`rodmol.Model` (a System is dispatched before)."""
     if not isinstance(model, Model):
-        raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
+        raise ParameterError(f"`model` must be a rodmol.Model or rodmol.System, got {model!r}")
+
+
+def check_run(*, initial, t0, scheme, backend, rtol, atol, progress, max_wall_time, backend_options):
+    """Check the arguments every run takes (see :func:`simulate`) that need no system, before
+    any work; an ``initial`` Result gives, unless ``t0`` is given, its last time. The
+    state-sized ones (``initial``, ``atol``) are checked by :func:`fit` against the system."""
     if isinstance(initial, Result):
         t0 = float(initial.t[-1]) if t0 is None else t0
-        initial = _last_state(initial, model)
+    elif isinstance(initial, str) and initial not in INITIAL:
+        raise ParameterError(f"unknown `initial` {_checks.short(initial)}"
+                             f"{_checks.did_you_mean(initial, INITIAL)}; use 'equilibrium', "
+                             "'straight' or a state")
     t0 = 0.0 if t0 is None else _checks.non_negative("t0", t0, " s")
     scheme = get_scheme(scheme)
     rtol = options.rtol(scheme.default_rtol if rtol is None else rtol)
@@ -248,30 +250,30 @@ def check_run(model, *, initial, t0, scheme, backend, rtol, atol, progress, max_
     max_wall_time = options.max_wall_time(max_wall_time)
     run = get_backend(backend)
     backend_options = options.backend_options(backend, run, backend_options)
-    layout = StateLayout(model.n_elements)
-    if isinstance(initial, str):
-        if initial not in INITIAL:
-            raise ParameterError(f"unknown `initial` {_checks.short(initial)}"
-                                 f"{_checks.did_you_mean(initial, INITIAL)}; use 'equilibrium', "
-                                 "'straight' or a state")
-    else:
-        initial = _state_sized("initial", initial, layout.size, layout=layout)
-    if atol is not None:
-        atol = _state_sized("atol", atol, layout.size, positive=True, layout=layout)
     return RunArguments(initial, t0, scheme, rtol, atol, progress, max_wall_time, backend, run,
-                        backend_options, layout)
+                        backend_options)
 
 
-def prepare_run(model, args, progress, sink=None):
-    """The one system of ``model``, its compiled kernels made ready, and the initial state, each
-    stage announced through ``progress``: returns (system, y0, timings [s], args), the
-    default ``atol`` of ``args`` taken from the system (:meth:`SemiDiscrete.atol_scale`)."""
+def fit(args, system):
+    """``args`` with ``initial`` and ``atol`` checked against the state of ``system`` (its
+    layout): an ``initial`` Result gives its last state, ``atol=None`` the system's
+    :meth:`~rodmol.discretise.system.SemiDiscrete.atol_scale` times ``rtol``."""
+    layout, initial = system.layout, args.initial
+    if isinstance(initial, Result):
+        initial = _last_state(initial, system)
+    if not isinstance(initial, str):
+        initial = _state_sized("initial", initial, layout)
+    atol = None if args.atol is None else _state_sized("atol", args.atol, layout, positive=True)
+    return replace(args, initial=initial, asked_atol=atol,
+                   atol=args.rtol * system.atol_scale() if atol is None else atol)
+
+
+def prepare_run(system, args, progress, sink=None):
+    """The compiled kernels of ``system`` made ready and the initial state, each stage
+    announced through ``progress``: returns (y0, timings [s])."""
     timings = {}
     with _stage(progress, "preparing the compiled kernels", timings, "prepare_s",
                 kernels.ready(args.run, args.backend_options)):
-        system = SemiDiscrete(model, args.scheme)  # the one system of this run
-        if args.atol is None:
-            args = replace(args, atol=args.rtol * system.atol_scale())
         check_scales(system, args.t0, args.atol)  # before the kernels' first run, which would fail on them
         kernels.prepare(system, args.t0, system.undeformed_state(), args.run, args.rtol, args.atol,
                         args.backend_options)
@@ -280,7 +282,7 @@ def prepare_run(model, args, progress, sink=None):
     with _stage(progress, f"solving the initial equilibrium at t = {args.t0:g} s", timings, "equilibrium_s",
                 not (isinstance(initial, str) and initial == "equilibrium")):
         y0 = _initial_state(system, initial, args.t0)
-    return system, y0, timings, args
+    return y0, timings
 
 
 @contextmanager
@@ -332,13 +334,14 @@ def _check_plan(plan, asked, t_end, size, sink):
                              "continue on the run's)")
 
 
-def _last_state(result, model):
+def _last_state(result, system):
     states = getattr(result, "states", None)
     if states is None or len(states) == 0:
         raise ParameterError("`initial`: this Result holds no states (written by an older rodmol?)")
-    if result.meta.get("n_elements") not in (None, model.n_elements):
+    n = system.layout.n_blocks
+    if result.meta.get("n_elements") not in (None, n):
         raise ParameterError(f"`initial`: the Result has N = {result.meta['n_elements']} elements, "
-                             f"the model {model.n_elements}")
+                             f"the model {n}")
     return states[-1]
 
 
@@ -348,16 +351,17 @@ def _initial_state(system, initial, t0):
             return equilibrium(system, t0)
         if initial == "straight":  # the rest shape: straight unless the rod has rest strains
             return system.undeformed_state()
-    y0 = np.array(initial, dtype=float)  # sized by check_run, or the resumed run's own state
+    y0 = np.array(initial, dtype=float)  # sized by fit, or the resumed run's own state
     problem = state_problem(system.layout, system.model.ds, t0, y0)
     if problem:
         raise ParameterError(f"`initial` is not a state of this rod: {problem}")
     return y0
 
 
-def _state_sized(name, value, size, positive=False, layout=None):
-    """A finite float array of length ``size`` (a scalar is broadcast if ``positive``);
-    the error names the first bad entry, which numpy's summarised repr would hide."""
+def _state_sized(name, value, layout, positive=False):
+    """A finite float array of the state's size (``layout``'s; a scalar is broadcast if
+    ``positive``); the error names the first bad entry, which numpy's summarised repr would hide."""
+    size = layout.size
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError, OverflowError):
@@ -372,6 +376,6 @@ def _state_sized(name, value, size, positive=False, layout=None):
     if np.any(bad):
         i = int(np.flatnonzero(bad)[0])
         need = "finite and > 0" if positive else "finite"
-        where = f" ({layout.entry_name(i)})" if layout is not None else ""
-        raise ParameterError(f"`{name}` entries must be {need}, got {float(arr[i])!r} at entry {i}{where}")
+        raise ParameterError(f"`{name}` entries must be {need}, got {float(arr[i])!r} at entry {i} "
+                             f"({layout.entry_name(i)})")
     return arr.copy()

@@ -167,9 +167,9 @@ def initial_state(model, t=0.0, system=None):
     (1e-10 of the load scale) is below the round-off floor of a fine grid,
     retry at 1e-9."""
     try:
-        return rodmol.equilibrium(model, t, system=system)
+        return rodmol.equilibrium(model if system is None else system, t)
     except rodmol.EquilibriumError:
-        return rodmol.equilibrium(model, t, tol=1e-9, system=system)
+        return rodmol.equilibrium(model if system is None else system, t, tol=1e-9)
 
 
 def outputs(t_end, dt=0.01):

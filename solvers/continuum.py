@@ -276,7 +276,7 @@ def discrete_positions(model, t, scheme):
     from rodmol.solve.equilibrium import equilibrium
 
     system = SemiDiscrete(model, scheme)
-    y = equilibrium(model, t, system=system)
+    y = equilibrium(system, t)
     return from_states(system, np.array([t]), y[None], True, "", {}).positions[0]
 
 

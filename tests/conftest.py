@@ -71,7 +71,8 @@ def observed_orders():
 
 
 class ChecksPassed(Exception):
-    """Raised where ``rodmol.simulate`` would start its work (building the system)."""
+    """Raised where ``rodmol.simulate`` would start its work (compiling, the kernels, the
+    initial equilibrium): building the system is no work, it sizes the state-sized checks."""
 
 
 @pytest.fixture
@@ -82,7 +83,7 @@ def checks_only(monkeypatch):
     def stop(*args, **kwargs):
         raise ChecksPassed
 
-    monkeypatch.setattr(sys.modules["rodmol.simulate"], "SemiDiscrete", stop)
+    monkeypatch.setattr(sys.modules["rodmol.simulate"], "prepare_run", stop)
     return ChecksPassed
 
 

@@ -30,7 +30,7 @@ SCHEMES = [("upwind", 1), ("centred", 2)]
 def static_result(model, scheme="centred"):
     """The equilibrium of ``model`` as a one-frame Result."""
     system = SemiDiscrete(model, scheme)
-    y = rodmol.equilibrium(model, system=system)
+    y = rodmol.equilibrium(system)
     return from_states(system, np.array([0.0]), y[None], True, "", {})
 
 

@@ -1,8 +1,13 @@
 """simulate builds one system and takes its sizes and default tolerances from it."""
 
+import subprocess
+import sys
+
 import numpy as np
+import pytest
 
 import rodmol
+from rodmol.discretise.layout import BLOCK, FIELDS, HEADER
 from rodmol.discretise.system import SemiDiscrete
 
 
@@ -22,3 +27,57 @@ def test_default_atol_is_the_systems_scale_times_rtol_and_simulates_as_the_defau
     given = rodmol.simulate(model, 0.02, rtol=1e-5, atol=rodmol.default_atol(model, 1e-5))
     np.testing.assert_array_equal(by_default.states, given.states)
     assert by_default.stats["steps"] == given.stats["steps"]
+
+
+def test_simulate_builds_one_system_and_hands_it_on(monkeypatch):
+    model = rodmol.scenarios.get("bending").model(6)
+    rodmol.simulate(model, 0.01)  # the kernels made ready: the run below builds only its own
+    built, seen = [], []
+    module = sys.modules["rodmol.simulate"]
+    init, solve = SemiDiscrete.__init__, module.equilibrium
+
+    def counting(self, *args, **kwargs):
+        built.append(self)
+        init(self, *args, **kwargs)
+
+    def spying(system, t):
+        seen.append(system)
+        return solve(system, t)
+
+    monkeypatch.setattr(SemiDiscrete, "__init__", counting)
+    monkeypatch.setattr(module, "equilibrium", spying)
+    result = rodmol.simulate(model, 0.02)
+    assert result.success and len(built) == 1 and seen == built
+
+
+def test_a_state_sized_argument_is_sized_by_the_systems_layout():
+    model = rodmol.scenarios.get("bending").model(6)
+    size = SemiDiscrete(model).size
+    with pytest.raises(rodmol.ParameterError, match=rf"`atol` must have length {size} \(the state size\)"):
+        rodmol.simulate(model, 0.01, atol=np.ones(size + 1))
+    bad = np.ones(size)
+    index = HEADER + BLOCK * 2 + FIELDS["q"].start
+    bad[index] = -1.0
+    with pytest.raises(rodmol.ParameterError, match=rf"-1.0 at entry {index} \(q\[0\] of element 2\)"):
+        rodmol.simulate(model, 0.01, atol=bad)
+
+
+@pytest.mark.subprocess
+def test_a_state_sized_argument_is_refused_before_compiling_and_a_system_compiles_when_first_evaluated():
+    """Building the system compiles nothing, so simulate checks ``atol`` against it before
+    any work; its first evaluation waits for the compiler (a fresh process sees both)."""
+    code = ("import rodmol\n"
+            "from rodmol.discretise import physics\n"
+            "model = rodmol.scenarios.get('bending').model(6)\n"
+            "try:\n"
+            "    rodmol.simulate(model, 1.0, atol=[1.0, 2.0])\n"
+            "except rodmol.ParameterError as error:\n"
+            "    print('refused' if 'atol' in str(error) else error)\n"
+            "print(len(physics._UNCOMPILED))\n"
+            "system = rodmol.SemiDiscrete(model)\n"
+            "print(len(physics._UNCOMPILED))\n"
+            "system(0.0, rodmol.straight_state(model))\n"
+            "print(len(physics._UNCOMPILED))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, check=False)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.split() == ["refused", "1", "1", "0"]

@@ -102,7 +102,7 @@ def robot():
 def test_statics_match_the_continuum_and_explain_tills_number(robot):
     system = rodmol.SemiDiscrete(robot)
     for t, z in ((0.0, 0.0), (10.0, HELD_Z)):
-        y = rodmol.equilibrium(robot, t, system=system)
+        y = rodmol.equilibrium(system, t)
         tip = system.state_view(t, y).tip
         exact, tension = reference_tip(z)
         print(f"\nz = {1e3 * z:.2f} mm: rodmol N=50 tip {tip[:2]}, T = {system.tensions(t, y)[0]:.5f} N; "

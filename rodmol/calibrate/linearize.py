@@ -62,12 +62,12 @@ def linearize(model, state, t=0.0, scheme=DEFAULT_SCHEME):
     """
     if not isinstance(model, Model):
         raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
+    probe = SemiDiscrete(model, scheme)
     if isinstance(state, str) and state == "equilibrium":
         from ..solve.equilibrium import equilibrium
 
-        state = equilibrium(model, t, scheme=scheme)
+        state = equilibrium(probe, t)
     y = np.asarray(state, dtype=float)
-    probe = SemiDiscrete(model, scheme)
     layout_size = probe.size
     if y.shape != (layout_size,) or not np.all(np.isfinite(y)):
         raise ParameterError(f"`state` must be {layout_size} finite numbers (the state size), got shape {y.shape}")

@@ -15,7 +15,7 @@ from ..discretise.schemes import DEFAULT_SCHEME
 from ..discretise.system import SemiDiscrete
 from ..errors import IntegrationError, ParameterError
 from ..result import from_states
-from ..simulate import _sink, check_run, prepare_run
+from ..simulate import _sink, check_model, check_run, fit, prepare_run
 from ..solve.stepping import Stepper
 from .held import HeldInputs
 
@@ -86,21 +86,23 @@ class Simulator:
         if backend != "cvode":
             raise ParameterError(f"`backend` {_checks.short(backend)}: the Simulator keeps CVODE alive "
                                  "between steps and has no other backend")
-        args = check_run(model, initial=initial, t0=t0, scheme=scheme, backend=backend, rtol=rtol,
-                         atol=atol, progress=progress, max_wall_time=max_wall_time,
-                         backend_options=backend_options)
+        check_model(model)
+        args = check_run(initial=initial, t0=t0, scheme=scheme, backend=backend, rtol=rtol, atol=atol,
+                         progress=progress, max_wall_time=max_wall_time, backend_options=backend_options)
         self._inputs = HeldInputs.of(model)
         self._row = self._inputs.initial_row(args.t0)
         live, self._held = self._inputs.live(self._row)
-        self._sink = _sink(out, False, overwrite)
         self.max_wall_time, self._scheme = args.max_wall_time, args.scheme
+        self._system = SemiDiscrete(live, args.scheme)
+        args = fit(args, self._system)
+        self._sink = _sink(out, False, overwrite)  # after every check: `overwrite` clears the earlier run
         announce = args.progress
         if announce is True:
             from .._progress import Progress
 
             announce = Progress()
         try:
-            self._system, y0, self._timings, args = prepare_run(live, args, announce, self._sink)
+            y0, self._timings = prepare_run(self._system, args, announce, self._sink)
         finally:
             if args.progress is True:
                 announce.close()

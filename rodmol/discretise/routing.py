@@ -33,9 +33,9 @@ class CableRouting:
     def __init__(self, model, s_cells):
         n, cables = model.n_elements, model.cables
         self.ds, self.n = model.ds, n
+        self.weights = np.array(cable_weights(model), dtype=float).reshape(len(cables), n)
         self.geometry = np.array([cell_geometry(c.offset, model.s_nodes, s_cells, c.name)
                                   for c in cables]).reshape(len(cables), n, 6)
-        self.weights = np.array(cable_weights(model), dtype=float).reshape(len(cables), n)
         self.friction = np.array([c.friction for c in cables])
         self.slip_speed = np.array([c.slip_speed for c in cables])
         self.index = {c.name: i for i, c in enumerate(cables)}

@@ -163,9 +163,9 @@ class SemiDiscrete:
     """
 
     def __init__(self, model, scheme=DEFAULT_SCHEME):
-        compile_signatures()  # the first system of a process waits for the compiler
         self.model = model
         self.scheme = get_scheme(scheme)
+        self.lightly_damped = grid_damping_ratio(model) < 1.0
         self.layout = StateLayout(model.n_elements)
         self.size = self.layout.size
         # Feedback and displacement-controlled tensions and friction read the whole state.
@@ -173,12 +173,11 @@ class SemiDiscrete:
         self.global_coupling = model.feedback or self._friction
         m = model
         s_cells = self.scheme.cell_points(m.s_nodes)
+        self.node_lengths = self.scheme.node_lengths(m.n_elements, m.ds)
         self.sampled = sampled = Sampled(m)
         self.cells = cell_properties(m, s_cells)
         #: The rest strains (q*, k*) of the cells, each (N, 3), local frame [-, 1/m].
         self.rest = rest_strains(m, s_cells)
-        self.node_lengths = self.scheme.node_lengths(m.n_elements, m.ds)
-        self.lightly_damped = grid_damping_ratio(m) < 1.0
         self._params = stencil.pack_params(*self.cells, sampled.mass, sampled.inertia, sampled.net_mass,
                                            sampled.drag_coefficient, sampled.added, *self.rest)
         self._consts = np.zeros(stencil.N_CONSTS)
@@ -314,7 +313,11 @@ class SemiDiscrete:
 
     def kernel_arguments(self):
         """Arguments of :func:`rodmol.discretise.stencil.rhs` after (y, out):
-        the packed model, the inputs :meth:`update_inputs` refreshes, scratch."""
+        the packed model, the inputs :meth:`update_inputs` refreshes, scratch.
+        The first call of a process waits for the compiler (or its disk cache):
+        building a system compiles nothing, so arguments are checked against it
+        first (``rodmol.simulate``)."""
+        compile_signatures()
         return self._args
 
     def undeformed_state(self):
@@ -329,7 +332,7 @@ class SemiDiscrete:
             out = np.empty(self.size)
         if self._inputs_vary:
             self.update_inputs(t, y)
-        stencil.rhs(y, out, *self._args)
+        stencil.rhs(y, out, *self.kernel_arguments())
         return out
 
     def rest_rates(self, t, y, out, load_factor=1.0, tensions=None, held_factor=None):
@@ -347,7 +350,7 @@ class SemiDiscrete:
         if held_factor is not None:  # a hold's value is its held displacement
             self.entry_values[self._hold_entries] = saved[2][self._hold_entries] * held_factor
         try:
-            stencil.rhs(y, out, *self._args)
+            stencil.rhs(y, out, *self.kernel_arguments())
         finally:
             for inputs, value in zip(scaled, saved):
                 inputs[:] = value

@@ -13,6 +13,8 @@ the compiled Jacobian of the dynamics takes them), and it is factorised with
 ``scipy.linalg.solve_banded``: the cost grows linearly with N.
 """
 
+import weakref
+
 import numpy as np
 from scipy.linalg import solve_banded
 
@@ -20,7 +22,7 @@ from ..discretise import centreline, external, rotations
 from ..discretise.jacobian import BandedDifferences
 from ..discretise.layout import BlockLayout
 from ..discretise.load_entries import load_scale
-from ..discretise.schemes import DEFAULT_SCHEME
+from ..discretise.schemes import DEFAULT_SCHEME, get_scheme
 from ..discretise.system import SemiDiscrete
 from ..errors import EquilibriumError, ParameterError
 from ..loads import P_STIFFNESS
@@ -44,7 +46,7 @@ def static_dependencies(depends):
     return {**_COMPATIBILITY, "q": at_rest("v"), "k": at_rest("w")}
 
 
-def equilibrium(model, t=0.0, *, scheme=DEFAULT_SCHEME, tol=1e-10, max_iter=40, system=None):
+def equilibrium(model, t=0.0, *, scheme=None, tol=1e-10, max_iter=40):
     """Static equilibrium of ``model`` under its loads at time ``t``.
 
     Gravity, buoyancy, the cable tensions and the external loads at ``t`` are
@@ -56,20 +58,20 @@ def equilibrium(model, t=0.0, *, scheme=DEFAULT_SCHEME, tol=1e-10, max_iter=40, 
     ----------
     model : Model or SemiDiscrete
         The model, or its system if one is built already (``simulate`` passes
-        its own): then the system's scheme is used.
+        its own; a loop over many equilibria of one model saves the build and
+        the Jacobian's structure, kept per system).
     t : float
         Time [s] at which the time-dependent inputs are evaluated.
-    scheme : str
+    scheme : str, optional
         The spatial scheme (``rodmol.SCHEMES``) whose rest state is sought: a
-        state at rest for one scheme is not at rest for the other.
+        state at rest for one scheme is not at rest for the other. Default:
+        ``"centred"`` for a Model, the system's own for a system (another
+        one is refused).
     tol : float
         Required max-norm of the force and torque residuals, relative to the
         load scale (:func:`rodmol.discretise.load_entries.load_scale`);
         raised to the round-off floor of the difference quotients on very
         fine grids.
-    system : SemiDiscrete, optional
-        The model's system, if one is built already (``simulate`` passes its
-        own); it overrides ``scheme``.
 
     Returns
     -------
@@ -87,14 +89,18 @@ def equilibrium(model, t=0.0, *, scheme=DEFAULT_SCHEME, tol=1e-10, max_iter=40, 
         If no equilibrium is found (e.g. a buckling load), or the one found
         has degenerate elements (see :mod:`rodmol.solve.watch`).
     """
-    if isinstance(model, SemiDiscrete):  # a system built already (simulate's): its model and scheme
-        model, system = model.model, model
-    if not isinstance(model, Model):
-        raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
-    system = SemiDiscrete(model, scheme) if system is None else system
-    solve = _closed_loop if model.feedback else _rest_state
+    if isinstance(model, SemiDiscrete):  # a system built already (simulate's): its scheme
+        system = model
+        if scheme is not None and get_scheme(scheme) != system.scheme:
+            raise ParameterError(f"`scheme` {scheme!r}: the system given is built with the "
+                                 f"{system.scheme.name!r} scheme (leave `scheme` out, or pass the model)")
+    elif isinstance(model, Model):
+        system = SemiDiscrete(model, DEFAULT_SCHEME if scheme is None else scheme)
+    else:
+        raise ParameterError(f"`model` must be a rodmol.Model or its SemiDiscrete, got {model!r}")
+    solve = _closed_loop if system.model.feedback else _rest_state
     y = solve(system, t, tol, max_iter)
-    problem = state_problem(system.layout, model.ds, t, y)
+    problem = state_problem(system.layout, system.model.ds, t, y)
     if problem:
         raise EquilibriumError(f"the static equilibrium is not a valid state of the rod: {problem}")
     return y
@@ -156,6 +162,20 @@ def _closed_loop(system, t, tol, max_iter, max_rounds=30):
                            "(the law and the arm have no common rest state, or it is unstable)")
 
 
+#: The static layout and banded differences of each system, built at its first equilibrium:
+#: a loop of equilibria (inverse statics, the closed loop) reuses them.
+_STRUCTURES = weakref.WeakKeyDictionary()
+
+
+def _structure(system):
+    """(static ``BlockLayout``, its ``BandedDifferences``) of ``system``, built once."""
+    found = _STRUCTURES.get(system)
+    if found is None:
+        static = BlockLayout(system.layout.n_blocks, dict(STATIC_FIELDS))
+        found = _STRUCTURES[system] = static, BandedDifferences(static, static_dependencies(system.depends))
+    return found
+
+
 class RestEquations:
     """The rest equations R(z; T) = 0 of ``system`` at time t, in the static
     unknowns z (the u, Q, q, k blocks of the state).
@@ -177,8 +197,7 @@ class RestEquations:
         model = system.model
         self.system, self.t, self.tensions = system, t, tensions
         self.layout = system.layout
-        self.static = BlockLayout(model.n_elements, dict(STATIC_FIELDS))
-        self.differences = BandedDifferences(self.static, static_dependencies(system.depends))
+        self.static, self.differences = _structure(system)
         self.bands = self.differences.bands
         base = model.base
         self._quat0 = rotations.from_matrix(base.rotation)

@@ -310,7 +310,7 @@ def test_banded_differences_equal_one_column_at_a_time(scheme):
     model = rodmol.scenarios.get("reaching").model(N)
     system = SemiDiscrete(model, scheme)
     equations = RestEquations(system, 3.0)
-    y = rodmol.equilibrium(model, 3.0, system=system)
+    y = rodmol.equilibrium(system, 3.0)
     z = equations.unknowns(y) + 1e-3 * np.random.default_rng(1).standard_normal(equations.unknowns(y).size)
     f0, h = equations.residual(z), 1.5e-8 * np.maximum(np.abs(z), 1.0)
     dense = np.empty((z.size, z.size))

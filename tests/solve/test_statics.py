@@ -20,6 +20,7 @@ from scipy.integrate import solve_bvp
 import rodmol
 from rodmol.discretise.load_entries import load_scale
 from rodmol.discretise.sampling import Sampled
+from rodmol.solve.equilibrium import RestEquations
 
 # Table I of the paper (the same numbers rodmol.arm.paper_rod() uses; restated
 # here so that the reference does not read them from rodmol).
@@ -190,3 +191,15 @@ def test_equilibrium_is_rest_state(medium):
           f"max |torque| / W = {np.max(np.abs(torque)) / weight:.2e}")
     assert np.max(np.abs(force)) < 1e-8 * weight / L
     assert np.max(np.abs(torque)) < 1e-8 * weight
+
+
+def test_a_system_is_solved_with_its_own_scheme_and_keeps_its_structure():
+    model = rodmol.scenarios.get("fetching").model(8)
+    system = rodmol.SemiDiscrete(model, "upwind")
+    with pytest.raises(rodmol.ParameterError, match=r"`scheme` 'centred': the system given is built with the 'upwind'"):
+        rodmol.equilibrium(system, scheme="centred")
+    np.testing.assert_array_equal(rodmol.equilibrium(system, scheme="upwind"), rodmol.equilibrium(system))
+    # The static layout and the column groups are built once per system, whatever t and tensions.
+    first, later = RestEquations(system, 0.0), RestEquations(system, 1.0, np.ones(len(model.cables)))
+    assert first.static is later.static and first.differences is later.differences
+    assert RestEquations(rodmol.SemiDiscrete(model, "upwind"), 0.0).differences is not first.differences
