@@ -9,12 +9,14 @@ import re
 from .. import _checks, scenarios
 from ..arm import LENGTH as PAPER_LENGTH
 from ..arm import paper_arm
+from ..discretise.layout import StateLayout
 from ..discretise.schemes import DEFAULT_SCHEME, get_scheme
+from ..discretise.system import SemiDiscrete
 from ..errors import ParameterError
 from ..model import Model
 from ..output.options import OutputOptions
 from ..run_spec import RunSpec
-from ..simulate import DEFAULT_BACKEND, INITIAL, OUTPUT_DT, check_run
+from ..simulate import DEFAULT_BACKEND, INITIAL, OUTPUT_DT, check_run, fit
 from ..solve import options as run_options
 from . import arm as arm_tables
 from . import tables
@@ -162,9 +164,11 @@ def _check_solver(ctx, solver, t_end, n_elements):
         stand_in, sized = paper_arm(n_elements), True
     except ParameterError:
         stand_in, sized = paper_arm(2), False
-    run = ctx.construct(path, lambda **kw: check_run(stand_in, t0=None, scheme=scheme, progress=None,
-                                                    backend_options={}, **{"max_wall_time": None, **kw}),
-                        options, given=table, keys=tuple(options))
+    def checked(**kw):  # the arguments alone, then those the stand-in's state sizes
+        args = check_run(t0=None, scheme=scheme, progress=None, backend_options={}, **{"max_wall_time": None, **kw})
+        return fit(args, SemiDiscrete(stand_in, args.scheme))
+
+    run = ctx.construct(path, checked, options, given=table, keys=tuple(options))
     if t_end is None or t_end is FAILED:
         return FAILED  # (recorded)
     t_end = ctx.read({"t_end": t_end}, path, "t_end", lambda v: _checks.positive("t_end", v, " s"))
@@ -172,7 +176,7 @@ def _check_solver(ctx, solver, t_end, n_elements):
     if failed(run, t_end, output_dt) or not sized:
         return FAILED if failed(run, t_end, output_dt) else run
     try:
-        run_options.output_count(t_end, output_dt, run.layout.size)
+        run_options.output_count(t_end, output_dt, StateLayout(stand_in.n_elements).size)
     except ParameterError as exc:
         # The message opens with t_end: its line, unless only output_dt was written here.
         ctx.add(path + (("output_dt",) if "output_dt" in table and "t_end" not in table else ("t_end",)),
