@@ -15,6 +15,9 @@ equations, used only to test these.
 import numba
 import numpy as np
 
+from . import kernel_cache
+
+kernel_cache.install()  # before any kernel is compiled or loaded
 #: Kernels with an explicit signature, compiled by :func:`compile_signatures`.
 _UNCOMPILED = []
 
