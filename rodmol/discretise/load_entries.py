@@ -167,8 +167,8 @@ def on_grid(loads, s_nodes, radius, rest=None):
 def of_model(model, scheme=DEFAULT_SCHEME):
     """The model's loads on its grid (holds read its rest shape on the cells of ``scheme``)."""
     held = any(load.spread == "node" for load in model.loads)
-    return on_grid(model.loads, model.s_nodes, model.rod.radius_at(model.s_nodes),
-                   rest_nodes(model, scheme) if held else None)
+    rest = rest_nodes(model, scheme) if held else None
+    return on_grid(model.loads, model.s_nodes, model.rod.radius_at(model.s_nodes), rest)
 
 
 def load_scale(model, t=0.0, tensions=None, grid=None):
