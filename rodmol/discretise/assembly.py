@@ -19,6 +19,14 @@ is then the same as between any two nodes of a rod. The rod's header (u0,
 Q0) integrates v0, w0 as for a single rod: it is not tied to the body's pose
 but drifts from it by the integration error only (``pose_drift``).
 
+Coupling (penalty joints, at any other node, loops allowed): the joint is
+the rod's hold (rodmol.Hold, one of its load entries), whose held point is
+the body's point x + R p with the orientation R Rj and the velocities
+R (v + w x p), R w (global), written into the hold's row before each call
+(:func:`rodmol.discretise.rigid.joint_wrench`). The body feels the hold's
+force and moment with the opposite sign, the force acting where the node
+is. A joint to the world is the rod's plain hold.
+
 Newton-Euler of a body about its origin, body frame, with the momentum
 P = m (v + w x c) and H = I_o w + m c x v of its own mass:
 M [v_t, w_t] = [F - w x P, T - w x H - v x P], where the 6x6 mass matrix M
@@ -29,9 +37,11 @@ wrenches, weight minus buoyancy at the centre of mass and quadratic drag.
 import numpy as np
 from scipy import sparse
 
-from .layout import BlockLayout
-from .physics import quaternion_rate
-from .rigid import clamp_wrench, free_body_rates, pack_body
+from ..errors import ParameterError
+from .layout import FIELDS, BlockLayout
+from .load_entries import count
+from .physics import quaternion_product, quaternion_rate
+from .rigid import clamp_wrench, free_body_rates, joint_wrench, pack_body
 from .rotations import from_matrix, matrices
 from .stencil import WORK_TOTAL
 from .system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE, SemiDiscrete, field_scales
@@ -74,6 +84,7 @@ class BodyPart:
         self.points, self.turns = np.zeros((0, 3)), np.zeros((0, 3, 3))
         self.shares = np.zeros(0)  # the base node's share of cell 0 [m] (Scheme.base_share ds)
         self.strains = np.zeros((0, 6), dtype=np.int64)  # state indices of (q, k) of each rod's cell 0
+        self.joints = []  # its penalty joints (JointPart)
 
     def clamp(self, name, sd, start, point, turn):
         """Hold the base of rod ``name`` (its system ``sd``, its state from ``start``)."""
@@ -91,6 +102,35 @@ class BodyPart:
     def base_velocities(self, v, w):
         """(n, 6) base velocities of the rods for the body velocities (v, w) (:func:`clamp_velocities`)."""
         return clamp_velocities(self.points, self.turns, v, w)
+
+
+class JointPart:
+    """A penalty joint between a rod node and a body: the rod's hold entry
+    (its parameter row and value, the kernel's arrays), the node's element
+    block in the state, the body point [m] and the section's held
+    orientation ``turn`` (quaternion, section to body frame)."""
+
+    def __init__(self, joint, sd, rod_start, part):
+        model = sd.model
+        hold = model.loads[joint.load]
+        entry = sum(count(load, model.s_nodes) for load in model.loads[:joint.load])
+        self.joint, self.sd, self.part, self.entry = joint, sd, part, entry
+        self.kind = int(sd.kernel_arguments()[6][entry])
+        self.row, self.value = sd.entry_params[entry], sd.entry_values[entry]
+        node = int(round(hold.s / model.ds))
+        self.node = rod_start + sd.layout.header + sd.layout.block * (node - 1)
+        self.point = np.asarray(joint.point, dtype=float)
+        q_b = from_matrix(part.body.rotation)
+        self.turn = np.array(quaternion_product((q_b[0], -q_b[1], -q_b[2], -q_b[3]), tuple(self.row[3:7])))
+        gap = float(np.linalg.norm(self.value))
+        if gap > 1e-6 * model.rod.length:
+            raise ParameterError(f"`{hold.name}` joins rod node s = {hold.s:g} m to body {part.name!r}, but the "
+                                 f"body point is {gap:.3g} m from where the node is at rest: place the body so "
+                                 "that they meet (its `position`, `rotation` or the joint's point)")
+
+    def wrench(self, y, body, row, value):
+        """Write the held point into ``row``, ``value`` and return the body's reaction (:func:`joint_wrench`)."""
+        return joint_wrench(self.kind, row, value, y, self.node, body, self.point, self.turn)
 
 
 class Assembly:
@@ -132,6 +172,12 @@ class Assembly:
             self.parts[name] = part.slice
             start = part.slice.stop
         self.size = start
+        self.joints = []
+        for joint in system.penalty_joints:
+            if joint.body is not None:
+                part = self.bodies[joint.body]
+                part.joints.append(JointPart(joint, self.rods[joint.rod], self.parts[joint.rod].start, part))
+                self.joints.append(part.joints[-1])
         self.free = [p for p in self.bodies.values() if p.body.free]
         self.lightly_damped = any(sd.lightly_damped for sd in self.rods.values())
         self._gravity = np.ascontiguousarray(system.gravity, dtype=float)
@@ -163,6 +209,12 @@ class Assembly:
             y[part.fields["Q"]] = from_matrix(part.body.rotation)
         return y
 
+    def body_state(self, part, t, y):
+        """A body's (x, Q, v, w) at (t, y) (13,): its pose and velocities (:meth:`body_velocities`)."""
+        if part.body.free:
+            return np.ascontiguousarray(y[part.slice])
+        return np.concatenate([y[part.slice], *self.body_velocities(part, t, y)])
+
     def body_velocities(self, part, t, y):
         """(v, w) of a body's origin at (t, y) [m/s, rad/s], body frame."""
         if part.body.free:
@@ -191,6 +243,8 @@ class Assembly:
         for part in self.free:  # the rods' base velocities first
             for sd, row in zip(part.systems, part.base_velocities(y[part.fields["v"]], y[part.fields["w"]])):
                 sd.base_velocities[:] = row
+        for joint in self.joints:  # and the held points of the penalty joints
+            joint.wrench(y, self.body_state(joint.part, t, y), joint.row, joint.value)
         for name, sd in self.rods.items():
             sl = self.parts[name]
             sd(t, y[sl], out[sl])
@@ -202,7 +256,15 @@ class Assembly:
         """The rates of body ``part``'s block at (t, y) into ``out`` (the whole
         state's rates), after the rods' rates at y (their cell 0's stress)."""
         if part.body.free:
-            force, torque = self.body_wrench(part, y) if part.rods else ((0.0,) * 3, (0.0,) * 3)
+            force, torque = self.body_wrench(part, y) if part.rods else (np.zeros(3), np.zeros(3))
+            if part.joints:
+                force, torque = np.array(force), np.array(torque)
+                body = np.ascontiguousarray(y[part.slice])
+                for joint in part.joints:  # on scratch rows: the rods' own rows stay as the last call set them
+                    f, m = joint.wrench(y, body, joint.row.copy(), joint.value.copy())
+                    force += f
+                    torque += m
+                force, torque = tuple(force), tuple(torque)
             free_body_rates(y[part.slice], part.params, part.rigid_mass, part.inverse_mass, self._gravity,
                             force, torque, DRAG_SMOOTHING_SPEED**2, QUATERNION_RESTORING_RATE, out[part.slice])
             return
@@ -235,6 +297,14 @@ class Assembly:
                 first = np.arange(start, start + sd.layout.header + sd.layout.block)
                 pat[np.ix_(first, velocity)] = True
                 pat[np.ix_(velocity, first)] = True
+        for joint in self.joints:
+            body = joint.part.slice
+            rows = joint.node + _block_entries("v", "w")
+            pat[np.ix_(rows, np.arange(body.start, body.stop))] = True
+            if joint.part.body.free:
+                node = joint.node + _block_entries("u", "Q", "v", "w")
+                velocity = np.r_[joint.part.fields["v"], joint.part.fields["w"]]
+                pat[np.ix_(velocity, node)] = True
         return pat.tocsc()
 
     def atol_scale(self):
@@ -273,6 +343,11 @@ class Assembly:
             linear += r @ momentum[:3]
             angular += _cross(y[part.fields["x"]], r @ momentum[:3]) + r @ momentum[3:]
         return linear, angular
+
+
+def _block_entries(*fields):
+    """Indices of ``fields`` within an element block."""
+    return np.concatenate([np.arange(FIELDS[f].start, FIELDS[f].stop) for f in fields])
 
 
 def _body_pattern(part):
