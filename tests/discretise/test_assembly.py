@@ -14,10 +14,18 @@ def _system():
     head = rodmol.RigidBody(0.05, (2e-5, 3e-5, 4e-5), centre_of_mass=(0.0, 0.004, 0.0), volume=2e-5,
                             drag=(1, 2, 3, 0.1, 0.2, 0.3), added_mass=(0.01, 0.02, 0.03, 0, 0, 0))
     plate = rodmol.RigidBody(0.5, (1e-3, 1e-3, 1e-3), motion="fixed", position=(1.0, 0.0, 0.0))
+    # Penalty joints: a's tip clamped to a free payload, b's tip pinned to a fixed post, c's middle pinned
+    # to the world: the loop head-a-payload closes through nothing, the loop plate-c-world through the world.
+    payload = rodmol.RigidBody(0.02, (1e-6, 2e-6, 3e-6), position=(0.21, 0.0, 0.0), centre_of_mass=(0.01, 0, 0))
+    post = rodmol.RigidBody(0.5, (1e-3, 1e-3, 1e-3), motion="fixed", position=(-0.22, 0.0, 0.0))
     joints = [rodmol.Joint(("head", (0.02, 0.0, 0.0)), ("a", "base")),
               rodmol.Joint(("head", (-0.02, 0.0, 0.0), np.diag([-1.0, -1.0, 1.0])), ("b", "base")),
-              rodmol.Joint(("plate", (0.0, 0.0, 0.0)), ("c", "base"))]
-    return rodmol.System({"a": arm, "b": arm, "c": arm}, {"head": head, "plate": plate}, joints,
+              rodmol.Joint(("plate", (0.0, 0.0, 0.0)), ("c", "base")),
+              rodmol.Joint(("payload", (0.01, 0.0, 0.0)), ("a", "tip")),
+              rodmol.Joint(("post", (0.0, 0.0, 0.0)), ("b", "tip"), kind="pin"),
+              rodmol.Joint("world", ("c", 0.1), kind="pin")]
+    return rodmol.System({"a": arm, "b": arm, "c": arm}, {"head": head, "plate": plate, "payload": payload,
+                                                           "post": post}, joints,
                          medium="water", gravity=(0.0, 0.0, -9.81))
 
 
@@ -25,9 +33,10 @@ def test_parts_tile_the_state_in_order():
     assembly = Assembly(_system())
     rod_size = assembly.rods["a"].size
     spans = [(s.start, s.stop) for s in assembly.parts.values()]
+    bodies = np.cumsum([3 * rod_size, 13, 7, 13, 7])
     assert spans == [(0, rod_size), (rod_size, 2 * rod_size), (2 * rod_size, 3 * rod_size),
-                     (3 * rod_size, 3 * rod_size + 13), (3 * rod_size + 13, 3 * rod_size + 20)]
-    assert assembly.size == 3 * rod_size + 20 == len(assembly.atol_scale())
+                     *zip(bodies[:-1], bodies[1:])]
+    assert assembly.size == bodies[-1] == len(assembly.atol_scale())
 
 
 def test_pattern_holds_every_nonzero_of_a_difference_jacobian():
@@ -51,3 +60,10 @@ def test_pattern_holds_every_nonzero_of_a_difference_jacobian():
     assert touched[first:first + 19, head["v"].start].any()  # the head carries the rod
     plate = assembly.bodies["plate"].fields
     assert not pattern[:, plate["x"]].any() and not pattern[plate["x"]].any()  # a fixed body stays
+    # The penalty joints: a's tip and the payload read each other; b's tip reads the post's pose.
+    payload, post = assembly.bodies["payload"].fields, assembly.bodies["post"].fields
+    tip_a = assembly.parts["a"].stop - assembly.rods["a"].layout.block
+    tip_b = assembly.parts["b"].stop - assembly.rods["b"].layout.block
+    assert touched[payload["v"].start:payload["w"].stop, tip_a:tip_a + 19].any()
+    assert touched[tip_a:tip_a + 19, payload["x"].start:payload["w"].stop].any()
+    assert touched[tip_b:tip_b + 19, post["x"].start:post["Q"].stop].any()
