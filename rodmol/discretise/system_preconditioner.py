@@ -6,9 +6,12 @@ Each rod gets its own exact block preconditioner
 velocities held at the state's; each body its block (I - gamma J_bb),
 inverted directly, J_bb by differences in the body's own entries: of the
 full right-hand side in its velocities (they move the rods' bases), of its
-own rates in its rotation, none in its position (no rate reads it). The joints' coupling blocks are left out: GMRES's
-products J v are differences of the full right-hand side, so it sees them,
-only converging in more iterations.
+own rates in its rotation and, if it has penalty joints (whose held points
+it moves), its position; no rate of a body without them reads its
+position. The joints' coupling blocks are left out: GMRES's products J v
+are differences of the full right-hand side, so it sees them, only
+converging in more iterations (many more for penalty joints: see
+:mod:`rodmol.solve.system_cvode`).
 """
 
 import numpy as np
@@ -47,10 +50,10 @@ class SystemPreconditioner:
                 jac, steps = self._jac[part.name], self._steps[part.name]
                 for j, index in enumerate(range(part.slice.start, part.slice.stop)):
                     field = self._field_of[part.name][j]
-                    if field == "x":  # no rate reads a body's position
+                    if field == "x" and not part.joints:  # no rate reads its position
                         continue
                     z[index] = y[index] + steps[j]
-                    if field == "Q":  # only the body's own rates read its rotation
+                    if field in ("x", "Q"):  # only the body's own rates (of the rods': off the block) read its pose
                         assembly.body_rates(part, t, z, self._out)
                     else:  # its velocities move the rods' bases
                         assembly(t, z, self._out)
