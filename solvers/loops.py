@@ -62,9 +62,9 @@ def robot(n, factor, joined=True):
     return rodmol.System(legs, {"platform": body}, joints, gravity=gravity)
 
 
-PROBLEMS = {  # name: (system(n, factor, joined), body, t_end per mode, N per mode)
-    "payload": (payload, "payload", (1.0, 0.5, 0.05), (16, 16, 6)),
-    "parallel robot": (robot, "platform", (1.5, 0.75, 0.05), (16, 16, 6)),
+PROBLEMS = {  # name: (system(n, factor, joined), t_end per mode, N per mode)
+    "payload": (payload, (1.0, 0.5, 0.05), (16, 16, 6)),
+    "parallel robot": (robot, (1.5, 0.75, 0.05), (16, 16, 6)),
 }
 
 
@@ -92,7 +92,7 @@ def main(argv=None):
     header = C.header_lines(args, SCRIPT)
     factors = C.pick(args, (1.0, 10.0, 100.0, 1e3, 1e4, 1e5), (1.0, 100.0, 1e4), (100.0,))
     rows = []
-    for name, (build, body, t_ends, sizes) in PROBLEMS.items():
+    for name, (build, t_ends, sizes) in PROBLEMS.items():
         t_end, n = C.pick(args, *t_ends), C.pick(args, *sizes)
         free = build(n, None, joined=False)
         rodmol.simulate(build(n, HOLD_STIFFNESS_FACTOR), t_end / 10)  # compile, warm
