@@ -299,10 +299,10 @@ class Assembly:
                 pat[np.ix_(velocity, first)] = True
         for joint in self.joints:
             body = joint.part.slice
-            rows = joint.node + _block_entries("v", "w")
+            rows = joint.node + block_entries("v", "w")
             pat[np.ix_(rows, np.arange(body.start, body.stop))] = True
             if joint.part.body.free:
-                node = joint.node + _block_entries("u", "Q", "v", "w")
+                node = joint.node + block_entries("u", "Q", "v", "w")
                 velocity = np.r_[joint.part.fields["v"], joint.part.fields["w"]]
                 pat[np.ix_(velocity, node)] = True
         return pat.tocsc()
@@ -345,7 +345,7 @@ class Assembly:
         return linear, angular
 
 
-def _block_entries(*fields):
+def block_entries(*fields):
     """Indices of ``fields`` within an element block."""
     return np.concatenate([np.arange(FIELDS[f].start, FIELDS[f].stop) for f in fields])
 
