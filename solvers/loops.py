@@ -7,13 +7,15 @@ Two systems whose loops close through penalty joints:
   straight under a small weight (0.5 m/s^2 sideways): it swings for 1 s;
 * ``parallel robot``: three legs (L = 0.2 m, r = 5 mm, E = 200 MPa, Kelvin-Voigt
   mu = 2 MPa s) clamped to the ground and, at their tips, to a free 0.5 kg
-  platform, released straight under gravity partly sideways; it settles in 1.5 s.
+  platform, released straight under gravity partly sideways; it settles in 1.5 s;
+* ``six legs``: the same with six legs (a Stewart-Gough layout, as in Till's
+  example) at a finer grid.
 
 For penalty stiffnesses k = factor E A / ds of the tip element (damping
 2 sqrt(k m), m = rho A ds, the Hold's default law), each system runs through
 ``rodmol.simulate`` (CVODE, default tolerances) with the sparse direct
-solver (the default for such systems) and, at the default factor, with GMRES
-and the block preconditioner. The table gives the drift |u - x - R p| of
+solver and with GMRES and the block preconditioner (the free bodies with
+penalty joints eliminated by their Schur complement). The table gives the drift |u - x - R p| of
 each joint (max over the run and at the end, relative to L), CVODE's
 right-hand sides and the solver's wall time, each also as a ratio to the same
 rods with free tips and no body (the joints' cost), measured in the same
@@ -29,7 +31,6 @@ from rodmol.holds import HOLD_STIFFNESS_FACTOR
 
 SCRIPT = "loops.py"
 UP = np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])  # a leg's x axis along global z
-LEGS = np.array([[0.05 * np.cos(a), 0.05 * np.sin(a), 0.0] for a in 2 * np.pi * np.arange(3) / 3 + 0.3])
 
 
 def _stiffness(model, factor):
@@ -47,24 +48,26 @@ def payload(n, factor, joined=True):
     return rodmol.System({"beam": beam}, {"payload": body}, [joint], gravity=(0.0, -0.5, 0.0))
 
 
-def robot(n, factor, joined=True):
+def robot(n, factor, joined=True, legs=3):
+    points = np.array([[0.05 * np.cos(a), 0.05 * np.sin(a), 0.0] for a in 2 * np.pi * np.arange(legs) / legs + 0.3])
     material = rodmol.Material(E=2e8, nu=0.5, mu=2e6, rho=1000.0)
     leg = rodmol.Rod(0.2, radius=0.005, material=material)
     legs = {f"leg{i}": rodmol.Model(leg, n, base=rodmol.BaseMotion(position=tuple(p), rotation=UP))
-            for i, p in enumerate(LEGS)}
+            for i, p in enumerate(points)}
     gravity = (-9.81, 0.0, -3.0)
     if not joined:
         return rodmol.System(legs, gravity=gravity)
     body = rodmol.RigidBody(0.5, (1e-3, 1e-3, 2e-3), centre_of_mass=(0.02, 0.01, 0.0), position=(0.0, 0.0, 0.2))
     stiffness = _stiffness(legs["leg0"], factor)
     joints = [rodmol.Joint(("platform", tuple(p)), (f"leg{i}", "tip"), stiffness=stiffness)
-              for i, p in enumerate(LEGS)]
+              for i, p in enumerate(points)]
     return rodmol.System(legs, {"platform": body}, joints, gravity=gravity)
 
 
 PROBLEMS = {  # name: (system(n, factor, joined), t_end per mode, N per mode)
     "payload": (payload, (1.0, 0.5, 0.05), (16, 16, 6)),
     "parallel robot": (robot, (1.5, 0.75, 0.05), (16, 16, 6)),
+    "six legs": (lambda n, factor, joined=True: robot(n, factor, joined, legs=6), (1.5, 0.75, 0.05), (60, 40, 6)),
 }
 
 
@@ -97,7 +100,7 @@ def main(argv=None):
         free = build(n, None, joined=False)
         rodmol.simulate(build(n, HOLD_STIFFNESS_FACTOR), t_end / 10)  # compile, warm
         run_free, wall_free = timed(free, t_end, args.reps)
-        cases = [(f, "sparse") for f in factors] + [(HOLD_STIFFNESS_FACTOR, "gmres")]
+        cases = [(f, solver) for f in factors for solver in ("gmres", "sparse")]
         for factor, solver in cases:
             system = build(n, factor)
             run, wall = timed(system, t_end, args.reps, linsolver=solver)

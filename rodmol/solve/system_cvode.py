@@ -3,18 +3,16 @@
 
 The Newton systems are solved (``linsolver``) by
 
-* ``"gmres"`` (the default of tree systems): GMRES preconditioned by the
-  rods' exact block preconditioners and the bodies' own blocks
+* ``"gmres"`` (default): GMRES preconditioned by the rods' exact block
+  preconditioners, the bodies' own blocks and, for free bodies with
+  penalty joints, their Schur complement
   (:mod:`rodmol.discretise.system_preconditioner`); about 2x faster than
-  ``"sparse"`` on the octopus (``solvers/octopus.py``, docs/performance.md);
-* ``"sparse"`` (the default when a penalty joint holds a rod node to a
-  body): SuperLU_MT (scikit-sundae) on the assembly's Jacobian pattern, the
-  rods' banded patterns on the diagonal and the joints' coupling blocks;
-  scikit-sundae fills the Jacobian by its own coloured differences over
-  that pattern. A penalty joint couples a rod node and a body as stiffly as
-  it holds them (the penalty stiffness, 100 E A / ds by default), which the
-  block preconditioner leaves out: GMRES then needs 20 to 50 times the
-  right-hand sides, or fails (``solvers/loops.py``, docs/systems.md);
+  ``"sparse"`` on the octopus (``solvers/octopus.py``, docs/performance.md),
+  as fast or faster on loops (``solvers/loops.py``, docs/systems.md);
+* ``"sparse"``: SuperLU_MT (scikit-sundae) on the assembly's Jacobian
+  pattern, the rods' banded patterns on the diagonal and the joints'
+  coupling blocks; scikit-sundae fills the Jacobian by its own coloured
+  differences over that pattern;
 * ``"dense"``: small systems and cross-checks.
 """
 
@@ -36,7 +34,7 @@ class _OutOfTime(Exception):
     """Raised inside the right-hand side when the wall-time budget is used up."""
 
 
-def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, linsolver="auto",
+def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, linsolver="gmres",
                  max_step=0.0, max_order="auto"):
     """Integrate ``assembly`` from ``y0`` at ``t_out[0]`` through the output
     times ``t_out`` [s].
@@ -46,8 +44,6 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
 
     ``max_order`` caps the BDF order; ``"auto"`` is 2 when a rod is lightly
     damped (``SemiDiscrete.lightly_damped``), else 5, as for one rod.
-    ``linsolver="auto"`` is ``"sparse"`` if a penalty joint holds a rod node
-    to a body (``assembly.joints``), else ``"gmres"``.
 
     Returns (t (n,), states (n, size), success, message, stats, error): the
     output frames reached; on failure (CVODE's, a user function's exception,
@@ -56,11 +52,8 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
     """
     from sksundae.cvode import CVODE, CVODEPrecond
 
-    if linsolver == "auto":
-        linsolver = "sparse" if assembly.joints else "gmres"
     if linsolver not in SYSTEM_LINEAR_SOLVERS:
-        raise ParameterError(f"unknown `linsolver` {linsolver!r} for a system; valid: "
-                             f"{['auto', *SYSTEM_LINEAR_SOLVERS]}")
+        raise ParameterError(f"unknown `linsolver` {linsolver!r} for a system; valid: {list(SYSTEM_LINEAR_SOLVERS)}")
     if max_order == "auto":
         max_order = 2 if assembly.lightly_damped else 5
     evals = [0]
