@@ -71,8 +71,8 @@ def test_pattern_holds_every_nonzero_of_a_difference_jacobian():
 
 
 def test_schur_preconditioner_inverts_the_newton_matrix_of_a_loop():
-    # Two arms from the world to one free bar (bases on the world: no tree coupling is left out), the
-    # bar a free body with penalty joints: the rods' exact blocks, the bar's block and the joints' blocks
+    # Two arms from the world to one free bar, a ring on one arm's middle (bases on the world: no tree
+    # coupling is left out), the bar and the ring free bodies with penalty joints: the rods' exact blocks, the bar's block and the joints' blocks
     # are all kept, so the preconditioner is the Newton matrix I - gamma J itself, to the error of its
     # forward differences (on the joints' stiff terms: 3e-5 of each entry's scale here, 1e-9 without
     # joints); without the joints' blocks (rods and bar each on their own) it is off by 100 times that.
@@ -81,9 +81,11 @@ def test_schur_preconditioner_inverts_the_newton_matrix_of_a_loop():
     arms = {name: rodmol.Model(rod, 4, base=rodmol.BaseMotion(position=(0.0, y, 0.0))) for name, y in
             (("a", 0.0), ("b", 0.04))}
     bar = rodmol.RigidBody(0.02, (1e-5, 1e-5, 1e-5), position=(0.2, 0.0, 0.0), centre_of_mass=(0.0, 0.02, 0.0))
+    ring = rodmol.RigidBody(0.01, (1e-6, 1e-6, 1e-6), position=(0.1, 0.0, 0.0))  # on a's middle: S couples bodies
     joints = [rodmol.Joint(("bar", (0.0, 0.0, 0.0)), ("a", "tip")),
-              rodmol.Joint(("bar", (0.0, 0.04, 0.0)), ("b", "tip"), kind="pin")]
-    assembly = Assembly(rodmol.System(arms, {"bar": bar}, joints, gravity=(0.0, -9.81, 0.0)))
+              rodmol.Joint(("bar", (0.0, 0.04, 0.0)), ("b", "tip"), kind="pin"),
+              rodmol.Joint(("ring", (0.0, 0.0, 0.0)), ("a", 0.1), kind="pin")]
+    assembly = Assembly(rodmol.System(arms, {"bar": bar, "ring": ring}, joints, gravity=(0.0, -9.81, 0.0)))
     scale = assembly.atol_scale()
     y = assembly.initial_state() + 1e-2 * np.random.default_rng(5).standard_normal(assembly.size) * scale
     fy = assembly(0.0, y).copy()
@@ -98,7 +100,7 @@ def test_schur_preconditioner_inverts_the_newton_matrix_of_a_loop():
     newton = np.eye(assembly.size) - gamma * jac
     precond = SystemPreconditioner(assembly, scale)
     precond.setup(0.0, y, fy, False, [0], gamma)
-    assert precond.coupled == [assembly.bodies["bar"]]
+    assert precond.coupled == [assembly.bodies["bar"], assembly.bodies["ring"]]
     v = np.random.default_rng(6).standard_normal(assembly.size) * scale
     r, z = newton @ v, np.empty_like(v)
     precond.solve(0.0, y, fy, r, z, gamma, 0.0, 1)
@@ -106,5 +108,6 @@ def test_schur_preconditioner_inverts_the_newton_matrix_of_a_loop():
     assert error < 2e-4
     apart = np.concatenate([precond.rods["a"].apply(r[assembly.parts["a"]]),
                             precond.rods["b"].apply(r[assembly.parts["b"]]),
-                            np.linalg.solve(np.eye(13) - gamma * precond._jac["bar"], r[assembly.parts["bar"]])])
+                            *[np.linalg.solve(np.eye(13) - gamma * precond._jac[b], r[assembly.parts[b]])
+                              for b in ("bar", "ring")]])
     assert np.abs((apart - v) / scale).max() > 100 * error
