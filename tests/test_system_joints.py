@@ -195,6 +195,9 @@ def test_parallel_robot_settles_at_the_shooting_equilibrium():
     for i, point in enumerate(LEG_POINTS):
         held = run["platform"].position[-1] + run["platform"].rotation[-1] @ point
         assert np.linalg.norm(run[f"leg{i}"].integrated_positions[-1, -1] - held) < 1e-6 * LEG_L
+    # The legs' Results record their joints' forces at each frame: settled, the platform's weight.
+    tips = sum(run[f"leg{i}"].external_force[-1, -1] * run[f"leg{i}"].node_length[-1] for i in range(3))
+    np.testing.assert_allclose(tips, PLATFORM_M * ROBOT_GRAVITY, atol=1e-3 * PLATFORM_M * 9.81)
 
 
 # ---------------------------------------------------------------- loops and holds

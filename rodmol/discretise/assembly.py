@@ -25,7 +25,8 @@ the body's point x + R p with the orientation R Rj and the velocities
 R (v + w x p), R w (global), written into the hold's row before each call
 (:func:`rodmol.discretise.rigid.joint_wrench`). The body feels the hold's
 force and moment with the opposite sign, the force acting where the node
-is. A joint to the world is the rod's plain hold.
+is. A joint to the world is the rod's plain hold. :mod:`rodmol.discretise.joints`
+holds the joints' parts.
 
 Newton-Euler of a body about its origin, body frame, with the momentum
 P = m (v + w x c) and H = I_o w + m c x v of its own mass:
@@ -37,11 +38,10 @@ wrenches, weight minus buoyancy at the centre of mass and quadratic drag.
 import numpy as np
 from scipy import sparse
 
-from ..errors import ParameterError
-from .layout import FIELDS, BlockLayout
-from .load_entries import count
-from .physics import quaternion_product, quaternion_rate
-from .rigid import clamp_wrench, free_body_rates, joint_wrench, pack_body
+from .joints import JointPart, RecordedJoints, block_entries
+from .layout import BlockLayout
+from .physics import quaternion_rate
+from .rigid import clamp_wrench, free_body_rates, pack_body
 from .rotations import from_matrix, matrices
 from .stencil import WORK_TOTAL
 from .system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE, SemiDiscrete, field_scales
@@ -102,35 +102,6 @@ class BodyPart:
     def base_velocities(self, v, w):
         """(n, 6) base velocities of the rods for the body velocities (v, w) (:func:`clamp_velocities`)."""
         return clamp_velocities(self.points, self.turns, v, w)
-
-
-class JointPart:
-    """A penalty joint between a rod node and a body: the rod's hold entry
-    (its parameter row and value, the kernel's arrays), the node's element
-    block in the state, the body point [m] and the section's held
-    orientation ``turn`` (quaternion, section to body frame)."""
-
-    def __init__(self, joint, sd, rod_start, part):
-        model = sd.model
-        hold = model.loads[joint.load]
-        entry = sum(count(load, model.s_nodes) for load in model.loads[:joint.load])
-        self.joint, self.sd, self.part, self.entry = joint, sd, part, entry
-        self.kind = int(sd.kernel_arguments()[6][entry])
-        self.row, self.value = sd.entry_params[entry], sd.entry_values[entry]
-        node = int(round(hold.s / model.ds))
-        self.node = rod_start + sd.layout.header + sd.layout.block * (node - 1)
-        self.point = np.asarray(joint.point, dtype=float)
-        q_b = from_matrix(part.body.rotation)
-        self.turn = np.array(quaternion_product((q_b[0], -q_b[1], -q_b[2], -q_b[3]), tuple(self.row[3:7])))
-        gap = float(np.linalg.norm(self.value))
-        if gap > 1e-6 * model.rod.length:
-            raise ParameterError(f"`{hold.name}` joins rod node s = {hold.s:g} m to body {part.name!r}, but the "
-                                 f"body point is {gap:.3g} m from where the node is at rest: place the body so "
-                                 "that they meet (its `position`, `rotation` or the joint's point)")
-
-    def wrench(self, y, body, row, value):
-        """Write the held point into ``row``, ``value`` and return the body's reaction (:func:`joint_wrench`)."""
-        return joint_wrench(self.kind, row, value, y, self.node, body, self.point, self.turn)
 
 
 class Assembly:
@@ -214,6 +185,24 @@ class Assembly:
         if part.body.free:
             return np.ascontiguousarray(y[part.slice])
         return np.concatenate([y[part.slice], *self.body_velocities(part, t, y)])
+
+    def recorded_rod(self, name, t, states, sd=None):
+        """Rod ``name``'s system (or ``sd``, a copy of it) for rebuilding its
+        Result from the frames ``states`` (n_t, size) at ``t``: if penalty
+        joints hold it to bodies, a :class:`RecordedJoints` replaying their
+        held points at the frames, else ``sd`` itself."""
+        sd = self.rods[name] if sd is None else sd
+        joints = [joint for joint in self.joints if joint.joint.rod == name]
+        if not joints:
+            return sd
+        replay = []
+        for joint in joints:
+            rows, values = np.tile(joint.row, (len(t), 1)), np.zeros((len(t), 3))
+            for i, (ti, yi) in enumerate(zip(t, states)):
+                yi = np.ascontiguousarray(yi)
+                joint.wrench(yi, self.body_state(joint.part, ti, yi), rows[i], values[i])
+            replay.append((joint.entry, rows, values))
+        return RecordedJoints(sd.model, sd.scheme, t, replay)
 
     def body_velocities(self, part, t, y):
         """(v, w) of a body's origin at (t, y) [m/s, rad/s], body frame."""
@@ -343,11 +332,6 @@ class Assembly:
             linear += r @ momentum[:3]
             angular += _cross(y[part.fields["x"]], r @ momentum[:3]) + r @ momentum[3:]
         return linear, angular
-
-
-def block_entries(*fields):
-    """Indices of ``fields`` within an element block."""
-    return np.concatenate([np.arange(FIELDS[f].start, FIELDS[f].stop) for f in fields])
 
 
 def _body_pattern(part):

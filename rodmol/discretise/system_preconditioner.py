@@ -26,7 +26,7 @@ body column and joined rod; a solve is z_r' = N_rr^-1 r_r, z_b = S^-1
 
 import numpy as np
 
-from .assembly import block_entries
+from .joints import block_entries
 
 #: A joint node's rows (its velocities) and columns (what the joint reads), within its element block.
 JOINT_ROWS, JOINT_COLUMNS = block_entries("v", "w"), block_entries("u", "Q", "v", "w")
