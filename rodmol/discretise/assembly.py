@@ -245,7 +245,7 @@ class Assembly:
         """The rates of body ``part``'s block at (t, y) into ``out`` (the whole
         state's rates), after the rods' rates at y (their cell 0's stress)."""
         if part.body.free:
-            force, torque = self.body_wrench(part, y) if part.rods else (np.zeros(3), np.zeros(3))
+            force, torque = self.body_wrench(part, y) if part.rods else ((0.0,) * 3, (0.0,) * 3)
             if part.joints:
                 force, torque = np.array(force), np.array(torque)
                 body = np.ascontiguousarray(y[part.slice])
