@@ -195,6 +195,9 @@ class System:
                 if joint.kind != "clamp":
                     raise NotSupportedYet(f"`joints[{i}]` pins the base of rod {rod!r}: a rod's base can only "
                                           "be clamped yet (pin any other node)")
+                if joint.stiffness is not None or joint.damping is not None:
+                    raise ParameterError(f"`joints[{i}]` clamps the base of rod {rod!r}: the clamp is eliminated "
+                                         "(exact), it takes no `stiffness` or `damping`")
                 if rod in clamps:
                     raise ParameterError(f"`joints[{i}]`: the base of rod {rod!r} is already jointed; hold a "
                                          "rod's other nodes by joints at its tip or at an arc length s")

@@ -98,6 +98,9 @@ def test_system_graph_checks():
         rodmol.Joint("world", ("arm", "middle"))
     with pytest.raises(rodmol.ParameterError, match="stiffness"):
         rodmol.Joint("world", ("arm", "tip"), stiffness=-1.0)
+    with pytest.raises(rodmol.ParameterError, match="eliminated"):
+        rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint(("head", (0, 0, 0)), ("arm", "base"),
+                                                                     stiffness=1e3)])
     # A tip held to the world is the rod's Hold; to a body, a Hold its assembly moves with the body.
     held = rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint("world", ("arm", "tip"), "pin"),
                                                            rodmol.Joint(("head", (0, 0, 0)), ("arm", 0.1))])
