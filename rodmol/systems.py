@@ -98,8 +98,10 @@ def _end(name, value):
 class PenaltyJoint:
     """A joint held by a penalty (:class:`rodmol.Hold`'s law): rod ``rod``'s
     hold ``loads[load]`` (its Model's), held by the body ``body`` (None: the
-    world) at ``point`` [m], body frame, with the section's orientation
-    ``rotation`` (section to body frame; None: as at rest)."""
+    world, or a rod) at ``point`` [m], body frame, with the section's
+    orientation ``rotation`` (section to body frame; None: as at rest), or
+    by the node of rod ``partner`` whose hold is its ``loads[partner_load]``
+    (each of the two rods holds the other's node: the pair is equal and opposite)."""
 
     index: int
     rod: str
@@ -108,6 +110,8 @@ class PenaltyJoint:
     point: np.ndarray | None
     rotation: np.ndarray | None
     kind: str
+    partner: str | None = None
+    partner_load: int | None = None
 
 
 class System:
@@ -185,9 +189,12 @@ class System:
                 if isinstance(e, tuple) and e[0] == "body" and e[1] not in self.bodies:
                     raise ParameterError(f"`joints[{i}]` names the body {e[1]!r}, which is not in `bodies`"
                                          f"{_checks.did_you_mean(e[1], self.bodies)}")
+            if len(rod_ends) == 2:
+                penalties += self._rod_to_rod(i, joint, rod_ends, holds)
+                continue
             if len(rod_ends) != 1:
                 raise NotSupportedYet(f"`joints[{i}]` joins {_describe(ends[0])} and {_describe(ends[1])}: "
-                                      "only a rod to a body or to the world is supported yet (not rod to rod, "
+                                      "only a rod to a body, to the world or to a rod is supported yet (not "
                                       "body to body or body to world)")
             _, rod, where = rod_ends[0]
             other = ends[1] if ends[0] is rod_ends[0] else ends[0]
@@ -221,6 +228,25 @@ class System:
         self.rods = {name: m.replace(loads=tuple(m.loads) + tuple(holds[name])) if holds[name] else m
                      for name, m in self.rods.items()}
         return clamps, penalties
+
+    def _rod_to_rod(self, i, joint, rod_ends, holds):
+        """The two penalty joints of ``joints[i]`` between two rods' nodes (not
+        bases): each rod's hold held by the other's node, appended to ``holds``."""
+        if any(where == "base" for _, _, where in rod_ends):
+            raise NotSupportedYet(f"`joints[{i}]` joins a rod's base to a rod: a base can only be clamped to a "
+                                  "body or the world yet (join a rod's tip or node s to the other rod)")
+        (_, a, where_a), (_, b, where_b) = rod_ends
+        if a == b and where_a == where_b:
+            raise ParameterError(f"`joints[{i}]` joins a node of rod {a!r} to itself")
+        loads = []
+        for rod, where in ((a, where_a), (b, where_b)):
+            model = self.rods[rod]
+            s = model.rod.length if where == "tip" else where
+            loads.append(len(model.loads) + len(holds[rod]))
+            holds[rod].append(Hold(s, joint.kind, stiffness=joint.stiffness, damping=joint.damping,
+                                   name=f"joints[{i}]"))
+        return [PenaltyJoint(i, a, loads[0], None, None, None, joint.kind, b, loads[1]),
+                PenaltyJoint(i, b, loads[1], None, None, None, joint.kind, a, loads[0])]
 
     def _clamp(self, i, rod, other):
         """(body or None, point, rotation) of ``joints[i]``, the clamp of rod ``rod``'s base to ``other``."""

@@ -90,8 +90,10 @@ def test_system_graph_checks():
         rodmol.System({"arm": _arm()}, {"head": head}, [on_head, rodmol.Joint("world", ("arm", "base"))])
     with pytest.raises(rodmol.NotSupportedYet, match="pins the base"):
         rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint(("head", (0, 0, 0)), ("arm", "base"), "pin")])
-    with pytest.raises(rodmol.NotSupportedYet, match="rod to rod"):
-        rodmol.System({"arm": _arm(), "arm2": _arm()}, joints=[rodmol.Joint(("arm", "tip"), ("arm2", 0.1))])
+    with pytest.raises(rodmol.NotSupportedYet, match="joins a rod's base to a rod"):
+        rodmol.System({"arm": _arm(), "arm2": _arm()}, joints=[rodmol.Joint(("arm", "tip"), ("arm2", "base"))])
+    with pytest.raises(rodmol.ParameterError, match="to itself"):
+        rodmol.System({"arm": _arm()}, joints=[rodmol.Joint(("arm", "tip"), ("arm", "tip"))])
     with pytest.raises(rodmol.ParameterError, match="velocity node"):
         rodmol.System({"arm": _arm()}, joints=[rodmol.Joint("world", ("arm", 0.07))])
     with pytest.raises(rodmol.ParameterError, match="'middle'"):

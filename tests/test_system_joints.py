@@ -266,3 +266,28 @@ def test_tip_clamped_to_a_driven_gripper_follows_it_and_settles_as_the_displaced
     held = model.replace(loads=[rodmol.Hold(0.2, "clamp", position=(0.2, 0.01, 0.0))])
     rest = rodmol.simulate(held, 0.01, initial=rodmol.equilibrium(held))
     np.testing.assert_allclose(run["arm"].positions[-1], rest.positions[0], atol=1e-5 * 0.2)  # measured 7e-7 m
+
+
+def test_two_half_beams_joined_at_their_tips_fall_as_one_clamped_clamped_beam():
+    # Two cantilevers from opposite walls, their tips clamped to each other (each rod's hold held by
+    # the other's node), against one rod of the whole span with its tip clamped by a Hold: at the middle
+    # the two tip nodes' half cells make the one node's cell, so the grids match, and the runs agree.
+    span, n = 0.5, 16
+    material = rodmol.Material(E=1e7, nu=0.5, mu=7e4, rho=1000.0)
+    half = rodmol.Rod(span / 2, radius=0.01, material=material)
+    left = rodmol.Model(half, n // 2)
+    right = rodmol.Model(half, n // 2, base=rodmol.BaseMotion(position=(span, 0.0, 0.0),
+                                                                rotation=np.diag([-1.0, -1.0, 1.0])))
+    system = rodmol.System({"left": left, "right": right}, joints=[rodmol.Joint(("left", "tip"), ("right", "tip"))],
+                           gravity=(0.0, -9.81, 0.0))
+    run = rodmol.simulate(system, 0.3, output_dt=0.02)
+    assert run.success and run.stats["linear_solver"] == "sparse"
+    whole = rodmol.Model(rodmol.Rod(span, radius=0.01, material=material), n, gravity=(0.0, -9.81, 0.0),
+                         loads=[rodmol.Hold(span, "clamp")])
+    one = rodmol.simulate(whole, 0.3, output_dt=0.02, initial="straight")
+    middle = run["left"].integrated_positions[:, -1]
+    assert -middle[:, 1].min() > 0.005  # it sags and swings
+    np.testing.assert_allclose(middle, one.integrated_positions[:, n // 2], atol=2e-5)  # measured 1.2e-5 m
+    np.testing.assert_allclose(run["right"].integrated_positions[:, -1], middle, atol=1e-5)  # the joint's gap
+    with pytest.raises(rodmol.NotSupportedYet, match="use 'sparse'"):
+        rodmol.simulate(system, 0.1, linsolver="gmres")

@@ -25,7 +25,10 @@ the body's point x + R p with the orientation R Rj and the velocities
 R (v + w x p), R w (global), written into the hold's row before each call
 (:func:`rodmol.discretise.rigid.joint_wrench`). The body feels the hold's
 force and moment with the opposite sign, the force acting where the node
-is. A joint to the world is the rod's plain hold. :mod:`rodmol.discretise.joints`
+is. A joint to the world is the rod's plain hold. A joint between two
+rods' nodes is two holds, each rod's held by the other's node: their
+forces (and clamp moments) are equal and opposite, acting at the two nodes
+(the couple of the pair, gap x F, is O(F^2 / k)). :mod:`rodmol.discretise.joints`
 holds the joints' parts.
 
 Newton-Euler of a body about its origin, body frame, with the momentum
@@ -38,7 +41,7 @@ wrenches, weight minus buoyancy at the centre of mass and quadratic drag.
 import numpy as np
 from scipy import sparse
 
-from .joints import JointPart, RecordedJoints, block_entries
+from .joints import JointPart, RecordedJoints, RodJointPart, block_entries
 from .layout import BlockLayout
 from .physics import quaternion_rate
 from .rigid import clamp_wrench, free_body_rates, pack_body
@@ -143,12 +146,16 @@ class Assembly:
             self.parts[name] = part.slice
             start = part.slice.stop
         self.size = start
-        self.joints = []
+        self.joints, self.rod_joints = [], []  # penalty joints to bodies, between rods (each side)
         for joint in system.penalty_joints:
+            rod = (self.rods[joint.rod], self.parts[joint.rod].start)
             if joint.body is not None:
                 part = self.bodies[joint.body]
-                part.joints.append(JointPart(joint, self.rods[joint.rod], self.parts[joint.rod].start, part))
+                part.joints.append(JointPart(joint, *rod, part))
                 self.joints.append(part.joints[-1])
+            elif joint.partner is not None:
+                self.rod_joints.append(RodJointPart(joint, *rod, self.rods[joint.partner],
+                                                    self.parts[joint.partner].start))
         self.free = [p for p in self.bodies.values() if p.body.free]
         self.lightly_damped = any(sd.lightly_damped for sd in self.rods.values())
         self._gravity = np.ascontiguousarray(system.gravity, dtype=float)
@@ -192,7 +199,7 @@ class Assembly:
         joints hold it to bodies, a :class:`RecordedJoints` replaying their
         held points at the frames, else ``sd`` itself."""
         sd = self.rods[name] if sd is None else sd
-        joints = [joint for joint in self.joints if joint.joint.rod == name]
+        joints = [joint for joint in self.joints + self.rod_joints if joint.joint.rod == name]
         if not joints:
             return sd
         replay = []
@@ -200,7 +207,10 @@ class Assembly:
             rows, values = np.tile(joint.row, (len(t), 1)), np.zeros((len(t), 3))
             for i, (ti, yi) in enumerate(zip(t, states)):
                 yi = np.ascontiguousarray(yi)
-                joint.wrench(yi, self.body_state(joint.part, ti, yi), rows[i], values[i])
+                if isinstance(joint, RodJointPart):
+                    joint.wrench(yi, rows[i], values[i])
+                else:
+                    joint.wrench(yi, self.body_state(joint.part, ti, yi), rows[i], values[i])
             replay.append((joint.entry, rows, values))
         return RecordedJoints(sd.model, sd.scheme, t, replay)
 
@@ -234,6 +244,8 @@ class Assembly:
                 sd.base_velocities[:] = row
         for joint in self.joints:  # and the held points of the penalty joints
             joint.wrench(y, self.body_state(joint.part, t, y), joint.row, joint.value)
+        for joint in self.rod_joints:
+            joint.wrench(y, joint.row, joint.value)
         for name, sd in self.rods.items():
             sl = self.parts[name]
             sd(t, y[sl], out[sl])
@@ -294,6 +306,8 @@ class Assembly:
                 node = joint.node + block_entries("u", "Q", "v", "w")
                 velocity = np.r_[joint.part.fields["v"], joint.part.fields["w"]]
                 pat[np.ix_(velocity, node)] = True
+        for joint in self.rod_joints:  # each side: its node's velocity rows against the partner node
+            pat[np.ix_(joint.node + block_entries("v", "w"), joint.partner_fields)] = True
         return pat.tocsc()
 
     def atol_scale(self):

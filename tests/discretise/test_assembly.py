@@ -15,8 +15,8 @@ def _system():
     head = rodmol.RigidBody(0.05, (2e-5, 3e-5, 4e-5), centre_of_mass=(0.0, 0.004, 0.0), volume=2e-5,
                             drag=(1, 2, 3, 0.1, 0.2, 0.3), added_mass=(0.01, 0.02, 0.03, 0, 0, 0))
     plate = rodmol.RigidBody(0.5, (1e-3, 1e-3, 1e-3), motion="fixed", position=(1.0, 0.0, 0.0))
-    # Penalty joints: a's tip clamped to a free payload, b's tip pinned to a fixed post, c's middle pinned
-    # to the world: the loop head-a-payload closes through nothing, the loop plate-c-world through the world.
+    # Penalty joints: a's tip clamped to a free payload, b's tip pinned to a fixed post, a node of c pinned
+    # to the world and its middle clamped to d's tip.
     payload = rodmol.RigidBody(0.02, (1e-6, 2e-6, 3e-6), position=(0.21, 0.0, 0.0), centre_of_mass=(0.01, 0, 0))
     post = rodmol.RigidBody(0.5, (1e-3, 1e-3, 1e-3), motion="fixed", position=(-0.22, 0.0, 0.0))
     joints = [rodmol.Joint(("head", (0.02, 0.0, 0.0)), ("a", "base")),
@@ -24,9 +24,11 @@ def _system():
               rodmol.Joint(("plate", (0.0, 0.0, 0.0)), ("c", "base")),
               rodmol.Joint(("payload", (0.01, 0.0, 0.0)), ("a", "tip")),
               rodmol.Joint(("post", (0.0, 0.0, 0.0)), ("b", "tip"), kind="pin"),
-              rodmol.Joint("world", ("c", 0.1), kind="pin")]
-    return rodmol.System({"a": arm, "b": arm, "c": arm}, {"head": head, "plate": plate, "payload": payload,
-                                                           "post": post}, joints,
+              rodmol.Joint("world", ("c", 0.05), kind="pin"),
+              rodmol.Joint(("d", "tip"), ("c", 0.1))]  # d rises from the world to c's middle
+    rise = rodmol.BaseMotion(position=(1.1, -0.2, 0.0), rotation=((0.0, -1.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0)))
+    return rodmol.System({"a": arm, "b": arm, "c": arm, "d": arm.replace(base=rise)},
+                         {"head": head, "plate": plate, "payload": payload, "post": post}, joints,
                          medium="water", gravity=(0.0, 0.0, -9.81))
 
 
@@ -34,9 +36,8 @@ def test_parts_tile_the_state_in_order():
     assembly = Assembly(_system())
     rod_size = assembly.rods["a"].size
     spans = [(s.start, s.stop) for s in assembly.parts.values()]
-    bodies = np.cumsum([3 * rod_size, 13, 7, 13, 7])
-    assert spans == [(0, rod_size), (rod_size, 2 * rod_size), (2 * rod_size, 3 * rod_size),
-                     *zip(bodies[:-1], bodies[1:])]
+    bodies = np.cumsum([4 * rod_size, 13, 7, 13, 7])
+    assert spans == [(k * rod_size, (k + 1) * rod_size) for k in range(4)] + list(zip(bodies[:-1], bodies[1:]))
     assert assembly.size == bodies[-1] == len(assembly.atol_scale())
 
 
@@ -68,6 +69,9 @@ def test_pattern_holds_every_nonzero_of_a_difference_jacobian():
     assert touched[payload["v"].start:payload["w"].stop, tip_a:tip_a + 19].any()
     assert touched[tip_a:tip_a + 19, payload["x"].start:payload["w"].stop].any()
     assert touched[tip_b:tip_b + 19, post["x"].start:post["Q"].stop].any()
+    tip_d = assembly.parts["d"].stop - assembly.rods["d"].layout.block
+    middle_c = assembly.parts["c"].start + assembly.rods["c"].layout.header + assembly.rods["c"].layout.block
+    assert touched[tip_d:tip_d + 19, middle_c:middle_c + 19].any() and touched[middle_c:middle_c + 19, tip_d:tip_d + 19].any()
 
 
 def test_schur_preconditioner_inverts_the_newton_matrix_of_a_loop():
