@@ -5,12 +5,15 @@ Two methods hold the joints:
 * a rod's *base* clamped to a rigid body or to the world is eliminated (a
   tree joint): the base takes the body's pose and velocities;
 * a joint at any other node of a rod (its tip or an arc length ``s``),
-  clamp or pin, to the world or to a body, is a stiff penalty: the law of
-  :class:`rodmol.Hold` (:func:`rodmol.discretise.external.hold`), whose held
-  point moves with the body. Such joints may close loops (several rods
-  between the ground and one platform, a rod held at both ends).
+  clamp or pin, to the world, to a body or to another rod's node, is a
+  stiff penalty: the law of :class:`rodmol.Hold`
+  (:func:`rodmol.discretise.external.hold`), whose held point moves with
+  the body (between two rods, each rod's hold is held by the other's node).
+  Such joints may close loops (several rods between the ground and one
+  platform, a rod held at both ends).
 
-Joints between two rods or two bodies raise :class:`rodmol.errors.NotSupportedYet`.
+Joints between two bodies (or a body and the world), a pinned base and a
+base joined to a rod raise :class:`rodmol.errors.NotSupportedYet`.
 """
 
 from dataclasses import dataclass
@@ -47,7 +50,9 @@ class Joint:
         rod's base frame the joint frame (default rotation: identity): the
         rod leaves the body along the joint frame's x axis. At any other
         node the rotation, if given, is the section's held orientation in
-        the body frame (default: the section's orientation at rest).
+        the body frame (default: the section's orientation at rest). Two
+        rods' tips or nodes s may be joined (the relative orientation of
+        their sections at rest is held by a clamp).
     kind : str
         ``"clamp"`` (all six relative motions fixed) or ``"pin"`` (the
         positions only: a ball joint; not at a rod's base).
