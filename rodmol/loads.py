@@ -67,10 +67,12 @@ KERNELS = {
 # radius), then the law, the section radius at the node and the depth over
 # which the penalty is smoothed. Vector loads have none. A hold's row: the
 # node's rest position (3), the held orientation's quaternion (4), then its
-# stiffness, damping, turning stiffness and turning damping.
-N_PARAMS = 13
+# stiffness, damping, turning stiffness and turning damping, and the held
+# point's velocity and angular velocity (3 + 3, global: zero for the world,
+# a body's for a joint of rodmol.System, written at each call by the assembly).
+N_PARAMS = 17
 P_STIFFNESS, P_DAMPING, P_FRICTION, P_SLIP, P_RADIUS, P_SMOOTHING = 7, 8, 9, 10, 11, 12
-P_TURN_STIFFNESS, P_TURN_DAMPING = 9, 10
+P_TURN_STIFFNESS, P_TURN_DAMPING, P_HELD_VELOCITY, P_HELD_SPIN = 9, 10, 11, 14
 
 
 def _frame(frame, name):

@@ -73,6 +73,7 @@ class SystemResult:
         held = next((part for part in assembly.free if name in part.rods), None)
         if held is not None:  # the same rod, its base moving as its body did at the frames
             sd = SemiDiscrete(sd.model.replace(base=self._recorded_base(name, held, sd.model.base)), sd.scheme)
+        sd = assembly.recorded_rod(name, self.t, self.states, sd)  # its penalty joints as at the frames
         return from_states(sd, self.t, y_rod, self.success, self.message, dict(self.stats))
 
     def _recorded_base(self, name, part, base):

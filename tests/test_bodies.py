@@ -86,10 +86,29 @@ def test_system_graph_checks():
     assert system.rods_on("head") == ["arm"]
     with pytest.raises(rodmol.ParameterError, match="'hed'.*did you mean 'head'"):
         rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint(("hed", (0, 0, 0)), ("arm", "base"))])
-    with pytest.raises(rodmol.NotSupportedYet, match="tip"):
-        rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint("world", ("arm", "tip"))])
-    with pytest.raises(rodmol.NotSupportedYet, match="loops"):
+    with pytest.raises(rodmol.ParameterError, match="already jointed"):
         rodmol.System({"arm": _arm()}, {"head": head}, [on_head, rodmol.Joint("world", ("arm", "base"))])
+    with pytest.raises(rodmol.NotSupportedYet, match="pins the base"):
+        rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint(("head", (0, 0, 0)), ("arm", "base"), "pin")])
+    with pytest.raises(rodmol.NotSupportedYet, match="joins a rod's base to a rod"):
+        rodmol.System({"arm": _arm(), "arm2": _arm()}, joints=[rodmol.Joint(("arm", "tip"), ("arm2", "base"))])
+    with pytest.raises(rodmol.ParameterError, match="to itself"):
+        rodmol.System({"arm": _arm()}, joints=[rodmol.Joint(("arm", "tip"), ("arm", "tip"))])
+    with pytest.raises(rodmol.ParameterError, match="velocity node"):
+        rodmol.System({"arm": _arm()}, joints=[rodmol.Joint("world", ("arm", 0.07))])
+    with pytest.raises(rodmol.ParameterError, match="'middle'"):
+        rodmol.Joint("world", ("arm", "middle"))
+    with pytest.raises(rodmol.ParameterError, match="stiffness"):
+        rodmol.Joint("world", ("arm", "tip"), stiffness=-1.0)
+    with pytest.raises(rodmol.ParameterError, match="eliminated"):
+        rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint(("head", (0, 0, 0)), ("arm", "base"),
+                                                                     stiffness=1e3)])
+    # A tip held to the world is the rod's Hold; to a body, a Hold its assembly moves with the body.
+    held = rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint("world", ("arm", "tip"), "pin"),
+                                                           rodmol.Joint(("head", (0, 0, 0)), ("arm", 0.1))])
+    assert [(h.s, h.kind, h.name) for h in held.rods["arm"].loads] == [(0.2, "pin", "joints[0]"),
+                                                                      (0.1, "clamp", "joints[1]")]
+    assert [(j.rod, j.load, j.body) for j in held.penalty_joints] == [("arm", 0, None), ("arm", 1, "head")]
     with pytest.raises(rodmol.NotSupportedYet, match="body 'head'"):
         rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint("world", ("head", (0, 0, 0)))])
     with pytest.raises(rodmol.ParameterError, match="used twice"):

@@ -191,6 +191,13 @@ def _holds(out):
         assert all(row["steps_over_free"] < 3 for row in runs), runs
 
 
+def _loops(out):
+    table = rows(out / "loops.csv")
+    sparse = [row for row in table if row["linear_solver"] == "sparse"]
+    assert sparse and all(row["success"] for row in sparse), sparse
+    assert all(row["max_drift_over_L"] < 1e-4 for row in sparse), sparse  # the default factor or stiffer
+
+
 SCRIPTS = {
     "scaling.py": (["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"], _scaling),
     "temporal.py": (["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv", "temporal_options.csv"],
@@ -215,6 +222,7 @@ SCRIPTS = {
     "octopus.py": (["octopus.csv", "octopus.md"], _octopus),
     "rest_strains_speed.py": (["rest_strains_speed.csv", "rest_strains_speed.md"], _rest_strains_speed),
     "holds.py": (["holds.csv", "holds.md"], _holds),
+    "loops.py": (["loops.csv", "loops.md"], _loops),
 }
 
 

@@ -19,6 +19,18 @@ is then the same as between any two nodes of a rod. The rod's header (u0,
 Q0) integrates v0, w0 as for a single rod: it is not tied to the body's pose
 but drifts from it by the integration error only (``pose_drift``).
 
+Coupling (penalty joints, at any other node, loops allowed): the joint is
+the rod's hold (rodmol.Hold, one of its load entries), whose held point is
+the body's point x + R p with the orientation R Rj and the velocities
+R (v + w x p), R w (global), written into the hold's row before each call
+(:func:`rodmol.discretise.rigid.joint_wrench`). The body feels the hold's
+force and moment with the opposite sign, the force acting where the node
+is. A joint to the world is the rod's plain hold. A joint between two
+rods' nodes is two holds, each rod's held by the other's node: their
+forces (and clamp moments) are equal and opposite, acting at the two nodes
+(the couple of the pair, gap x F, is O(F^2 / k)). :mod:`rodmol.discretise.joints`
+holds the joints' parts.
+
 Newton-Euler of a body about its origin, body frame, with the momentum
 P = m (v + w x c) and H = I_o w + m c x v of its own mass:
 M [v_t, w_t] = [F - w x P, T - w x H - v x P], where the 6x6 mass matrix M
@@ -29,6 +41,7 @@ wrenches, weight minus buoyancy at the centre of mass and quadratic drag.
 import numpy as np
 from scipy import sparse
 
+from .joints import JointPart, RecordedJoints, RodJointPart, block_entries
 from .layout import BlockLayout
 from .physics import quaternion_rate
 from .rigid import clamp_wrench, free_body_rates, pack_body
@@ -74,6 +87,7 @@ class BodyPart:
         self.points, self.turns = np.zeros((0, 3)), np.zeros((0, 3, 3))
         self.shares = np.zeros(0)  # the base node's share of cell 0 [m] (Scheme.base_share ds)
         self.strains = np.zeros((0, 6), dtype=np.int64)  # state indices of (q, k) of each rod's cell 0
+        self.joints = []  # its penalty joints (JointPart)
 
     def clamp(self, name, sd, start, point, turn):
         """Hold the base of rod ``name`` (its system ``sd``, its state from ``start``)."""
@@ -132,6 +146,16 @@ class Assembly:
             self.parts[name] = part.slice
             start = part.slice.stop
         self.size = start
+        self.joints, self.rod_joints = [], []  # penalty joints to bodies, between rods (each side)
+        for joint in system.penalty_joints:
+            rod = (self.rods[joint.rod], self.parts[joint.rod].start)
+            if joint.body is not None:
+                part = self.bodies[joint.body]
+                part.joints.append(JointPart(joint, *rod, part))
+                self.joints.append(part.joints[-1])
+            elif joint.partner is not None:
+                self.rod_joints.append(RodJointPart(joint, *rod, self.rods[joint.partner],
+                                                    self.parts[joint.partner].start))
         self.free = [p for p in self.bodies.values() if p.body.free]
         self.lightly_damped = any(sd.lightly_damped for sd in self.rods.values())
         self._gravity = np.ascontiguousarray(system.gravity, dtype=float)
@@ -163,6 +187,33 @@ class Assembly:
             y[part.fields["Q"]] = from_matrix(part.body.rotation)
         return y
 
+    def body_state(self, part, t, y):
+        """A body's (x, Q, v, w) at (t, y) (13,): its pose and velocities (:meth:`body_velocities`)."""
+        if part.body.free:
+            return np.ascontiguousarray(y[part.slice])
+        return np.concatenate([y[part.slice], *self.body_velocities(part, t, y)])
+
+    def recorded_rod(self, name, t, states, sd=None):
+        """Rod ``name``'s system (or ``sd``, a copy of it) for rebuilding its
+        Result from the frames ``states`` (n_t, size) at ``t``: if penalty
+        joints hold it to bodies, a :class:`RecordedJoints` replaying their
+        held points at the frames, else ``sd`` itself."""
+        sd = self.rods[name] if sd is None else sd
+        joints = [joint for joint in self.joints + self.rod_joints if joint.joint.rod == name]
+        if not joints:
+            return sd
+        replay = []
+        for joint in joints:
+            rows, values = np.tile(joint.row, (len(t), 1)), np.zeros((len(t), 3))
+            for i, (ti, yi) in enumerate(zip(t, states)):
+                yi = np.ascontiguousarray(yi)
+                if isinstance(joint, RodJointPart):
+                    joint.wrench(yi, rows[i], values[i])
+                else:
+                    joint.wrench(yi, self.body_state(joint.part, ti, yi), rows[i], values[i])
+            replay.append((joint.entry, rows, values))
+        return RecordedJoints(sd.model, sd.scheme, t, replay)
+
     def body_velocities(self, part, t, y):
         """(v, w) of a body's origin at (t, y) [m/s, rad/s], body frame."""
         if part.body.free:
@@ -191,6 +242,10 @@ class Assembly:
         for part in self.free:  # the rods' base velocities first
             for sd, row in zip(part.systems, part.base_velocities(y[part.fields["v"]], y[part.fields["w"]])):
                 sd.base_velocities[:] = row
+        for joint in self.joints:  # and the held points of the penalty joints
+            joint.wrench(y, self.body_state(joint.part, t, y), joint.row, joint.value)
+        for joint in self.rod_joints:
+            joint.wrench(y, joint.row, joint.value)
         for name, sd in self.rods.items():
             sl = self.parts[name]
             sd(t, y[sl], out[sl])
@@ -203,6 +258,14 @@ class Assembly:
         state's rates), after the rods' rates at y (their cell 0's stress)."""
         if part.body.free:
             force, torque = self.body_wrench(part, y) if part.rods else ((0.0,) * 3, (0.0,) * 3)
+            if part.joints:
+                force, torque = np.array(force), np.array(torque)
+                body = np.ascontiguousarray(y[part.slice])
+                for joint in part.joints:  # on scratch rows: the rods' own rows stay as the last call set them
+                    f, m = joint.wrench(y, body, joint.row.copy(), joint.value.copy())
+                    force += f
+                    torque += m
+                force, torque = tuple(force), tuple(torque)
             free_body_rates(y[part.slice], part.params, part.rigid_mass, part.inverse_mass, self._gravity,
                             force, torque, DRAG_SMOOTHING_SPEED**2, QUATERNION_RESTORING_RATE, out[part.slice])
             return
@@ -235,6 +298,16 @@ class Assembly:
                 first = np.arange(start, start + sd.layout.header + sd.layout.block)
                 pat[np.ix_(first, velocity)] = True
                 pat[np.ix_(velocity, first)] = True
+        for joint in self.joints:
+            body = joint.part.slice
+            rows = joint.node + block_entries("v", "w")
+            pat[np.ix_(rows, np.arange(body.start, body.stop))] = True
+            if joint.part.body.free:
+                node = joint.node + block_entries("u", "Q", "v", "w")
+                velocity = np.r_[joint.part.fields["v"], joint.part.fields["w"]]
+                pat[np.ix_(velocity, node)] = True
+        for joint in self.rod_joints:  # each side: its node's velocity rows against the partner node
+            pat[np.ix_(joint.node + block_entries("v", "w"), joint.partner_fields)] = True
         return pat.tocsc()
 
     def atol_scale(self):

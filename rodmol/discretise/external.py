@@ -20,6 +20,8 @@ from ..loads import (
     N_PARAMS,  # noqa: F401 (the row width, read here by the system)
     P_DAMPING,
     P_FRICTION,
+    P_HELD_SPIN,
+    P_HELD_VELOCITY,
     P_RADIUS,
     P_SLIP,
     P_SMOOTHING,
@@ -123,13 +125,20 @@ def clamp_moment(quat, held, w, stiffness, damping):
 @jit
 def hold(kind, p, value, u, quat, r, v, w):
     """(force, moment) [N, N m], local, of a hold (rodmol.Hold) at a node of
-    pose (u, quat): held at p[0:3] + ``value`` (its rest position plus the
-    held displacement, global) and, for a clamp, at the orientation p[3:7]."""
+    pose (u, quat) moving with (v, w) (local): held at p[0:3] + ``value`` (its
+    rest position plus the held displacement, global) and, for a clamp, at the
+    orientation p[3:7]. The held point moves with the velocity and angular
+    velocity of the row's ``P_HELD_VELOCITY``, ``P_HELD_SPIN`` (global: zero
+    on the world, a body's for a joint of a system): the damping acts on the
+    velocities relative to it."""
     gap = sub(u, add((p[0], p[1], p[2]), value))
-    f = pin_force(to_local(r, gap), v, p[P_STIFFNESS], p[P_DAMPING])
+    held_v = (p[P_HELD_VELOCITY], p[P_HELD_VELOCITY + 1], p[P_HELD_VELOCITY + 2])
+    f = pin_force(to_local(r, gap), sub(v, to_local(r, held_v)), p[P_STIFFNESS], p[P_DAMPING])
     if kind != CLAMP:
         return f, (0.0, 0.0, 0.0)
-    return f, clamp_moment(quat, (p[3], p[4], p[5], p[6]), w, p[P_TURN_STIFFNESS], p[P_TURN_DAMPING])
+    held_w = (p[P_HELD_SPIN], p[P_HELD_SPIN + 1], p[P_HELD_SPIN + 2])
+    return f, clamp_moment(quat, (p[3], p[4], p[5], p[6]), sub(w, to_local(r, held_w)), p[P_TURN_STIFFNESS],
+                           p[P_TURN_DAMPING])
 
 
 @jit

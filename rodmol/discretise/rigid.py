@@ -1,10 +1,24 @@
 """Compiled physics of a system's free rigid bodies: the wrench of the rods
-clamped to a body and the body's Newton-Euler rates
-(:mod:`rodmol.discretise.assembly` says the frames and the equations)."""
+clamped to a body, the penalty joints' reactions and the body's Newton-Euler
+rates (:mod:`rodmol.discretise.assembly` says the frames and the equations)."""
 
 import numpy as np
 
-from .physics import add, cross, jit, quaternion_rate, rotation, scale, sub, to_global, to_local
+from ..loads import P_HELD_SPIN, P_HELD_VELOCITY
+from .external import hold
+from .layout import QUAT, U, V, W
+from .physics import (
+    add,
+    cross,
+    jit,
+    quaternion_product,
+    quaternion_rate,
+    rotation,
+    scale,
+    sub,
+    to_global,
+    to_local,
+)
 
 #: Entries of a body's parameter row: net mass [kg] (minus the displaced
 #: fluid), centre of mass (3) [m], drag coefficients (6), body frame.
@@ -88,3 +102,42 @@ def free_body_rates(state, params, rigid, inverse, gravity, force, torque, smoot
         out[i] = x_t[i]
     for i in range(4):
         out[3 + i] = q_t[i]
+
+
+@jit
+def joint_wrench(kind, row, value, y, node, body, point, turn):
+    """A penalty joint between the rod node whose element block starts at
+    ``y[node]`` and the point ``point`` [m] (body frame) of a body in the
+    state ``body`` (x, Q, v, w: origin [m] and quaternion, global;
+    velocities [m/s, rad/s], body frame), the section's held orientation
+    ``turn`` (quaternion, section to body frame).
+
+    Writes the held point's pose and motion into the hold's parameter
+    ``row`` (orientation, velocity and angular velocity, global) and its
+    displacement from the row's rest position into ``value`` (3,), where the
+    rod's kernel reads them (:func:`rodmol.discretise.external.hold`), and
+    returns the reaction on the body: the force and moment [N, N m] about
+    its origin, body frame, equal and opposite to the node's, the force
+    acting where the node is (so momentum and angular momentum are kept)."""
+    x_b = (body[0], body[1], body[2])
+    q_b = (body[3], body[4], body[5], body[6])
+    v_b, w_b = _row3(body, 7), _row3(body, 10)
+    r_b = rotation(q_b)
+    target = add(x_b, to_global(r_b, _row3(point, 0)))
+    for i in range(3):
+        value[i] = target[i] - row[i]
+    held = quaternion_product(q_b, (turn[0], turn[1], turn[2], turn[3]))
+    for i in range(4):
+        row[3 + i] = held[i]
+    velocity = to_global(r_b, add(v_b, cross(w_b, _row3(point, 0))))
+    spin = to_global(r_b, w_b)
+    for i in range(3):
+        row[P_HELD_VELOCITY + i] = velocity[i]
+        row[P_HELD_SPIN + i] = spin[i]
+    u = _row3(y, node + U)
+    quat = (y[node + QUAT], y[node + QUAT + 1], y[node + QUAT + 2], y[node + QUAT + 3])
+    r = rotation(quat)
+    f, m = hold(kind, row, (value[0], value[1], value[2]), u, quat, r, _row3(y, node + V), _row3(y, node + W))
+    force = scale(-1.0, to_local(r_b, to_global(r, f)))
+    moment = scale(-1.0, to_local(r_b, to_global(r, m)))
+    return force, add(moment, cross(to_local(r_b, sub(u, x_b)), force))

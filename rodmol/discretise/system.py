@@ -241,6 +241,12 @@ class SemiDiscrete:
         self.grid_loads = entries
 
     @property
+    def entry_params(self):
+        """The load entries' parameter rows (E, ``N_PARAMS``): the kernel's own
+        array (a system's penalty joints write their held points into it)."""
+        return self._entry_params
+
+    @property
     def inputs_vary(self):
         """True if an input changes with time or state: :meth:`update_inputs` then
         runs at every evaluation (else the inputs were read once)."""

@@ -6,12 +6,30 @@ Each rod gets its own exact block preconditioner
 velocities held at the state's; each body its block (I - gamma J_bb),
 inverted directly, J_bb by differences in the body's own entries: of the
 full right-hand side in its velocities (they move the rods' bases), of its
-own rates in its rotation, none in its position (no rate reads it). The joints' coupling blocks are left out: GMRES's
-products J v are differences of the full right-hand side, so it sees them,
-only converging in more iterations.
+own rates in its rotation and, if it has penalty joints (whose held points
+it moves), its position; no rate of a body without them reads its
+position. The tree joints' coupling blocks are left out: GMRES's products
+J v are differences of the full right-hand side, so it sees them, only
+converging in more iterations.
+
+A penalty joint between a rod node and a free body couples them as stiffly
+as it holds them: left out, GMRES needs hundreds of times the right-hand
+sides or fails. Its blocks are kept, and the free bodies with penalty
+joints are eliminated by their Schur complement: with N = I - gamma J split
+into the rods (r) and those bodies (b), N_rb holding each joint node's
+velocity rows against its body's entries and N_br the body's rows against
+the node's u, Q, v, w (both by differences), S = N_bb - N_br N_rr^-1 N_rb
+(dense, 13 rows per body) is formed at each setup from one rod solve per
+body column and joined rod; a solve is z_r' = N_rr^-1 r_r, z_b = S^-1
+(r_b - N_br z_r'), z_r = z_r' - N_rr^-1 N_rb z_b.
 """
 
 import numpy as np
+
+from .joints import block_entries
+
+#: A joint node's rows (its velocities) and columns (what the joint reads), within its element block.
+JOINT_ROWS, JOINT_COLUMNS = block_entries("v", "w"), block_entries("u", "Q", "v", "w")
 
 #: Relative step of the body blocks' differences, times each entry's scale.
 BODY_STEP = 1e-7
@@ -30,6 +48,13 @@ class SystemPreconditioner:
         self._inverse = {p.name: np.eye(p.layout.size) for p in self.bodies}
         self._field_of = {p.name: [f for f, n in p.layout.fields.items() for _ in range(n)] for p in self.bodies}
         self._out = np.empty(assembly.size)
+        self._scale, self.gamma = scale, np.nan
+        # The Schur complement's bodies (free, with penalty joints) and their offsets in S.
+        self.coupled = [p for p in self.bodies if p.body.free and p.joints]
+        self._offset = dict(zip((p.name for p in self.coupled), 13 * np.arange(len(self.coupled))))
+        self._rod_to_body = {id(j): np.zeros((len(JOINT_ROWS), 13)) for p in self.coupled for j in p.joints}
+        self._body_to_rod = {id(j): np.zeros((13, len(JOINT_COLUMNS))) for p in self.coupled for j in p.joints}
+        self._schur = np.eye(13 * len(self.coupled))
         self.jac_evals = self.setups = self.solves = 0
 
     def setup(self, t, y, fy, jok, jnew, gamma):
@@ -44,17 +69,23 @@ class SystemPreconditioner:
             z = np.array(y)
             for part in self.bodies:
                 assembly(t, y, self._out)  # the rods' stress at y (their Jacobians and other bodies moved it)
+                coupled = part in self.coupled
+                if coupled:
+                    self._joint_columns(part, t, y, fy, z)
                 jac, steps = self._jac[part.name], self._steps[part.name]
                 for j, index in enumerate(range(part.slice.start, part.slice.stop)):
                     field = self._field_of[part.name][j]
-                    if field == "x":  # no rate reads a body's position
+                    if field == "x" and not part.joints:  # no rate reads its position
                         continue
                     z[index] = y[index] + steps[j]
-                    if field == "Q":  # only the body's own rates read its rotation
+                    if field in ("x", "Q") and not coupled:  # of the rates kept, only the body's read its pose
                         assembly.body_rates(part, t, z, self._out)
-                    else:  # its velocities move the rods' bases
+                    else:  # its velocities move the rods' bases, its pose the joints' held points
                         assembly(t, z, self._out)
                     jac[:, j] = (self._out[part.slice] - fy[part.slice]) / steps[j]
+                    for joint in part.joints if coupled else ():
+                        rows = joint.node + JOINT_ROWS
+                        self._rod_to_body[id(joint)][:, j] = (self._out[rows] - fy[rows]) / steps[j]
                     z[index] = y[index]
             assembly(t, y, self._out)  # leave the rods as at y
             self.jac_evals += 1
@@ -63,7 +94,53 @@ class SystemPreconditioner:
             prec.factor(gamma)
         for part in self.bodies:
             self._inverse[part.name] = np.linalg.inv(np.eye(part.layout.size) - gamma * self._jac[part.name])
+        self.gamma = gamma
+        if self.coupled:
+            self._factor_schur(gamma)
         self.setups += 1
+
+    def _joint_columns(self, part, t, y, fy, z):
+        """The body's rows against each of its joint nodes' columns (N_br / -gamma), by differences of its rates."""
+        assembly = self.assembly
+        for joint in part.joints:
+            block = self._body_to_rod[id(joint)]
+            for c, index in enumerate(joint.node + JOINT_COLUMNS):
+                step = BODY_STEP * max(self._scale[index], 1e-300)
+                z[index] = y[index] + step
+                assembly.body_rates(part, t, z, self._out)
+                block[:, c] = (self._out[part.slice] - fy[part.slice]) / step
+                z[index] = y[index]
+
+    def _rod_solve(self, name, rows_values):
+        """N_rr^-1 of a right-hand side nonzero at joint rows only: [(joint, values (6,))] of rod ``name``."""
+        rhs = np.zeros(self.assembly.rods[name].size)
+        start = self.assembly.parts[name].start
+        for joint, values in rows_values:
+            rhs[joint.node - start + JOINT_ROWS] += values
+        return self.rods[name].apply(rhs)
+
+    def _factor_schur(self, gamma):
+        """S = N_bb - N_br N_rr^-1 N_rb over the coupled bodies, inverted."""
+        schur = np.zeros_like(self._schur)
+        for part in self.coupled:
+            o = self._offset[part.name]
+            schur[o:o + 13, o:o + 13] = np.eye(13) - gamma * self._jac[part.name]
+        for part in self.coupled:
+            o = self._offset[part.name]
+            by_rod = {}
+            for joint in part.joints:
+                by_rod.setdefault(joint.joint.rod, []).append(joint)
+            for rod, joints in by_rod.items():
+                start = self.assembly.parts[rod].start
+                for k in range(13):
+                    x = self._rod_solve(rod, [(j, -gamma * self._rod_to_body[id(j)][:, k]) for j in joints])
+                    for other in self.coupled:  # every body joined to this rod reads x at its joint nodes
+                        for joint in other.joints:
+                            if joint.joint.rod == rod:
+                                oo = self._offset[other.name]
+                                n_br = -gamma * self._body_to_rod[id(joint)]
+                                schur[oo:oo + 13, o + k] -= n_br @ x[joint.node - start + JOINT_COLUMNS]
+        self._schur = np.linalg.inv(schur)
 
     def solve(self, t, y, fy, r, z, gamma, delta, lr):
         """z = P^-1 r with the last factors."""
@@ -72,5 +149,24 @@ class SystemPreconditioner:
             sl = parts[name]
             prec.solve(t, y[sl], fy[sl], r[sl], z[sl], gamma, delta, lr)
         for part in self.bodies:
-            z[part.slice] = self._inverse[part.name] @ r[part.slice]
+            if part not in self.coupled:
+                z[part.slice] = self._inverse[part.name] @ r[part.slice]
+        if not self.coupled:
+            self.solves += 1
+            return
+        g = self.gamma
+        rhs = np.concatenate([r[part.slice] for part in self.coupled])
+        for part in self.coupled:
+            o = self._offset[part.name]
+            for joint in part.joints:
+                rhs[o:o + 13] -= -g * self._body_to_rod[id(joint)] @ z[joint.node + JOINT_COLUMNS]
+        z_b = self._schur @ rhs
+        by_rod = {}
+        for part in self.coupled:
+            o = self._offset[part.name]
+            z[part.slice] = z_b[o:o + 13]
+            for joint in part.joints:
+                by_rod.setdefault(joint.joint.rod, []).append((joint, -g * self._rod_to_body[id(joint)] @ z_b[o:o + 13]))
+        for rod, rows_values in by_rod.items():
+            z[parts[rod]] -= self._rod_solve(rod, rows_values)
         self.solves += 1

@@ -5,6 +5,7 @@ import numpy as np
 
 import rodmol
 from rodmol.discretise.assembly import Assembly
+from rodmol.discretise.system_preconditioner import SystemPreconditioner
 
 
 def _system():
@@ -14,10 +15,20 @@ def _system():
     head = rodmol.RigidBody(0.05, (2e-5, 3e-5, 4e-5), centre_of_mass=(0.0, 0.004, 0.0), volume=2e-5,
                             drag=(1, 2, 3, 0.1, 0.2, 0.3), added_mass=(0.01, 0.02, 0.03, 0, 0, 0))
     plate = rodmol.RigidBody(0.5, (1e-3, 1e-3, 1e-3), motion="fixed", position=(1.0, 0.0, 0.0))
+    # Penalty joints: a's tip clamped to a free payload, b's tip pinned to a fixed post, a node of c pinned
+    # to the world and its middle clamped to d's tip.
+    payload = rodmol.RigidBody(0.02, (1e-6, 2e-6, 3e-6), position=(0.21, 0.0, 0.0), centre_of_mass=(0.01, 0, 0))
+    post = rodmol.RigidBody(0.5, (1e-3, 1e-3, 1e-3), motion="fixed", position=(-0.22, 0.0, 0.0))
     joints = [rodmol.Joint(("head", (0.02, 0.0, 0.0)), ("a", "base")),
               rodmol.Joint(("head", (-0.02, 0.0, 0.0), np.diag([-1.0, -1.0, 1.0])), ("b", "base")),
-              rodmol.Joint(("plate", (0.0, 0.0, 0.0)), ("c", "base"))]
-    return rodmol.System({"a": arm, "b": arm, "c": arm}, {"head": head, "plate": plate}, joints,
+              rodmol.Joint(("plate", (0.0, 0.0, 0.0)), ("c", "base")),
+              rodmol.Joint(("payload", (0.01, 0.0, 0.0)), ("a", "tip")),
+              rodmol.Joint(("post", (0.0, 0.0, 0.0)), ("b", "tip"), kind="pin"),
+              rodmol.Joint("world", ("c", 0.05), kind="pin"),
+              rodmol.Joint(("d", "tip"), ("c", 0.1))]  # d rises from the world to c's middle
+    rise = rodmol.BaseMotion(position=(1.1, -0.2, 0.0), rotation=((0.0, -1.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0)))
+    return rodmol.System({"a": arm, "b": arm, "c": arm, "d": arm.replace(base=rise)},
+                         {"head": head, "plate": plate, "payload": payload, "post": post}, joints,
                          medium="water", gravity=(0.0, 0.0, -9.81))
 
 
@@ -25,9 +36,9 @@ def test_parts_tile_the_state_in_order():
     assembly = Assembly(_system())
     rod_size = assembly.rods["a"].size
     spans = [(s.start, s.stop) for s in assembly.parts.values()]
-    assert spans == [(0, rod_size), (rod_size, 2 * rod_size), (2 * rod_size, 3 * rod_size),
-                     (3 * rod_size, 3 * rod_size + 13), (3 * rod_size + 13, 3 * rod_size + 20)]
-    assert assembly.size == 3 * rod_size + 20 == len(assembly.atol_scale())
+    bodies = np.cumsum([4 * rod_size, 13, 7, 13, 7])
+    assert spans == [(k * rod_size, (k + 1) * rod_size) for k in range(4)] + list(zip(bodies[:-1], bodies[1:]))
+    assert assembly.size == bodies[-1] == len(assembly.atol_scale())
 
 
 def test_pattern_holds_every_nonzero_of_a_difference_jacobian():
@@ -51,3 +62,56 @@ def test_pattern_holds_every_nonzero_of_a_difference_jacobian():
     assert touched[first:first + 19, head["v"].start].any()  # the head carries the rod
     plate = assembly.bodies["plate"].fields
     assert not pattern[:, plate["x"]].any() and not pattern[plate["x"]].any()  # a fixed body stays
+    # The penalty joints: a's tip and the payload read each other; b's tip reads the post's pose.
+    payload, post = assembly.bodies["payload"].fields, assembly.bodies["post"].fields
+    tip_a = assembly.parts["a"].stop - assembly.rods["a"].layout.block
+    tip_b = assembly.parts["b"].stop - assembly.rods["b"].layout.block
+    assert touched[payload["v"].start:payload["w"].stop, tip_a:tip_a + 19].any()
+    assert touched[tip_a:tip_a + 19, payload["x"].start:payload["w"].stop].any()
+    assert touched[tip_b:tip_b + 19, post["x"].start:post["Q"].stop].any()
+    tip_d = assembly.parts["d"].stop - assembly.rods["d"].layout.block
+    middle_c = assembly.parts["c"].start + assembly.rods["c"].layout.header + assembly.rods["c"].layout.block
+    assert touched[tip_d:tip_d + 19, middle_c:middle_c + 19].any() and touched[middle_c:middle_c + 19, tip_d:tip_d + 19].any()
+
+
+def test_schur_preconditioner_inverts_the_newton_matrix_of_a_loop():
+    # Two arms from the world to one free bar, a ring on one arm's middle (bases on the world: no tree
+    # coupling is left out), the bar and the ring free bodies with penalty joints: the rods' exact blocks, the bar's block and the joints' blocks
+    # are all kept, so the preconditioner is the Newton matrix I - gamma J itself, to the error of its
+    # forward differences (on the joints' stiff terms: 3e-5 of each entry's scale here, 1e-9 without
+    # joints); without the joints' blocks (rods and bar each on their own) it is off by 100 times that.
+    mat = rodmol.Material(E=1e5, nu=0.5, mu=300.0, rho=1080.0)
+    rod = rodmol.Rod(0.2, radius=0.01, material=mat)
+    arms = {name: rodmol.Model(rod, 4, base=rodmol.BaseMotion(position=(0.0, y, 0.0))) for name, y in
+            (("a", 0.0), ("b", 0.04))}
+    bar = rodmol.RigidBody(0.02, (1e-5, 1e-5, 1e-5), position=(0.2, 0.0, 0.0), centre_of_mass=(0.0, 0.02, 0.0))
+    ring = rodmol.RigidBody(0.01, (1e-6, 1e-6, 1e-6), position=(0.1, 0.0, 0.0))  # on a's middle: S couples bodies
+    joints = [rodmol.Joint(("bar", (0.0, 0.0, 0.0)), ("a", "tip")),
+              rodmol.Joint(("bar", (0.0, 0.04, 0.0)), ("b", "tip"), kind="pin"),
+              rodmol.Joint(("ring", (0.0, 0.0, 0.0)), ("a", 0.1), kind="pin")]
+    assembly = Assembly(rodmol.System(arms, {"bar": bar, "ring": ring}, joints, gravity=(0.0, -9.81, 0.0)))
+    scale = assembly.atol_scale()
+    y = assembly.initial_state() + 1e-2 * np.random.default_rng(5).standard_normal(assembly.size) * scale
+    fy = assembly(0.0, y).copy()
+    jac = np.empty((assembly.size, assembly.size))
+    for j in range(assembly.size):
+        z, h = y.copy(), 1e-7 * scale[j]
+        z[j] += h
+        up = assembly(0.0, z).copy()
+        z[j] -= 2 * h
+        jac[:, j] = (up - assembly(0.0, z)) / (2 * h)
+    gamma = 1e-4
+    newton = np.eye(assembly.size) - gamma * jac
+    precond = SystemPreconditioner(assembly, scale)
+    precond.setup(0.0, y, fy, False, [0], gamma)
+    assert precond.coupled == [assembly.bodies["bar"], assembly.bodies["ring"]]
+    v = np.random.default_rng(6).standard_normal(assembly.size) * scale
+    r, z = newton @ v, np.empty_like(v)
+    precond.solve(0.0, y, fy, r, z, gamma, 0.0, 1)
+    error = np.abs((z - v) / scale).max()
+    assert error < 2e-4
+    apart = np.concatenate([precond.rods["a"].apply(r[assembly.parts["a"]]),
+                            precond.rods["b"].apply(r[assembly.parts["b"]]),
+                            *[np.linalg.solve(np.eye(13) - gamma * precond._jac[b], r[assembly.parts[b]])
+                              for b in ("bar", "ring")]])
+    assert np.abs((apart - v) / scale).max() > 100 * error

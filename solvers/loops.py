@@ -1,0 +1,151 @@
+"""Penalty joints of systems (rodmol.Joint at a rod's tip): the constraint drift and the cost against the penalty stiffness, and the linear solvers.
+
+Two systems whose loops close through penalty joints:
+
+* ``payload``: a slender cantilever (L = 1 m, r = 1 cm, E = 1 GPa, no
+  material damping) whose tip is clamped to a 0.3 kg payload, released
+  straight under a small weight (0.5 m/s^2 sideways): it swings for 1 s;
+* ``parallel robot``: three legs (L = 0.2 m, r = 5 mm, E = 200 MPa, Kelvin-Voigt
+  mu = 2 MPa s) clamped to the ground and, at their tips, to a free 0.5 kg
+  platform, released straight under gravity partly sideways; it settles in 1.5 s;
+* ``six legs``: the same with six legs (a Stewart-Gough layout, as in Till's
+  example) at a finer grid;
+* ``two half beams``: two cantilevers (L = 0.25 m, r = 1 cm, E = 10 MPa)
+  from opposite walls, their tips clamped to each other, released straight
+  under gravity (the sparse solver only: GMRES is refused for joints
+  between rods).
+
+For penalty stiffnesses k = factor E A / ds of the tip element (damping
+2 sqrt(k m), m = rho A ds, the Hold's default law), each system runs through
+``rodmol.simulate`` (CVODE, default tolerances) with the sparse direct
+solver and with GMRES and the block preconditioner (the free bodies with
+penalty joints eliminated by their Schur complement). The table gives the drift |u - x - R p| of
+each joint (max over the run and at the end, relative to L; between two
+rods, the nodes' distance), CVODE's
+right-hand sides and the solver's wall time, each also as a ratio to the same
+rods with free tips and no body (the joints' cost), measured in the same
+run, medians of --reps.
+
+    python solvers/loops.py [--quick | --smoke] [--out DIR] [--reps K]
+"""
+
+import _common as C
+from _common import np, rodmol
+
+from rodmol.holds import HOLD_STIFFNESS_FACTOR
+
+SCRIPT = "loops.py"
+UP = np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])  # a leg's x axis along global z
+
+
+def _stiffness(model, factor):
+    rod = model.rod
+    return factor * rod.material.E * float(rod.area(rod.length)) / model.ds
+
+
+def payload(n, factor, joined=True):
+    material = rodmol.Material(E=1e9, nu=0.5, mu=0.0, rho=1000.0)
+    beam = rodmol.Model(rodmol.Rod(1.0, radius=0.01, material=material), n)
+    if not joined:
+        return rodmol.System({"beam": beam}, gravity=(0.0, -0.5, 0.0))
+    body = rodmol.RigidBody(0.3, (1e-5, 2e-4, 2e-4), position=(1.0, 0.0, 0.0))
+    joint = rodmol.Joint(("payload", (0.0, 0.0, 0.0)), ("beam", "tip"), stiffness=_stiffness(beam, factor))
+    return rodmol.System({"beam": beam}, {"payload": body}, [joint], gravity=(0.0, -0.5, 0.0))
+
+
+def robot(n, factor, joined=True, legs=3):
+    points = np.array([[0.05 * np.cos(a), 0.05 * np.sin(a), 0.0] for a in 2 * np.pi * np.arange(legs) / legs + 0.3])
+    material = rodmol.Material(E=2e8, nu=0.5, mu=2e6, rho=1000.0)
+    leg = rodmol.Rod(0.2, radius=0.005, material=material)
+    legs = {f"leg{i}": rodmol.Model(leg, n, base=rodmol.BaseMotion(position=tuple(p), rotation=UP))
+            for i, p in enumerate(points)}
+    gravity = (-9.81, 0.0, -3.0)
+    if not joined:
+        return rodmol.System(legs, gravity=gravity)
+    body = rodmol.RigidBody(0.5, (1e-3, 1e-3, 2e-3), centre_of_mass=(0.02, 0.01, 0.0), position=(0.0, 0.0, 0.2))
+    stiffness = _stiffness(legs["leg0"], factor)
+    joints = [rodmol.Joint(("platform", tuple(p)), (f"leg{i}", "tip"), stiffness=stiffness)
+              for i, p in enumerate(points)]
+    return rodmol.System(legs, {"platform": body}, joints, gravity=gravity)
+
+
+def halves(n, factor, joined=True):
+    material = rodmol.Material(E=1e7, nu=0.5, mu=7e4, rho=1000.0)
+    half = rodmol.Rod(0.25, radius=0.01, material=material)
+    right = rodmol.BaseMotion(position=(0.5, 0.0, 0.0), rotation=np.diag([-1.0, -1.0, 1.0]))
+    rods = {"left": rodmol.Model(half, n), "right": rodmol.Model(half, n, base=right)}
+    if not joined:
+        return rodmol.System(rods, gravity=(0.0, -9.81, 0.0))
+    joint = rodmol.Joint(("left", "tip"), ("right", "tip"), stiffness=_stiffness(rods["left"], factor))
+    return rodmol.System(rods, joints=[joint], gravity=(0.0, -9.81, 0.0))
+
+
+PROBLEMS = {  # name: (system(n, factor, joined), t_end per mode, N per mode)
+    "payload": (payload, (1.0, 0.5, 0.05), (16, 16, 6)),
+    "parallel robot": (robot, (1.5, 0.75, 0.05), (16, 16, 6)),
+    "six legs": (lambda n, factor, joined=True: robot(n, factor, joined, legs=6), (1.5, 0.75, 0.05), (60, 40, 6)),
+    "two half beams": (halves, (0.3, 0.3, 0.05), (8, 8, 4)),
+}
+
+
+def _node(run, system, rod, load):
+    model = system.rods[rod]
+    return run[rod].integrated_positions[:, int(round(model.loads[load].s / model.ds))]
+
+
+def drift(run, system):
+    """Max over the joints of |u - x - R p| (or |u_a - u_b| between two rods) [m] at each frame."""
+    gaps = []
+    for joint in system.penalty_joints:
+        if joint.partner is not None:
+            gaps.append(np.linalg.norm(_node(run, system, joint.rod, joint.load)
+                                       - _node(run, system, joint.partner, joint.partner_load), axis=1))
+            continue
+        body = run[joint.body]
+        held = body.position + np.einsum("tij,j->ti", body.rotation, joint.point)
+        gaps.append(np.linalg.norm(_node(run, system, joint.rod, joint.load) - held, axis=1))
+    return np.max(gaps, axis=0)
+
+
+def timed(system, t_end, reps, **options):
+    walls = []
+    for _ in range(reps):
+        run = rodmol.simulate(system, t_end, output_dt=t_end / 50, **options)
+        walls.append(run.stats["wall_time_s"])
+    return run, float(np.median(walls))
+
+
+def main(argv=None):
+    args = C.parse_args(__doc__.splitlines()[0], argv)
+    header = C.header_lines(args, SCRIPT)
+    factors = C.pick(args, (1.0, 10.0, 100.0, 1e3, 1e4, 1e5), (1.0, 100.0, 1e4), (100.0,))
+    rows = []
+    for name, (build, t_ends, sizes) in PROBLEMS.items():
+        t_end, n = C.pick(args, *t_ends), C.pick(args, *sizes)
+        free = build(n, None, joined=False)
+        rodmol.simulate(build(n, HOLD_STIFFNESS_FACTOR), t_end / 10)  # compile, warm
+        run_free, wall_free = timed(free, t_end, args.reps)
+        solvers = ("sparse",) if name == "two half beams" else ("gmres", "sparse")  # GMRES refuses rod-rod joints
+        cases = [(f, solver) for f in factors for solver in solvers]
+        for factor, solver in cases:
+            system = build(n, factor)
+            run, wall = timed(system, t_end, args.reps, linsolver=solver)
+            gap = drift(run, system) / system.rods[next(iter(system.rods))].rod.length
+            rows.append(dict(
+                problem=name, N=n, factor=factor, default=factor == HOLD_STIFFNESS_FACTOR, linear_solver=solver,
+                success=run.success, t_reached_s=float(run.t[-1]), max_drift_over_L=float(gap.max()),
+                end_drift_over_L=float(gap[-1]), rhs=run.stats["rhs_evals"],
+                rhs_over_free=run.stats["rhs_evals"] / run_free.stats["rhs_evals"], solver_s=wall,
+                solver_over_free=wall / wall_free))
+            print({k: (f"{v:.4g}" if isinstance(v, float) else v) for k, v in rows[-1].items()}, flush=True)
+
+    formats = dict(factor="g", t_reached_s=".3g", max_drift_over_L=".2e", end_drift_over_L=".2e",
+                   rhs_over_free=".2f", solver_s=".3f", solver_over_free=".2f")
+    C.write_results(args, "loops", "Penalty joints of systems: drift and cost against the penalty stiffness",
+                    header, rows, [
+                        ("k = factor E A / ds, damping 2 sqrt(k m); ratios to the same rods with free tips "
+                         "and no body, same run, same linear solver default", C.markdown_table(rows, formats=formats))])
+
+
+if __name__ == "__main__":
+    main()
