@@ -22,7 +22,6 @@ from ..loads import (
 )
 from .layout import StateLayout
 from .rotations import from_matrix
-from .schemes import DEFAULT_SCHEME
 from .undeformed import undeformed_state
 
 
@@ -97,13 +96,14 @@ def _held_entries(load, s_nodes, rest):
     return np.array([node]), np.array([1.0 / ds]), row, lambda t: shift
 
 
-def rest_nodes(model, scheme=DEFAULT_SCHEME):
+def rest_nodes(model, undeformed=None):
     """What holds read at the nodes 0..N of ``model`` at rest in its rest shape
-    (on the cells of ``scheme``): the pose (``u`` [m], ``Q``, global), E A / ds
-    [N/m] (``axial_stiffness``), the node's mass rho A ds [kg] and the section
+    (``undeformed``, its undeformed state; by default on the centred scheme's
+    cells): the pose (``u`` [m], ``Q``, global), E A / ds [N/m]
+    (``axial_stiffness``), the node's mass rho A ds [kg] and the section
     ``radius`` [m]."""
     s, layout = model.s_nodes, StateLayout(model.n_elements)
-    y = undeformed_state(model, scheme)
+    y = undeformed_state(model) if undeformed is None else undeformed
     u = layout.integrated_positions(y)
     quat = layout.quaternions(y)
     area = model.rod.area(s)
@@ -164,10 +164,11 @@ def on_grid(loads, s_nodes, radius, rest=None):
                     timed)
 
 
-def of_model(model, scheme=DEFAULT_SCHEME):
-    """The model's loads on its grid (holds read its rest shape on the cells of ``scheme``)."""
+def of_model(model, undeformed=None):
+    """The model's loads on its grid (holds read its rest shape from ``undeformed``,
+    the model's undeformed state; by default on the centred scheme's cells)."""
     held = any(load.spread == "node" for load in model.loads)
-    rest = rest_nodes(model, scheme) if held else None
+    rest = rest_nodes(model, undeformed) if held else None
     return on_grid(model.loads, model.s_nodes, model.rod.radius_at(model.s_nodes), rest)
 
 

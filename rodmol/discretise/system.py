@@ -19,7 +19,7 @@ from . import centreline, external, load_entries, rotations, stencil
 from .layout import StateLayout, merge
 from .physics import compile_signatures
 from .routing import CableRouting
-from .sampling import Sampled, cell_properties, rest_strains
+from .sampling import Sampled, cell_properties
 from .schemes import DEFAULT_SCHEME, get_scheme
 from .undeformed import undeformed_state
 
@@ -176,8 +176,9 @@ class SemiDiscrete:
         self.node_lengths = self.scheme.node_lengths(m.n_elements, m.ds)
         self.sampled = sampled = Sampled(m)
         self.cells = cell_properties(m, s_cells)
+        self._undeformed = undeformed_state(m, self.scheme)
         #: The rest strains (q*, k*) of the cells, each (N, 3), local frame [-, 1/m].
-        self.rest = rest_strains(m, s_cells)
+        self.rest = tuple(self.layout.field(self._undeformed, f) for f in ("q", "k"))
         self._params = stencil.pack_params(*self.cells, sampled.mass, sampled.inertia, sampled.net_mass,
                                            sampled.drag_coefficient, sampled.added, *self.rest)
         self._consts = np.zeros(stencil.N_CONSTS)
@@ -229,7 +230,7 @@ class SemiDiscrete:
         self.read_held(0.0)
 
     def _setup_loads(self):
-        entries = load_entries.of_model(self.model, self.scheme)
+        entries = load_entries.of_model(self.model, self._undeformed)
         self._kinds = np.ascontiguousarray(entries.kind, dtype=np.int64)
         self._nodes = np.ascontiguousarray(entries.node - 1, dtype=np.int64)  # element blocks
         # A point load's share of a node is spread over the node's own length.
@@ -328,7 +329,7 @@ class SemiDiscrete:
 
     def undeformed_state(self):
         """The unloaded rod at rest in its rest shape, on this system's cells (:func:`undeformed_state`)."""
-        return undeformed_state(self.model, self.scheme)
+        return self._undeformed.copy()
 
     # ------------------------------------------------------------------ evaluation
 
