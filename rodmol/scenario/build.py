@@ -10,11 +10,12 @@ from .. import _checks, scenarios
 from ..arm import LENGTH as PAPER_LENGTH
 from ..arm import paper_arm
 from ..discretise.schemes import DEFAULT_SCHEME, get_scheme
+from ..discretise.system import SemiDiscrete
 from ..errors import ParameterError
 from ..model import Model
 from ..output.options import OutputOptions
 from ..run_spec import RunSpec
-from ..simulate import DEFAULT_BACKEND, INITIAL, OUTPUT_DT, check_run
+from ..simulate import DEFAULT_BACKEND, INITIAL, OUTPUT_DT, check_run, fit
 from ..solve import options as run_options
 from . import arm as arm_tables
 from . import tables
@@ -162,8 +163,10 @@ def _check_solver(ctx, solver, t_end, n_elements):
         stand_in, sized = paper_arm(n_elements), True
     except ParameterError:
         stand_in, sized = paper_arm(2), False
-    run = ctx.construct(path, lambda **kw: check_run(stand_in, t0=None, scheme=scheme, progress=None,
-                                                    backend_options={}, **{"max_wall_time": None, **kw}),
+    system = SemiDiscrete(stand_in, get_scheme(scheme))  # (sizes the state; compiles nothing)
+    run = ctx.construct(path, lambda **kw: fit(check_run(t0=None, scheme=scheme, progress=None,
+                                                         backend_options={}, **{"max_wall_time": None, **kw}),
+                                               system),
                         options, given=table, keys=tuple(options))
     if t_end is None or t_end is FAILED:
         return FAILED  # (recorded)
@@ -172,7 +175,7 @@ def _check_solver(ctx, solver, t_end, n_elements):
     if failed(run, t_end, output_dt) or not sized:
         return FAILED if failed(run, t_end, output_dt) else run
     try:
-        run_options.output_count(t_end, output_dt, run.layout.size)
+        run_options.output_count(t_end, output_dt, system.size)
     except ParameterError as exc:
         # The message opens with t_end: its line, unless only output_dt was written here.
         ctx.add(path + (("output_dt",) if "output_dt" in table and "t_end" not in table else ("t_end",)),
