@@ -28,11 +28,12 @@ from pathlib import Path
 from .._files import output_directory
 from .._progress import Progress
 from .._version import __version__
-from ..errors import ParameterError
+from ..errors import NotSupportedYet, ParameterError
 from ..output import h5result
 from ..output.formats import FORMATS, get_format
 from ..output.lock import OutputLock
 from ..output.run_files import cannot_write
+from ..systems import System
 from .options import EXAMPLES, add_run_options, load_spec
 
 EXIT_FAILED, EXIT_USAGE, EXIT_OUTPUT, EXIT_INTERRUPTED = 1, 2, 3, 130
@@ -100,6 +101,10 @@ class _Parser(argparse.ArgumentParser):
 
 def _run(args):
     spec = load_spec(args)
+    if isinstance(spec.model, System):
+        raise NotSupportedYet(f"{spec.source} describes a system: `rodmol run` cannot write its results yet "
+                              "(result files of systems are not supported yet); run it from Python, "
+                              "rodmol.load_scenario(path).simulate()")
     out = args.out or spec.output.directory or Path("out") / spec.name
     output_directory(out, "--out")  # before the run, so a directory that cannot be made does not waste it
     with OutputLock(out):  # one run per output directory
