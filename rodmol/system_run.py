@@ -1,16 +1,18 @@
 """A run of a :class:`rodmol.System` (rods and rigid bodies), reached through
-:func:`rodmol.simulate`: in memory, from rest, with CVODE.
+:func:`rodmol.simulate`: in memory, from rest, with CVODE; with ``out=DIR``
+its files are written once it ended (:mod:`rodmol.output.system_files`,
+through :func:`rodmol.run_sinks.system_writer`).
 
 Not yet for systems (each raises :class:`rodmol.errors.NotSupportedYet`):
-the equilibrium start, streamed output (``out``), ``resume``, ``overwrite``
-and the other backends. ``progress`` is reported at the output times only.
+the equilibrium start, streaming while the run goes, ``resume`` and the
+other backends. ``progress`` is reported at the output times only.
 """
 
 import warnings
 
 import numpy as np
 
-from . import _checks
+from . import _checks, run_sinks
 from .discretise.assembly import Assembly
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
 from .errors import NotSupportedYet, ParameterError
@@ -30,9 +32,10 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
     SystemResult (at its last time unless ``t0`` is given); the other
     arguments as for :func:`rodmol.simulate`. Returns a
     :class:`rodmol.system_result.SystemResult`."""
-    for name, value, unset in (("out", out, None), ("resume", resume, False), ("overwrite", overwrite, False)):
-        if value is not unset:
-            raise NotSupportedYet(f"`{name}` is not supported yet for systems (in-memory runs only)")
+    if resume is not False:
+        raise NotSupportedYet("`resume` is not supported yet for systems (their files are written after the run)")
+    if out is None and overwrite is not False:
+        raise ParameterError("`overwrite` needs `out`")
     if isinstance(initial, str) and initial == "equilibrium":
         raise NotSupportedYet("`initial='equilibrium'` is not supported yet for systems: use 'straight'")
     if backend not in (None, "cvode"):
@@ -60,6 +63,7 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
     atol = rtol * assembly.atol_scale() if atol is None else _sized("atol", atol, assembly.size)
     if np.any(atol <= 0):
         raise ParameterError("`atol` must be > 0")
+    writer = None if out is None else run_sinks.system_writer(out, overwrite=bool(overwrite))
     owned = progress is True
     if owned:
         from ._progress import Progress
@@ -74,7 +78,10 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
             progress.close()
     if not success:
         warnings.warn(message, RuntimeWarning, stacklevel=3)
-    return SystemResult(assembly, t, y, success, message, stats, error)
+    result = SystemResult(assembly, t, y, success, message, stats, error)
+    if writer is not None:
+        writer(result)
+    return result
 
 
 def _sized(name, value, size, scalar=True):
