@@ -12,7 +12,7 @@ A system's run directory (``simulate(system, ..., out=DIR)``,
   the shown frames (``KEY_points``, global);
 * ``bodies.xdmf``: the bodies for ParaView, one temporal collection each,
   drawn as their mesh (:meth:`rodmol.RigidBody.from_mesh`) or, without one, as
-  the box of uniform density with their mass and inertia, at their pose;
+  the ellipsoid of uniform density with their mass and inertia, at their pose;
 * a folder per rod, named after it: that rod's run directory exactly as a
   single rod's (``result.h5``, ``rod.xdmf``, ``cables.xdmf``, ``markers.xdmf``;
   :mod:`rodmol.output.stream`).
@@ -42,17 +42,17 @@ FORMAT = "rodmol-system"
 BODY_FIELDS = ("position", "quaternion", "velocity", "angular_velocity")
 #: A drawn body's surface, body frame: points [m] and triangles (:func:`body_surface`).
 SURFACE = ("surface_points", "surface_triangles")
-#: The 12 triangles of a box on its corners (index = 4 x + 2 y + z), normals outward.
-BOX_TRIANGLES = np.array([(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1),
-                          (2, 3, 7), (2, 7, 6), (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)])
+#: Rings and meridians of the drawn ellipsoid.
+RINGS, MERIDIANS = 16, 32
 
 
 def body_surface(body):
     """The surface drawing ``body``: (points (n, 3) [m], body frame; triangles (m, 3)).
 
-    Its mesh file if it has one; else the box of uniform density with its
-    mass m and inertia (principal values I_i along the principal axes, about
-    the centre of mass): edge a_i = sqrt(6 (I_j + I_k - I_i) / m).
+    Its mesh file if it has one; else the ellipsoid of uniform density with
+    its mass m and inertia (principal values I_i along the principal axes,
+    about the centre of mass): semi-axes a_i = sqrt(5 (I_j + I_k - I_i) / (2 m))
+    (a sphere's inertia gives the sphere).
     """
     if body.mesh is not None:
         import meshio
@@ -61,9 +61,20 @@ def body_surface(body):
         triangles = np.concatenate([block.data for block in mesh.cells if block.type == "triangle"])
         return np.asarray(mesh.points, dtype=float)[:, :3], triangles.astype(np.int64)
     values, axes = np.linalg.eigh(body.inertia)
-    edges = np.sqrt(np.maximum(6.0 * (values.sum() - 2.0 * values) / body.mass, 1e-30))
-    signs = np.array([(x, y, z) for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)])
-    return body.centre_of_mass + (signs * edges) @ axes.T, BOX_TRIANGLES.copy()
+    semi = np.sqrt(np.maximum(2.5 * (values.sum() - 2.0 * values) / body.mass, 1e-30))
+    polar = np.linspace(0.0, np.pi, RINGS + 1)[1:-1]
+    around = np.linspace(0.0, 2.0 * np.pi, MERIDIANS, endpoint=False)
+    ring = np.stack([np.outer(np.sin(polar), np.cos(around)), np.outer(np.sin(polar), np.sin(around)),
+                     np.outer(np.cos(polar), np.ones(MERIDIANS))], axis=-1).reshape(-1, 3)
+    unit = np.vstack([[0.0, 0.0, 1.0], ring, [0.0, 0.0, -1.0]])
+    j = np.arange(MERIDIANS)
+    triangles = [np.stack([np.zeros(MERIDIANS, int), 1 + j, 1 + (j + 1) % MERIDIANS], axis=1)]
+    for r in range(RINGS - 2):
+        a, b = 1 + r * MERIDIANS + j, 1 + r * MERIDIANS + (j + 1) % MERIDIANS
+        triangles += [np.stack([a, a + MERIDIANS, b], axis=1), np.stack([b, a + MERIDIANS, b + MERIDIANS], axis=1)]
+    last = 1 + (RINGS - 2) * MERIDIANS
+    triangles.append(np.stack([last + j, np.full(MERIDIANS, len(unit) - 1), last + (j + 1) % MERIDIANS], axis=1))
+    return body.centre_of_mass + (unit * semi) @ axes.T, np.vstack(triangles).astype(np.int64)
 
 
 def surface_of(result, name):
