@@ -29,7 +29,7 @@ HEAD_RADIUS = 0.05  # m
 RING = 0.6  # the arms leave the head on the circle 0.6 of its radius below its centre
 TILT = np.radians(8.0)  # the arms leave the head this far below the horizontal
 FLOOR = -RING * HEAD_RADIUS - LENGTH * np.sin(TILT) - TIP_RADIUS  # m, global z: the straight tips touch it
-SETTLE = 1.5  # s at rest before the crawl
+SETTLE = 2.5  # s at rest before the crawl
 PERIOD = 0.5  # s, one crawl cycle
 PULL = 2.0  # N, the largest tension
 CYCLES = 8  # crawl cycles in the run below
@@ -48,7 +48,7 @@ def head():
 
 def floor():
     """The sea floor, z = FLOOR: a stiff, damped penalty with Coulomb friction."""
-    return rodmol.PlaneContact(point=(0.0, 0.0, FLOOR), normal=(0.0, 0.0, 1.0), stiffness=2e3, damping=100.0,
+    return rodmol.PlaneContact(point=(0.0, 0.0, FLOOR), normal=(0.0, 0.0, 1.0), stiffness=2e3, damping=300.0,
                                friction=0.6, slip_speed=2e-3, name="floor")
 
 

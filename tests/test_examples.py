@@ -51,3 +51,31 @@ def test_reach_policies_records_an_episode(tmp_path):
     assert runs["proportional"][2] < 0.5 * runs["proportional"][1]
     assert runs["proportional"][0] > runs["random"][0]
     assert (tmp_path / "episode_0001" / "rod.xdmf").is_file()
+
+
+def test_the_octopus_rests_on_the_floor_and_crawls_forward():
+    """examples/octopus.py at N = 10: the octopus settles, held above the floor by its
+    arms, straight (the arms' symmetry), the floor carrying its weight less its
+    buoyancy; then the crawl moves the head forward (+x) and not sideways."""
+    import importlib.util
+
+    import numpy as np
+
+    import rodmol
+
+    spec = importlib.util.spec_from_file_location("octopus_example", EXAMPLES / "octopus.py")
+    octopus = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(octopus)
+    system = octopus.octopus(10)
+    result = rodmol.simulate(system, octopus.SETTLE + 2 * octopus.PERIOD, output_dt=0.05)
+    assert result.success
+    head, rest = result["head"], np.searchsorted(result.t, octopus.SETTLE)
+    assert np.linalg.norm(head.velocity[rest]) < 5e-3  # m/s: settled (measured 2.2e-3)
+    assert np.all(np.abs(head.position[rest, :2]) < 1e-6)  # straight down, by the symmetry
+    assert octopus.FLOOR < head.position[rest, 2] - octopus.HEAD_RADIUS < octopus.FLOOR + 0.01  # just above
+    floor = sum((result[name].external_force[rest, :, 2] * result[name].node_length).sum() for name in result.rods)
+    # The floor carries the weight less the buoyancy (from the parts' volumes); measured
+    # 0.616 N against 0.705 N at N = 10 and 0.651 N at N = 30 (docs/systems.md).
+    assert floor == pytest.approx(octopus.net_weight(system), rel=0.15)
+    moved = head.position[-1] - head.position[rest]
+    assert moved[0] > 2e-3 and abs(moved[1]) < 1e-6  # m in two cycles (measured 3.9 mm)
