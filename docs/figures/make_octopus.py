@@ -11,8 +11,20 @@ the head from bodies.xdmf, the sea floor as a plane.
 import os
 import sys
 
-from paraview.simple import (ColorBy, CreateView, ExtractSurface, GetColorTransferFunction, LoadPalette, Plane,
-                             Render, SaveScreenshot, Show, Text, Tube, Xdmf3ReaderS)
+from paraview.simple import (
+    ColorBy,
+    CreateView,
+    ExtractSurface,
+    GetColorTransferFunction,
+    LoadPalette,
+    Plane,
+    Render,
+    SaveScreenshot,
+    Show,
+    Text,
+    Tube,
+    Xdmf3ReaderS,
+)
 
 directory, png = os.path.abspath(sys.argv[1]), sys.argv[2]
 t = float(sys.argv[3]) if len(sys.argv) > 3 else 6.5
@@ -40,7 +52,7 @@ floor = Plane(registrationName="floor", Origin=[-0.55, -0.55, FLOOR], Point1=[0.
               Point2=[-0.55, 0.55, FLOOR])
 ground = Show(floor, view)
 ground.DiffuseColor, ground.Opacity = [0.76, 0.70, 0.55], 0.8
-Show(Text(registrationName="time", Text="t = %.2f s" % t), view).FontSize = 14
+Show(Text(registrationName="time", Text=f"t = {t:.2f} s"), view).FontSize = 14
 
 view.CameraPosition = [0.55, -0.75, 0.42]
 view.CameraFocalPoint = [0.02, 0.0, -0.06]
