@@ -101,14 +101,37 @@ class _Parser(argparse.ArgumentParser):
 
 def _run(args):
     spec = load_spec(args)
-    if isinstance(spec.model, System):
-        raise NotSupportedYet(f"{spec.source} describes a system: `rodmol run` cannot write its results yet "
-                              "(result files of systems are not supported yet); run it from Python, "
-                              "rodmol.load_scenario(path).simulate()")
     out = args.out or spec.output.directory or Path("out") / spec.name
     output_directory(out, "--out")  # before the run, so a directory that cannot be made does not waste it
     with OutputLock(out):  # one run per output directory
+        if isinstance(spec.model, System):
+            return _run_system(args, spec, out)
         return _run_locked(args, spec, out)
+
+
+def _run_system(args, spec, out):
+    """``rodmol run`` of a system file: the run, then its files (written once it ended)."""
+    if args.resume or args.resume_anyway:
+        raise NotSupportedYet("`--resume` is not supported yet for systems (their files are written after "
+                              "the run)")
+    if (args.format or spec.output.format) != "xdmf":
+        raise ParameterError("a system's run is written as `--format xdmf` only")
+    say = (lambda *a, **k: None) if args.quiet else print
+    system = spec.model
+    say(f"rodmol: {spec.name}: {len(system.rods)} rods, {len(system.bodies)} bodies, t_end = {spec.t_end:g} s, "
+        f"{spec.solver['scheme']} scheme -> {out}")
+    progress = None if args.quiet else Progress(stream=sys.stdout)
+    started = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # the summary gives the message
+        result = spec.simulate(progress=progress, out=out, overwrite=args.overwrite)
+    if progress:
+        progress.close()
+    state = "finished" if result.success else f"failed: {result.message}"
+    print(f"rodmol: {spec.name}: {state}; {len(result.t)} output frames to t = {result.t[-1]:g} s in "
+          f"{time.perf_counter() - started:.3g} s, written to {out} (open bodies.xdmf and NAME/rod.xdmf)",
+          file=sys.stdout if result.success else sys.stderr)
+    return 0 if result.success else EXIT_FAILED
 
 
 def _run_locked(args, spec, out):

@@ -184,7 +184,7 @@ class SystemWriter:
     def __init__(self, directory, *, overwrite):
         self.directory = output_directory(directory, "out")
         refuse_replacing(self.directory, overwrite, "`resume` (not supported yet for systems)",
-                         "`overwrite=True`")
+                         "`overwrite=True` (`--overwrite`)")
 
     def __call__(self, result):
         return write_system(result, self.directory)
