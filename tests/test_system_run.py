@@ -155,7 +155,7 @@ def test_progress_sees_every_output_and_the_wall_time_budget_stops_the_run():
 
 
 @pytest.mark.parametrize("kwargs, match", [
-    (dict(out="somewhere"), "`out` is not supported yet"),
+    (dict(resume=True), "`resume` is not supported yet"),
     (dict(initial="equilibrium"), "equilibrium"),
     (dict(backend="rk23"), "rk23"),
     (dict(linsolver="band"), "linsolver"),
