@@ -4,8 +4,8 @@ its files are written once it ended (:mod:`rodmol.output.system_files`,
 through :func:`rodmol.run_sinks.system_writer`).
 
 Not yet for systems (each raises :class:`rodmol.errors.NotSupportedYet`):
-the equilibrium start, streaming while the run goes, ``resume`` and the
-other backends. ``progress`` is reported at the output times only.
+the equilibrium start with a free body, streaming while the run goes,
+``resume`` and the other backends. ``progress`` is reported at the output times only.
 """
 
 import warnings
@@ -17,6 +17,7 @@ from .discretise.assembly import Assembly
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
 from .errors import NotSupportedYet, ParameterError
 from .solve import options
+from .solve.equilibrium import equilibrium
 from .solve.system_cvode import cvode_system
 from .system_result import SystemResult
 
@@ -27,7 +28,9 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
                     output_dt=None, output_times=None, t0=None, progress=None, max_wall_time=None,
                     out=None, resume=False, overwrite=False, **backend_options):
     """Integrate ``system`` from rest (``initial="straight"``: every rod
-    straight at its base, every body at rest at its pose), from a state
+    straight at its base, every body at rest at its pose), from its static
+    equilibrium (``"equilibrium"``, bodies fixed or driven only:
+    :func:`rodmol.solve.equilibrium.system_rest_state`), from a state
     vector (``SystemResult.states[k]``) or from the last frame of an earlier
     SystemResult (at its last time unless ``t0`` is given); the other
     arguments as for :func:`rodmol.simulate`. Returns a
@@ -36,8 +39,6 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
         raise NotSupportedYet("`resume` is not supported yet for systems (their files are written after the run)")
     if out is None and overwrite is not False:
         raise ParameterError("`overwrite` needs `out`")
-    if isinstance(initial, str) and initial == "equilibrium":
-        raise NotSupportedYet("`initial='equilibrium'` is not supported yet for systems: use 'straight'")
     if backend not in (None, "cvode"):
         raise NotSupportedYet(f"`backend` {backend!r} is not supported yet for systems: use 'cvode'")
     checked = options.backend_options("cvode", cvode_system, backend_options)
@@ -56,8 +57,11 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
     t_out = options.output_times(t0, t_end, output_dt, output_times, assembly.size)
     if initial is None or (isinstance(initial, str) and initial == "straight"):
         y0 = assembly.initial_state()
+    elif isinstance(initial, str) and initial == "equilibrium":  # bodies fixed or driven only
+        y0 = equilibrium(assembly, t0)
     elif isinstance(initial, str):
-        raise ParameterError(f"unknown `initial` {_checks.short(initial)}; use 'straight' or a state")
+        raise ParameterError(f"unknown `initial` {_checks.short(initial)}; use 'straight', 'equilibrium' "
+                             "or a state")
     else:
         y0 = _sized("initial", initial, assembly.size, scalar=False)
     atol = rtol * assembly.atol_scale() if atol is None else _sized("atol", atol, assembly.size)
