@@ -128,8 +128,6 @@ def read_system(directory):
     """The :class:`SystemResult` of a system's run directory (its rods read on first access)."""
     import h5py
 
-    from .formats import load_result
-
     directory = Path(directory)
     path = directory / INDEX
     try:
@@ -143,7 +141,8 @@ def read_system(directory):
                       for key in info["bodies"].values()}
     except (OSError, KeyError, ValueError) as exc:
         raise h5result.damaged(path, exc) from exc
-    rods = {name: (lambda key=key: load_result(directory / key)) for name, key in info["rods"].items()}
+    rods = {name: (lambda key=key: h5result.read_result(directory / key / h5result.INDEX))
+            for name, key in info["rods"].items()}
     bodies = {name: (lambda key=key: _body(t, fields[key])) for name, key in info["bodies"].items()}
     return SystemResult(None, t, states, info["success"], info["message"], info["stats"], saved=(rods, bodies))
 
