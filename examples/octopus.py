@@ -10,9 +10,10 @@ the floor; then it crawls: in each cycle the three front arms curl down
 (cable 2, below the centreline), so that their tips, held on the floor by
 friction, drag the head forward (+x), then curl up (cable 4) and straighten
 again above the floor. The system is built in Python here; docs/systems.md
-shows the picture, and tests/test_examples.py checks that the resting
-octopus is held by the floor (the contact forces balance the weight less the
-buoyancy), symmetric, and that the crawl moves it forward.
+shows the picture and the measured numbers, and tests/test_examples.py
+checks that the resting octopus is held just above the floor by its arms,
+symmetric, that the floor carries its weight less its buoyancy (to first
+order in ds: docs/systems.md), and that the crawl moves it forward.
 
     python examples/octopus.py [OUT_DIR]
 """
@@ -29,7 +30,7 @@ HEAD_RADIUS = 0.05  # m
 RING = 0.6  # the arms leave the head on the circle 0.6 of its radius below its centre
 TILT = np.radians(8.0)  # the arms leave the head this far below the horizontal
 FLOOR = -RING * HEAD_RADIUS - LENGTH * np.sin(TILT) - TIP_RADIUS  # m, global z: the straight tips touch it
-SETTLE = 2.5  # s at rest before the crawl
+SETTLE = 4.0  # s at rest before the crawl
 PERIOD = 0.5  # s, one crawl cycle
 PULL = 2.0  # N, the largest tension
 CYCLES = 8  # crawl cycles in the run below

@@ -2,7 +2,7 @@
 
     python examples/octopus.py out/octopus
     xvfb-run -a -s "-screen 0 1280x1024x24" pvpython docs/figures/make_octopus.py out/octopus \\
-        docs/figures/octopus.png 6.5
+        docs/figures/octopus.png 8.0
 
 Each arm's rod.xdmf as a tube of its true radius coloured by its curvature,
 the head from bodies.xdmf, the sea floor as a plane.
@@ -27,7 +27,7 @@ from paraview.simple import (
 )
 
 directory, png = os.path.abspath(sys.argv[1]), sys.argv[2]
-t = float(sys.argv[3]) if len(sys.argv) > 3 else 6.5
+t = float(sys.argv[3]) if len(sys.argv) > 3 else 8.0
 FLOOR = float(sys.argv[4]) if len(sys.argv) > 4 else -0.0922  # examples/octopus.py's FLOOR [m]
 view = CreateView("RenderView")
 view.ViewSize = [1200, 700]
