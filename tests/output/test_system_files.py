@@ -87,3 +87,17 @@ def test_plot_draws_every_part(written, tmp_path):
     result, _ = written
     paths = plot(result, tmp_path)
     assert len(paths) == 3 and all(p.stat().st_size > 10_000 for p in paths)
+
+
+def test_render_draws_every_rod_and_body(written, tmp_path):
+    pytest.importorskip("pyvista")
+    from PIL import Image
+
+    from rodmol.output.pictures import render
+
+    _, out = written
+    (png,) = render(rodmol.load_result(out), tmp_path, size=(320, 240), frames=0)
+    pixels = np.asarray(Image.open(png).convert("RGB"), dtype=float)
+    body = np.all(np.abs(pixels - (0.8 * 255, 0.55 * 255, 0.35 * 255)) < 60, axis=-1).mean()  # the head's colour
+    drawn = np.any(np.abs(pixels - pixels[0, 0]) > 30, axis=-1).mean()
+    assert body > 0.002 and drawn > body + 0.01  # the head, and the rods besides
