@@ -5,6 +5,7 @@ importing the floors above it. The sink protocol is
 :mod:`rodmol.solve.chunked`'s."""
 
 _factory = []  # the one registered factory: (directory, resume=, overwrite=) -> sink
+_system_factory = []  # (directory, overwrite=) -> writer(SystemResult), for a System's out=DIR
 
 
 def register_directory(factory):
@@ -17,3 +18,16 @@ def directory_sink(directory, *, resume, overwrite):
     if not _factory:
         raise RuntimeError("no directory sink is registered: import rodmol (rodmol.output.stream registers it)")
     return _factory[0](directory, resume=resume, overwrite=overwrite)
+
+
+def register_system_writer(factory):
+    """Make ``factory(directory, overwrite=bool)`` the writer of a System's ``out=DIR``: it
+    checks the directory (before the run) and returns ``write(result)`` (after it)."""
+    _system_factory[:] = [factory]
+
+
+def system_writer(directory, *, overwrite):
+    """The registered writer of a System's run into ``directory`` (see :func:`register_system_writer`)."""
+    if not _system_factory:
+        raise RuntimeError("no system writer is registered: import rodmol (rodmol.output.system_files registers it)")
+    return _system_factory[0](directory, overwrite=overwrite)

@@ -12,8 +12,9 @@ from .simulate import simulate
 
 @dataclass(frozen=True)
 class RunSpec:
-    """A checked run: the model, ``t_end`` [s], the options of
-    :func:`rodmol.simulate` (``solver``) and the outputs."""
+    """A checked run: the model (a :class:`Model`, or a :class:`rodmol.System`
+    from a system file), ``t_end`` [s], the options of :func:`rodmol.simulate`
+    (``solver``) and the outputs."""
 
     name: str
     description: str

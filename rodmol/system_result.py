@@ -5,6 +5,7 @@ import numpy as np
 from .base_motion import BaseMotion
 from .discretise.rotations import matrices
 from .discretise.system import SemiDiscrete
+from .errors import ParameterError
 from .result import from_states
 
 
@@ -19,12 +20,15 @@ class BodyResult:
     quaternion : (n_t, 4) the same rotations as unit quaternions (scalar first).
     velocity : (n_t, 3) velocity of the body origin [m/s], body frame.
     angular_velocity : (n_t, 3) angular velocity [rad/s], body frame.
+    surface : (points (n, 3) [m], body frame; triangles (m, 3)) or None
+        How the body is drawn, for a result read from files (else from the RigidBody).
     """
 
     def __init__(self, t, position, quaternion, velocity, angular_velocity):
         self.t, self.position, self.quaternion = t, position, quaternion
         self.rotation = matrices(quaternion)
         self.velocity, self.angular_velocity = velocity, angular_velocity
+        self.surface = None
 
 
 class SystemResult:
@@ -38,24 +42,46 @@ class SystemResult:
     t : (n_t,) output times [s].
     states : (n_t, size) the assembled states (``Assembly.parts`` says where each part sits).
     success, message, stats, error : as for :class:`rodmol.Result`.
+    assembly : the run's :class:`rodmol.discretise.assembly.Assembly`; None for a
+        result read from files (:func:`rodmol.load_result`), whose parts are read
+        from them (``saved``: {rod name: reader}, {body name: reader}).
     """
 
-    def __init__(self, assembly, t, states, success, message, stats, error=None):
+    def __init__(self, assembly, t, states, success, message, stats, error=None, saved=None):
         self.assembly, self.t, self.states = assembly, np.asarray(t, dtype=float), np.asarray(states)
         self.success, self.message, self.stats, self.error = success, message, stats, error
-        self._parts = {}
+        self._parts, self._saved = {}, saved
+
+    @property
+    def rods(self):
+        """Names of the rods."""
+        return list(self.assembly.rods if self._saved is None else self._saved[0])
+
+    @property
+    def bodies(self):
+        """Names of the bodies."""
+        return list(self.assembly.bodies if self._saved is None else self._saved[1])
 
     @property
     def names(self):
         """Names of the rods, then of the bodies."""
-        return list(self.assembly.parts)
+        return self.rods + self.bodies
 
     def __getitem__(self, name):
-        if name not in self.assembly.parts:
+        if name not in self.names:
             raise KeyError(f"{name!r} is neither a rod nor a body of the system (names: {self.names})")
         if name not in self._parts:
-            self._parts[name] = self._rod(name) if name in self.assembly.rods else self._body(name)
+            if self._saved is not None:
+                self._parts[name] = {**self._saved[0], **self._saved[1]}[name]()
+            else:
+                self._parts[name] = self._rod(name) if name in self.assembly.rods else self._body(name)
         return self._parts[name]
+
+    def _system(self, what):
+        if self.assembly is None:
+            raise ParameterError(f"`{what}` needs the System: a result read from files has none "
+                                 "(simulate the System again, or use its rods' and bodies' arrays)")
+        return self.assembly
 
     def _body(self, name):
         part = self.assembly.bodies[name]
@@ -93,14 +119,15 @@ class SystemResult:
     def momentum(self):
         """Total linear [kg m/s] and angular momentum about the origin [kg m^2/s]
         of the system at each frame, global: two (n_t, 3) arrays."""
-        pairs = [self.assembly.momentum(y) for y in self.states]
+        assembly = self._system("momentum")
+        pairs = [assembly.momentum(y) for y in self.states]
         return np.array([p[0] for p in pairs]), np.array([p[1] for p in pairs])
 
     def pose_drift(self, name):
         """How far the base header of rod ``name`` (integrated with the rod) has
         drifted from its clamp on its body (integrated with the body): (distance
         [m], angle [rad]) at each frame, each (n_t,); zeros for a rod not on a body."""
-        assembly, n_t = self.assembly, len(self.t)
+        assembly, n_t = self._system("pose_drift"), len(self.t)
         body = assembly.system.clamps.get(name, (None,))[0]
         if body is None:
             return np.zeros(n_t), np.zeros(n_t)

@@ -1,20 +1,23 @@
 """A run of a :class:`rodmol.System` (rods and rigid bodies), reached through
-:func:`rodmol.simulate`: in memory, from rest, with CVODE.
+:func:`rodmol.simulate`: in memory, from rest, with CVODE; with ``out=DIR``
+its files are written once it ended (:mod:`rodmol.output.system_files`,
+through :func:`rodmol.run_sinks.system_writer`).
 
 Not yet for systems (each raises :class:`rodmol.errors.NotSupportedYet`):
-the equilibrium start, streamed output (``out``), ``resume``, ``overwrite``
-and the other backends. ``progress`` is reported at the output times only.
+the equilibrium start with a free body, streaming while the run goes,
+``resume`` and the other backends. ``progress`` is reported at the output times only.
 """
 
 import warnings
 
 import numpy as np
 
-from . import _checks
+from . import _checks, run_sinks
 from .discretise.assembly import Assembly
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
 from .errors import NotSupportedYet, ParameterError
 from .solve import options
+from .solve.equilibrium import equilibrium
 from .solve.system_cvode import cvode_system
 from .system_result import SystemResult
 
@@ -25,16 +28,17 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
                     output_dt=None, output_times=None, t0=None, progress=None, max_wall_time=None,
                     out=None, resume=False, overwrite=False, **backend_options):
     """Integrate ``system`` from rest (``initial="straight"``: every rod
-    straight at its base, every body at rest at its pose), from a state
+    straight at its base, every body at rest at its pose), from its static
+    equilibrium (``"equilibrium"``, bodies fixed or driven only:
+    :func:`rodmol.solve.equilibrium.system_rest_state`), from a state
     vector (``SystemResult.states[k]``) or from the last frame of an earlier
     SystemResult (at its last time unless ``t0`` is given); the other
     arguments as for :func:`rodmol.simulate`. Returns a
     :class:`rodmol.system_result.SystemResult`."""
-    for name, value, unset in (("out", out, None), ("resume", resume, False), ("overwrite", overwrite, False)):
-        if value is not unset:
-            raise NotSupportedYet(f"`{name}` is not supported yet for systems (in-memory runs only)")
-    if isinstance(initial, str) and initial == "equilibrium":
-        raise NotSupportedYet("`initial='equilibrium'` is not supported yet for systems: use 'straight'")
+    if resume is not False:
+        raise NotSupportedYet("`resume` is not supported yet for systems (their files are written after the run)")
+    if out is None and overwrite is not False:
+        raise ParameterError("`overwrite` needs `out`")
     if backend not in (None, "cvode"):
         raise NotSupportedYet(f"`backend` {backend!r} is not supported yet for systems: use 'cvode'")
     checked = options.backend_options("cvode", cvode_system, backend_options)
@@ -53,13 +57,17 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
     t_out = options.output_times(t0, t_end, output_dt, output_times, assembly.size)
     if initial is None or (isinstance(initial, str) and initial == "straight"):
         y0 = assembly.initial_state()
+    elif isinstance(initial, str) and initial == "equilibrium":  # bodies fixed or driven only
+        y0 = equilibrium(assembly, t0)
     elif isinstance(initial, str):
-        raise ParameterError(f"unknown `initial` {_checks.short(initial)}; use 'straight' or a state")
+        raise ParameterError(f"unknown `initial` {_checks.short(initial)}; use 'straight', 'equilibrium' "
+                             "or a state")
     else:
         y0 = _sized("initial", initial, assembly.size, scalar=False)
     atol = rtol * assembly.atol_scale() if atol is None else _sized("atol", atol, assembly.size)
     if np.any(atol <= 0):
         raise ParameterError("`atol` must be > 0")
+    writer = None if out is None else run_sinks.system_writer(out, overwrite=bool(overwrite))
     owned = progress is True
     if owned:
         from ._progress import Progress
@@ -74,7 +82,10 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
             progress.close()
     if not success:
         warnings.warn(message, RuntimeWarning, stacklevel=3)
-    return SystemResult(assembly, t, y, success, message, stats, error)
+    result = SystemResult(assembly, t, y, success, message, stats, error)
+    if writer is not None:
+        writer(result)
+    return result
 
 
 def _sized(name, value, size, scalar=True):

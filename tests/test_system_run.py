@@ -155,8 +155,7 @@ def test_progress_sees_every_output_and_the_wall_time_budget_stops_the_run():
 
 
 @pytest.mark.parametrize("kwargs, match", [
-    (dict(out="somewhere"), "`out` is not supported yet"),
-    (dict(initial="equilibrium"), "equilibrium"),
+    (dict(resume=True), "`resume` is not supported yet"),
     (dict(backend="rk23"), "rk23"),
     (dict(linsolver="band"), "linsolver"),
     (dict(krylov_dim=3), "unknown option"),
@@ -187,3 +186,34 @@ def test_sinking_body_starts_at_its_net_weight_over_its_mass_and_ends_at_its_ter
     assert speed[1] / 0.002 == pytest.approx(weight / (mass + added + rod_mass), rel=2e-3)
     assert speed[-1] == pytest.approx(np.sqrt(weight / drag), rel=1e-4)
     np.testing.assert_allclose(run["body"].position[-1, :2], 0.0, atol=1e-9)
+
+
+def test_the_equilibrium_of_a_system_on_a_fixed_body_is_each_rods_own_on_its_clamp():
+    """With every body's pose given, no rod acts on another: the system's rest
+    state is each rod's single-rod equilibrium clamped where its joint puts it,
+    and a run from it stays there. A free body is refused, naming it."""
+    from rodmol.discretise.assembly import Assembly
+
+    material = rodmol.Material(E=2e5, nu=0.5, mu=300.0, rho=1100.0)
+    rod = rodmol.Rod(0.2, radius=(0.01, 0.005), material=material)
+    arms = {name: rodmol.Model(rod, 8, cables=[rodmol.Cable((side * 0.004, 0.0), 0.2, tension=0.1)])
+            for name, side in (("up", 1.0), ("down", -1.0))}
+    turn = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    frame = rodmol.RigidBody(1.0, (1e-3, 1e-3, 1e-3), motion="fixed", position=(0.1, 0.2, 0.3), rotation=turn)
+    joints = [rodmol.Joint(("frame", (0.02, 0.0, 0.0)), ("up", "base")),
+              rodmol.Joint(("frame", (-0.02, 0.0, 0.0), np.diag([-1.0, -1.0, 1.0])), ("down", "base"))]
+    system = rodmol.System(arms, {"frame": frame}, joints, gravity=(0.0, 0.0, -9.81))
+    y = rodmol.equilibrium(system)
+    parts = Assembly(system).parts
+    for name in arms:
+        alone = system.rods[name].replace(base=system.base_motion(name))
+        assert np.allclose(y[parts[name]], rodmol.equilibrium(alone), rtol=0.0, atol=1e-12)
+    run = rodmol.simulate(system, 0.05, initial="equilibrium", output_dt=0.05)
+    for name in arms:
+        tip = run[name].tip
+        assert np.linalg.norm(tip[-1] - tip[0]) < 1e-8  # m: at rest (it sags by cm under gravity)
+        assert np.linalg.norm(tip[0] - run[name].positions[0, 0] - 0.2 * turn[:, 0] * (1 if name == "up" else -1)) > 0.01
+    free = rodmol.System(arms, {"head": rodmol.RigidBody(1.0, (1e-3, 1e-3, 1e-3))},
+                         [rodmol.Joint(("head", (0.0, 0.0, 0.0)), ("up", "base"))])
+    with pytest.raises(rodmol.NotSupportedYet, match="free body \\('head'\\)"):
+        rodmol.simulate(free, 0.1, initial="equilibrium")

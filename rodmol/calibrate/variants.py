@@ -26,7 +26,7 @@ from dataclasses import replace
 from .. import _checks
 from ..cables import Tension, as_tension
 from ..discretise.schemes import DEFAULT_SCHEME, get_scheme
-from ..errors import ParameterError
+from ..errors import NotSupportedYet, ParameterError
 from ..inputs import TimeInput
 from ..model import Model
 from ..parameters import Material, Medium
@@ -60,14 +60,18 @@ class ScaledTension(TimeInput):
 
 
 def as_spec(spec):
-    """A RunSpec, or the RunSpec of a scenario file path."""
-    if isinstance(spec, RunSpec):
-        return spec
+    """A RunSpec of one rod, or the RunSpec of a scenario file path (a system's is
+    refused: NotSupportedYet)."""
     if isinstance(spec, (str, os.PathLike)):
         from ..scenario.file import load_scenario
 
-        return load_scenario(spec)
-    raise ParameterError(f"expected a scenario (rodmol.load_scenario(...), a RunSpec or a path), got {spec!r}")
+        spec = load_scenario(spec)
+    if not isinstance(spec, RunSpec):
+        raise ParameterError(f"expected a scenario (rodmol.load_scenario(...), a RunSpec or a path), got {spec!r}")
+    if not isinstance(spec.model, Model):
+        raise NotSupportedYet(f"{spec.source}: variants and calibration of a system (several rods and bodies) "
+                              "are not supported yet: they take a single rod's scenario")
+    return spec
 
 
 def spec_of(model, t_end, name="model", **solver):

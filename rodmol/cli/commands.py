@@ -28,11 +28,12 @@ from pathlib import Path
 from .._files import output_directory
 from .._progress import Progress
 from .._version import __version__
-from ..errors import ParameterError
+from ..errors import NotSupportedYet, ParameterError
 from ..output import h5result
 from ..output.formats import FORMATS, get_format
 from ..output.lock import OutputLock
 from ..output.run_files import cannot_write
+from ..systems import System
 from .options import EXAMPLES, add_run_options, load_spec
 
 EXIT_FAILED, EXIT_USAGE, EXIT_OUTPUT, EXIT_INTERRUPTED = 1, 2, 3, 130
@@ -103,7 +104,34 @@ def _run(args):
     out = args.out or spec.output.directory or Path("out") / spec.name
     output_directory(out, "--out")  # before the run, so a directory that cannot be made does not waste it
     with OutputLock(out):  # one run per output directory
+        if isinstance(spec.model, System):
+            return _run_system(args, spec, out)
         return _run_locked(args, spec, out)
+
+
+def _run_system(args, spec, out):
+    """``rodmol run`` of a system file: the run, then its files (written once it ended)."""
+    if args.resume or args.resume_anyway:
+        raise NotSupportedYet("`--resume` is not supported yet for systems (their files are written after "
+                              "the run)")
+    if (args.format or spec.output.format) != "xdmf":
+        raise ParameterError("a system's run is written as `--format xdmf` only")
+    say = (lambda *a, **k: None) if args.quiet else print
+    system = spec.model
+    say(f"rodmol: {spec.name}: {len(system.rods)} rods, {len(system.bodies)} bodies, t_end = {spec.t_end:g} s, "
+        f"{spec.solver['scheme']} scheme -> {out}")
+    progress = None if args.quiet else Progress(stream=sys.stdout)
+    started = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # the summary gives the message
+        result = spec.simulate(progress=progress, out=out, overwrite=args.overwrite)
+    if progress:
+        progress.close()
+    state = "finished" if result.success else f"failed: {result.message}"
+    print(f"rodmol: {spec.name}: {state}; {len(result.t)} output frames to t = {result.t[-1]:g} s in "
+          f"{time.perf_counter() - started:.3g} s, written to {out} (open bodies.xdmf and NAME/rod.xdmf)",
+          file=sys.stdout if result.success else sys.stderr)
+    return 0 if result.success else EXIT_FAILED
 
 
 def _run_locked(args, spec, out):

@@ -21,7 +21,8 @@ from pathlib import Path
 from .._checks import did_you_mean
 from .._files import output_directory
 from ..errors import ParameterError
-from . import h5result, npz, run_files, stream, writers
+from ..system_result import SystemResult
+from . import h5result, npz, run_files, stream, system_files, writers
 
 
 @dataclass(frozen=True)
@@ -78,7 +79,8 @@ def get_format(name, what="format"):
 
 
 def write_series(result, directory, every=None, format=DEFAULT):
-    """Write a finished :class:`rodmol.Result` for ParaView into ``directory``.
+    """Write a finished :class:`rodmol.Result` (or a system's ``SystemResult``:
+    :func:`rodmol.output.system_files.write_system`) for ParaView into ``directory``.
 
     ``format="xdmf"`` (default): ``result.h5`` and the XDMF views
     (:class:`rodmol.output.stream.RunWriter`), returns the path of ``rod.xdmf``;
@@ -89,6 +91,10 @@ def write_series(result, directory, every=None, format=DEFAULT):
     of them up to :data:`rodmol.output.parts.MAX_SHOWN` frames.
     """
     entry = get_format(format)
+    if isinstance(result, SystemResult):  # each rod's files as a single rod's, the bodies', the index
+        if entry.name != "xdmf":
+            raise ParameterError(f"a system's result is written as 'xdmf' only, got `format` {format!r}")
+        return system_files.write_system(result, directory, every)
     return entry.write(result, output_directory(directory, "directory"), every)
 
 
@@ -98,6 +104,8 @@ def result_file(path):
     path = Path(path)
     if path.is_dir() or path.suffix == ".xdmf":
         folder = path if path.is_dir() else path.parent
+        if system_files.is_system(folder):
+            return folder / system_files.INDEX
         names = [f.result_file for f in FORMATS.values()]
         found = [folder / name for name in names if (folder / name).is_file()]
         if not found:
@@ -107,7 +115,8 @@ def result_file(path):
 
 
 def load_result(path):
-    """Read a :class:`Result`: a run directory (its ``result.h5``, else ``result.npz``), a
+    """Read a :class:`Result`, or a :class:`SystemResult` from a system's run directory
+    (:mod:`rodmol.output.system_files`): a run directory (its ``result.h5``, else ``result.npz``), a
     streamed run's ``result.h5`` or one of its views (``rod.xdmf``, ...; arrays read on first
     access), or a ``.npz`` written by :meth:`Result.save`.
 
@@ -122,6 +131,8 @@ def load_result(path):
         raise ParameterError(f"`path`: {exc}") from None
     if not path.is_file():
         raise ParameterError(f"`path`: no such result file or run directory: {str(path)!r}")
+    if system_files.is_system(path):
+        return system_files.read_system(path.parent)
     by_suffix = {Path(f.result_file).suffix: f for f in FORMATS.values()}
     # Any other name is a file of Result.save, which writes the vtp format's result.npz.
     return by_suffix.get(path.suffix, FORMATS["vtp"]).read(path)

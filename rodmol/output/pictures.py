@@ -2,6 +2,8 @@
 
 from pathlib import Path
 
+import numpy as np
+
 from .run_files import PLOTTED, RENDERED
 
 
@@ -9,10 +11,11 @@ def render(result, directory, size=(960, 720), frames=60, progress=None):
     """Render ``last_frame.png`` and (``frames`` > 0) ``animation.gif`` into ``directory``.
 
     Off-screen pyvista: the body as a tube of the true radius coloured by the
-    bending curvature, the cables as lines (red when pulled), the markers as dots.
+    bending curvature, the cables as lines (red when pulled), the markers as dots;
+    of a SystemResult, every rod so and every rigid body as its surface
+    (:func:`rodmol.output.system_files.body_surface`).
     ``progress``: a ``rodmol._progress.Progress`` showing the frames drawn.
     """
-    import numpy as np
     import pyvista as pv
     from PIL import Image
 
@@ -20,28 +23,37 @@ def render(result, directory, size=(960, 720), frames=60, progress=None):
 
     pv.OFF_SCREEN = True
     _quiet_vtk()
-    bending = np.linalg.norm(result.curvature[..., 1:], axis=-1)
-    r_max = float(np.max(result.radius))
-    low, high = result.positions.min(axis=(0, 1)) - r_max, result.positions.max(axis=(0, 1)) + r_max
+    rods, bodies = _parts(result)
+    bending = [np.linalg.norm(rod.curvature[..., 1:], axis=-1) for rod in rods]
+    top = max(max(float(b.max()) for b in bending), 1e-9)
+    r_max = max(float(np.max(rod.radius)) for rod in rods)
+    points = [rod.positions.reshape(-1, 3) for rod in rods] + [_placed(body, surface, slice(None)).reshape(-1, 3)
+                                                             for body, surface in bodies]
+    low = np.min([p.min(axis=0) for p in points], axis=0) - r_max
+    high = np.max([p.max(axis=0) for p in points], axis=0) + r_max
     plotter = pv.Plotter(off_screen=True, window_size=list(size))
     plotter.set_background("white")
 
     def draw(k):
-        rod = rod_mesh(result, k)
-        rod.point_data["bending curvature [1/m]"] = bending[k]
-        plotter.add_mesh(rod.tube(scalars="radius [m]", absolute=True, n_sides=32), name="body",
-                         scalars="bending curvature [1/m]", clim=[0.0, max(float(bending.max()), 1e-9)],
-                         cmap="viridis", smooth_shading=True, opacity=0.55,
-                         scalar_bar_args=dict(color="black"))
-        cables = cables_mesh(result, k)
-        if cables.n_cells:
-            pulled = cables.cell_data["tension [N]"] > 0
-            colours = np.where(pulled[:, None], [[0.85, 0.1, 0.1]], [[0.6, 0.6, 0.6]])
-            cables.cell_data["colour"] = (255 * colours).astype(np.uint8)
-            plotter.add_mesh(cables, name="cables", scalars="colour", rgb=True, line_width=3)
-        if len(result.meta.get("markers", [])):
-            plotter.add_mesh(markers_mesh(result, k), name="markers", color="black", point_size=10,
-                             render_points_as_spheres=True)
+        for i, part in enumerate(rods):
+            rod = rod_mesh(part, k)
+            rod.point_data["bending curvature [1/m]"] = bending[i][k]
+            plotter.add_mesh(rod.tube(scalars="radius [m]", absolute=True, n_sides=32), name=f"body {i}",
+                             scalars="bending curvature [1/m]", clim=[0.0, top], cmap="viridis",
+                             smooth_shading=True, opacity=0.55, scalar_bar_args=dict(color="black"))
+            cables = cables_mesh(part, k)
+            if cables.n_cells:
+                pulled = cables.cell_data["tension [N]"] > 0
+                colours = np.where(pulled[:, None], [[0.85, 0.1, 0.1]], [[0.6, 0.6, 0.6]])
+                cables.cell_data["colour"] = (255 * colours).astype(np.uint8)
+                plotter.add_mesh(cables, name=f"cables {i}", scalars="colour", rgb=True, line_width=3)
+            if len(part.meta.get("markers", [])):
+                plotter.add_mesh(markers_mesh(part, k), name=f"markers {i}", color="black", point_size=10,
+                                 render_points_as_spheres=True)
+        for i, (body, (corners, triangles)) in enumerate(bodies):
+            faces = np.hstack([np.full((len(triangles), 1), 3), triangles]).ravel()
+            plotter.add_mesh(pv.PolyData(_placed(body, (corners, triangles), k), faces), name=f"rigid {i}",
+                             color=(0.8, 0.55, 0.35), smooth_shading=False)
         plotter.add_text(f"t = {result.t[k]:.2f} s", name="time", color="black", font_size=12)
 
     draw(len(result.t) - 1)
@@ -67,6 +79,22 @@ def render(result, directory, size=(960, 720), frames=60, progress=None):
     return written
 
 
+def _parts(result):
+    """(the rods' Results, [(BodyResult, its surface)]) of a Result or a SystemResult."""
+    from .system_files import surface_of
+
+    if not hasattr(result, "bodies"):
+        return [result], []
+    return [result[name] for name in result.rods], [(result[name], surface_of(result, name))
+                                                   for name in result.bodies]
+
+
+def _placed(body, surface, k):
+    """The body's surface points at frame(s) ``k`` [m], global."""
+    points = surface[0]
+    return body.position[k, ..., None, :] + np.einsum("...ij,pj->...pi", body.rotation[k], points)
+
+
 def _quiet_vtk():
     """Hide VTK's console warnings (it first tries an X display, then falls back to EGL)."""
     from vtkmodules.vtkCommonCore import vtkLogger
@@ -84,6 +112,8 @@ def plot(result, directory):
     import numpy as np
 
     directory, written = Path(directory), []
+    if hasattr(result, "bodies"):
+        return _plot_system(result, directory)
     names = [m["name"] for m in result.meta.get("markers", [])]
 
     fig, axes = plt.subplots(1, 2, figsize=(11, 5), constrained_layout=True)
@@ -120,6 +150,53 @@ def plot(result, directory):
     ax.grid(alpha=0.3)
     if pulled:
         ax.legend(fontsize=8)
+    written.append(_save(fig, directory / PLOTTED[2]))
+    return written
+
+
+def _plot_system(result, directory):
+    """:func:`plot` of a SystemResult: the rods' tip paths and the bodies' paths,
+    the bodies' positions vs time, every cable's tension vs time."""
+    import matplotlib.pyplot as plt
+
+    rods, bodies = {n: result[n] for n in result.rods}, {n: result[n] for n in result.bodies}
+    fig, axes = plt.subplots(1, 2, figsize=(11, 5), constrained_layout=True)
+    for ax, (i, j) in zip(axes, ((0, 1), (0, 2))):
+        for name, rod in rods.items():
+            ax.plot(rod.tip[:, i], rod.tip[:, j], lw=1, label=f"{name} tip")
+            ax.plot(rod.positions[-1, :, i], rod.positions[-1, :, j], ":", color="grey")
+        for name, body in bodies.items():
+            ax.plot(body.position[:, i], body.position[:, j], "k-", lw=2, label=name)
+        ax.set(xlabel=f"{'xyz'[i]} [m]", ylabel=f"{'xyz'[j]} [m]")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=7)
+    fig.suptitle("Paths, global frame (dotted: the rods at the last frame)")
+    written = [_save(fig, directory / PLOTTED[0])]
+
+    fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True, constrained_layout=True)
+    for i, ax in enumerate(axes):
+        for name, body in bodies.items():
+            ax.plot(result.t, body.position[:, i], lw=1.5, label=name)
+        ax.set(ylabel=f"{'xyz'[i]} [m]")
+        ax.grid(alpha=0.3)
+    if bodies:
+        axes[0].legend(fontsize=8, ncol=5)
+    axes[-1].set(xlabel="t [s]")
+    fig.suptitle("Body positions (origin), global frame")
+    written.append(_save(fig, directory / PLOTTED[1]))
+
+    fig, ax = plt.subplots(figsize=(8, 3.5), constrained_layout=True)
+    pulled = 0
+    for name, rod in rods.items():
+        for i, cable in enumerate(rod.meta.get("cables", [])):
+            if np.any(rod.tensions[:, i] > 0):
+                ax.plot(result.t, rod.tensions[:, i], label=f"{name}: {cable['name']}")
+                pulled += 1
+    ax.set(xlabel="t [s]", ylabel="tension [N]", title="Cable tensions" + ("" if pulled else " (all slack)"))
+    ax.grid(alpha=0.3)
+    if pulled:
+        ax.legend(fontsize=7, ncol=2)
     written.append(_save(fig, directory / PLOTTED[2]))
     return written
 

@@ -27,9 +27,12 @@ SERIES = "vtk"
 RENDERED = ("last_frame.png", "animation.gif")
 #: ``rodmol plot``'s pictures.
 PLOTTED = ("tip_path.png", "markers.png", "tensions.png")
+#: A system's run (:mod:`rodmol.output.system_files`): its index and the bodies' view
+#: (each rod's files in a folder of its own, a run directory as a single rod's).
+SYSTEM = ("system.h5", "bodies.xdmf")
 #: The files a run writes directly into its directory.
 TOP = (h5result.INDEX, NPZ, *(f"{view}.xdmf" for view in xdmf.VIEWS), *(f"{part}.pvd" for part in PARTS),
-       *RENDERED, *PLOTTED)
+       *RENDERED, *PLOTTED, *SYSTEM)
 #: The numbered files in its folders: folder -> the names' pattern (a regular expression).
 NUMBERED = {h5result.FRAMES: r"chunk_\d{6}\.(h5|xmf)", SERIES: rf"({'|'.join(PARTS)})_\d+\.vtp"}
 #: Name patterns (glob) of the numbered files, for their temporaries.

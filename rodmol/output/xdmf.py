@@ -113,6 +113,16 @@ def marker_grids(h5, t, n_markers):
     return _frames(grid, t)
 
 
+def body_grids(h5, t, key, n_points, n_triangles):
+    """Grids of a rigid body (a triangulated surface, the view arrays ``KEY_points``,
+    time-first, global, and ``KEY_triangles``) at the frames ``t``."""
+    grid = (f'<Grid Name="{key}" GridType="Uniform"><Time Value="{T}"/>'
+            f'<Topology TopologyType="Triangle" NumberOfElements="{n_triangles}">'
+            f'{_item(h5, f"{key}_triangles", (n_triangles, 3), integer=True)}</Topology>'
+            f'<Geometry GeometryType="XYZ">{_item(h5, f"{key}_points", (n_points, 3), len(t))}</Geometry></Grid>')
+    return _frames(grid, t)
+
+
 def fragment(views):
     """A chunk's grids, ``views`` (view name -> list of encoded grid lines), as an XDMF file's
     text (a list of encoded pieces: megabytes, not copied into one)."""

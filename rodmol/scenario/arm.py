@@ -65,12 +65,13 @@ def rod(data, ctx):
     return FAILED if failed(body) else built
 
 
-def medium(data, ctx, default):
-    """``medium = "water"`` or a ``[medium]`` table; returns (medium, Model switches)."""
+def medium(data, ctx, default, at=()):
+    """``medium = "water"`` or a ``[medium]`` table (in the table at path ``at``);
+    returns (medium, Model switches)."""
     value = data.get("medium", default)
-    path = ("medium",)
+    path = at + ("medium",)
     if isinstance(value, str):
-        return ctx.read({"medium": value}, (), "medium", Medium.preset), {}
+        return ctx.read({"medium": value}, at, "medium", Medium.preset), {}
     table = ctx.table(value, path, tables.MEDIUM)
     preset = ctx.read(table, path, "preset", Medium.preset, MEDIA["air"])
     coefficients = values(tables.MEDIUM, ctx, path, table, keys=tables.Source(Medium).parameters())
@@ -81,35 +82,37 @@ def medium(data, ctx, default):
     return fluid, switches
 
 
-def entries(data, ctx, kind):
-    """The list of ``[[kind]]`` tables, or FAILED (recorded) if ``kind`` is not one."""
+def entries(data, ctx, kind, at=()):
+    """The list of ``[[kind]]`` tables (in the table at path ``at``), or FAILED
+    (recorded) if ``kind`` is not one."""
     found = data.get(kind, [])
     if not isinstance(found, list):
-        ctx.add((kind,), f"`{kind}` must be an array of tables `[[{kind}]]`, got {found!r}")
+        ctx.add(at + (kind,), f"`{kind}` must be an array of tables `[[{kind}]]`, got {found!r}")
         return FAILED
     return found
 
 
-def numbered(data, ctx, kind, table, build):
-    """The objects of the ``[[kind]]`` tables; a nameless one is ``"kind K"``."""
-    found = entries(data, ctx, kind)
+def numbered(data, ctx, kind, table, build, at=()):
+    """The objects of the ``[[kind]]`` tables (in the table at path ``at``); a
+    nameless one is ``"kind K"``."""
+    found = entries(data, ctx, kind, at)
     if found is FAILED:
         return FAILED
     built = []
     for i, entry in enumerate(found):
         name = {} if isinstance(entry, dict) and "name" in entry else {"name": f"{kind} {i + 1}"}
-        built.append(build_table(entry, ctx, (kind, i), table, build, extra=name))
+        built.append(build_table(entry, ctx, at + (kind, i), table, build, extra=name))
     return FAILED if failed(*built) else built
 
 
-def cables(data, ctx):
+def cables(data, ctx, at=()):
     """The ``[[cable]]`` tables of an arm written out in full."""
-    return numbered(data, ctx, "cable", tables.CABLE, Cable)
+    return numbered(data, ctx, "cable", tables.CABLE, Cable, at)
 
 
-def markers(data, ctx):
+def markers(data, ctx, at=()):
     """The ``[[marker]]`` tables."""
-    return numbered(data, ctx, "marker", tables.MARKER, Marker)
+    return numbered(data, ctx, "marker", tables.MARKER, Marker, at)
 
 
 def paper_cables(data, ctx, scenario):
@@ -142,9 +145,9 @@ def _cable_number(value):
     return value
 
 
-def base(data, ctx):
+def base(data, ctx, at=()):
     """``[base]``: a clamp, fixed or moving."""
-    path, table = ("base",), data.get("base", {})
+    path, table = at + ("base",), data.get("base", {})
     fixed = ctx.read(table, path, "fixed", lambda v: _checks.flag("fixed", v), False) \
         if isinstance(table, dict) else False
     if fixed is True and ("velocity" in table or "angular_velocity" in table):
@@ -152,3 +155,16 @@ def base(data, ctx):
                                    "`angular_velocity`")
     built = build_table(table, ctx, path, tables.BASE, BaseMotion)
     return FAILED if failed(fixed, built) or (fixed is True and not built.fixed) else built
+
+
+def check_lengths(ctx, length, cables, markers, loads, at=()):
+    """Anchors, markers and point loads beyond the tip, all of them (Model
+    would stop at the first); ``at``: the path of the arm's table."""
+    points = [(i, load) for i, load in enumerate(loads) if hasattr(load, "s")]
+    for kind, items, key, value in (("cable", enumerate(cables), "anchor", lambda c: c.anchor),
+                                    ("marker", enumerate(markers), "s", lambda m: m.s),
+                                    ("load", points, "s", lambda p: p.s)):
+        for i, item in items:
+            if value(item) > length * (1 + 1e-12):
+                ctx.add(at + (kind, i, key), f"`{key}` must lie within the rod, <= L = {length!r} m, "
+                                             f"got {value(item)!r}")

@@ -9,7 +9,6 @@ import re
 from .. import _checks, scenarios
 from ..arm import LENGTH as PAPER_LENGTH
 from ..arm import paper_arm
-from ..discretise.layout import StateLayout
 from ..discretise.schemes import DEFAULT_SCHEME, get_scheme
 from ..discretise.system import SemiDiscrete
 from ..errors import ParameterError
@@ -19,6 +18,7 @@ from ..run_spec import RunSpec
 from ..simulate import DEFAULT_BACKEND, INITIAL, OUTPUT_DT, check_run, fit
 from ..solve import options as run_options
 from . import arm as arm_tables
+from . import system as system_file
 from . import tables
 from .loads import loads as load_tables
 from .problems import FAILED, failed
@@ -32,6 +32,8 @@ def build(data, ctx, default_name):
     ctx.table(data, (), tables.TOP)
     name = ctx.read(data, (), "name", lambda v: _string("name", v), default_name)
     description = ctx.read(data, (), "description", lambda v: _string("description", v), "")
+    if system_file.is_system(data):
+        return _build_system(data, ctx, name, description)
     arm = ctx.read(data, (), "arm", lambda v: _checks.choice("arm", v, tables.ARMS))
     scenario = ctx.read(data, (), "scenario", lambda v: _checks.choice("scenario", v, tuple(scenarios.SCENARIOS)))
     if scenario not in (None, FAILED) and arm is None:
@@ -57,7 +59,7 @@ def build(data, ctx, default_name):
         tensions = arm_tables.paper_cables(data, ctx, scenario)
         parts = (medium, base, tensions, loads)
         if not failed(loads):
-            _check_lengths(ctx, PAPER_LENGTH, [], [], loads)
+            arm_tables.check_lengths(ctx, PAPER_LENGTH, [], [], loads)
         build_model = lambda **kw: paper_arm(medium=medium, tensions=tensions,  # noqa: E731
                                              base=base, loads=loads, **kw)
     else:
@@ -66,7 +68,7 @@ def build(data, ctx, default_name):
         markers = arm_tables.markers(data, ctx)
         parts = (medium, base, rod, cables, markers, loads)
         if not failed(rod, cables, markers, loads):
-            _check_lengths(ctx, rod.length, cables, markers, loads)
+            arm_tables.check_lengths(ctx, rod.length, cables, markers, loads)
         build_model = lambda n_elements, **kw: Model(rod, n_elements, medium=medium,  # noqa: E731
                                                      cables=cables, base=base, markers=markers,
                                                      loads=loads, **kw)
@@ -82,23 +84,24 @@ def build(data, ctx, default_name):
     return RunSpec(name, description, ctx.source, model, t_end, solver, output)
 
 
+def _build_system(data, ctx, name, description):
+    """The RunSpec of a system file (:mod:`rodmol.scenario.system`): its [solver]
+    starts from rest by default (``initial = "straight"``)."""
+    n_elements, scheme = _discretization(data, ctx)
+    solver, t_end = _solver(data, ctx, None, initial="straight")
+    solver["scheme"] = scheme
+    checked = _check_solver(ctx, solver, t_end, n_elements)
+    output = _output(data, ctx)
+    system = system_file.system(data, ctx, n_elements, solver)
+    if ctx.problems or failed(system, checked):
+        return None
+    return RunSpec(name, description, ctx.source, system, t_end, solver, output)
+
+
 def _string(key, value):
     if not isinstance(value, str):
         raise ParameterError(f"`{key}` must be a string, got {_checks.short(value)}")
     return value
-
-
-def _check_lengths(ctx, length, cables, markers, loads):
-    """Anchors, markers and point loads beyond the tip, all of them (Model
-    would stop at the first)."""
-    points = [(i, load) for i, load in enumerate(loads) if hasattr(load, "s")]
-    for kind, items, key, value in (("cable", enumerate(cables), "anchor", lambda c: c.anchor),
-                                    ("marker", enumerate(markers), "s", lambda m: m.s),
-                                    ("load", points, "s", lambda p: p.s)):
-        for i, item in items:
-            if value(item) > length * (1 + 1e-12):
-                ctx.add((kind, i, key), f"`{key}` must lie within the rod, <= L = {length!r} m, "
-                                        f"got {value(item)!r}")
 
 
 def _model_problem(data, key, message):
@@ -136,12 +139,12 @@ def _discretization(data, ctx):
     return table.get("n_elements", tables.DISCRETIZATION.default("n_elements")), scheme
 
 
-def _solver(data, ctx, t_end_default):
+def _solver(data, ctx, t_end_default, initial=INITIAL[0]):
     """The [solver] values as simulate takes them (checked with the model, by
-    :func:`_check_solver`), and t_end."""
+    :func:`_check_solver`), and t_end; ``initial``: the default start."""
     path = ("solver",)
     table = ctx.table(data.get("solver", {}), path, tables.SOLVER, required=())  # t_end: below
-    defaults = dict(backend=DEFAULT_BACKEND, rtol=None, atol=None, output_dt=OUTPUT_DT, initial=INITIAL[0])
+    defaults = dict(backend=DEFAULT_BACKEND, rtol=None, atol=None, output_dt=OUTPUT_DT, initial=initial)
     options = {key: tables.convert(key, table.get(key, default), ctx.base_dir) for key, default in defaults.items()}
     if "max_wall_time" in table:
         options["max_wall_time"] = table["max_wall_time"]
@@ -164,11 +167,11 @@ def _check_solver(ctx, solver, t_end, n_elements):
         stand_in, sized = paper_arm(n_elements), True
     except ParameterError:
         stand_in, sized = paper_arm(2), False
-    def checked(**kw):  # the arguments alone, then those the stand-in's state sizes
-        args = check_run(t0=None, scheme=scheme, progress=None, backend_options={}, **{"max_wall_time": None, **kw})
-        return fit(args, SemiDiscrete(stand_in, args.scheme))
-
-    run = ctx.construct(path, checked, options, given=table, keys=tuple(options))
+    system = SemiDiscrete(stand_in, get_scheme(scheme))  # (sizes the state; compiles nothing)
+    run = ctx.construct(path, lambda **kw: fit(check_run(t0=None, scheme=scheme, progress=None,
+                                                         backend_options={}, **{"max_wall_time": None, **kw}),
+                                               system),
+                        options, given=table, keys=tuple(options))
     if t_end is None or t_end is FAILED:
         return FAILED  # (recorded)
     t_end = ctx.read({"t_end": t_end}, path, "t_end", lambda v: _checks.positive("t_end", v, " s"))
@@ -176,7 +179,7 @@ def _check_solver(ctx, solver, t_end, n_elements):
     if failed(run, t_end, output_dt) or not sized:
         return FAILED if failed(run, t_end, output_dt) else run
     try:
-        run_options.output_count(t_end, output_dt, StateLayout(stand_in.n_elements).size)
+        run_options.output_count(t_end, output_dt, system.size)
     except ParameterError as exc:
         # The message opens with t_end: its line, unless only output_dt was written here.
         ctx.add(path + (("output_dt",) if "output_dt" in table and "t_end" not in table else ("t_end",)),

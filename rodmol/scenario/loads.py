@@ -12,18 +12,19 @@ from .problems import FAILED, failed
 from .tables import LOADS
 
 
-def loads(data, ctx):
-    """The loads of the ``[[load]]`` tables, in order; FAILED if any has a problem."""
-    tables = entries(data, ctx, "load")
+def loads(data, ctx, at=()):
+    """The loads of the ``[[load]]`` tables (in the table at path ``at``), in
+    order; FAILED if any has a problem."""
+    tables = entries(data, ctx, "load", at)
     if tables is FAILED:
         return FAILED
-    built = [_load(ctx, ("load", i), entry) for i, entry in enumerate(tables)]
+    built = [_load(ctx, at + ("load", i), entry) for i, entry in enumerate(tables)]
     return FAILED if failed(*built) else built
 
 
 def _load(ctx, path, entry):
     if not isinstance(entry, dict):
-        ctx.add(path[:1], f"`load` must be an array of tables `[[load]]`, got {entry!r}")
+        ctx.add(path[:-1], f"`load` must be an array of tables `[[load]]`, got {entry!r}")
         return FAILED
     if "type" not in entry:
         ctx.add(path, f"missing required key `type`; valid types: {', '.join(LOADS)}")

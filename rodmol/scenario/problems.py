@@ -59,11 +59,13 @@ class Override:
 
 
 def table_label(path):
-    """How a table is named in messages: ``[rod]``, ``[[cable]] #2``."""
+    """How a table is named in messages: ``[rod]``, ``[[cable]] #2``,
+    ``[[rod]] #1 [[cable]] #2``."""
     if not path:
         return ""
     if len(path) >= 2 and isinstance(path[1], int):
-        return f"[[{path[0]}]] #{path[1] + 1}"
+        entry = f"[[{path[0]}]] #{path[1] + 1}"
+        return entry + (" " + table_label(path[2:]) if len(path) > 2 else "")
     return "[" + ".".join(map(str, path)) + "]"
 
 

@@ -21,6 +21,7 @@ from pathlib import Path
 
 from ..arm import paper_arm
 from ..base_motion import BaseMotion
+from ..bodies import RigidBody
 from ..cables import Cable
 from ..inputs import as_time_input
 from ..loads import SCENARIO_TYPES
@@ -30,6 +31,7 @@ from ..output.options import OutputOptions
 from ..parameters import Material, Medium
 from ..rod import Rod
 from ..simulate import simulate
+from ..systems import Joint, System
 
 #: Units of the keys [SI], by name (a [[load]] type's own come from its record).
 UNITS = {"length": "m", "radius": "m", "E": "Pa", "G": "Pa", "mu": "Pa s", "rho": "kg/m^3",
@@ -37,10 +39,11 @@ UNITS = {"length": "m", "radius": "m", "E": "Pa", "G": "Pa", "mu": "Pa s", "rho"
          "displacement": "m", "compliance": "1/N", "base_to_actuator": "m", "rest_length": "m",
          "friction": "-", "slip_speed": "m/s", "drag_coefficients": "kg/m^2", "gravity": "m/s^2",
          "position": "m", "velocity": "m/s", "angular_velocity": "rad/s", "t_end": "s",
-         "output_dt": "s", "max_wall_time": "s", "rest_curvature": "1/m", "rest_stretch": "-"}
+         "output_dt": "s", "max_wall_time": "s", "rest_curvature": "1/m", "rest_stretch": "-",
+         "mass": "kg", "inertia": "kg m^2", "volume": "m^3", "centre_of_mass": "m", "density": "kg/m^3"}
 
 #: Keys whose value may name a file (CSV table), relative to the scenario file.
-FILE_KEYS = ("tension", "displacement", "force", "moment", "directory")
+FILE_KEYS = ("tension", "displacement", "force", "moment", "directory", "mesh")
 #: Keys whose constructor takes a function of t: the file gives what
 #: :func:`rodmol.inputs.as_time_input` accepts (3 numbers, knots, a CSV file).
 TIME_FUNCTIONS = ("velocity", "angular_velocity")
@@ -124,11 +127,26 @@ OUTPUT = Table((Source(OutputOptions),))
 LOADS = {kind: Table((Source(build),), own=("type",), units=units)
          for kind, (build, units) in SCENARIO_TYPES.items()}
 
-#: The tables, by name (``[[...]]`` arrays of tables: cable, marker, load).
+#: A system file's tables: [system] (its medium, a name or a table as
+#: [medium], and gravity), [[rod]] (a rod's keys, its name and grid, and its
+#: own [material], [[cable]], [[marker]], [[load]] and [base] nested),
+#: [[body]] (a RigidBody, or one filling a mesh of a given density) and [[joint]].
+SYSTEM = Table((Source(System, only=("medium", "gravity")),))
+SYSTEM_ROD = Table((Source(Rod, skip=("material",)), Source(Model, only=("n_elements",))),
+                   own=("name", "material", "cable", "marker", "load", "base"))
+BODY = Table((Source(RigidBody), Source(RigidBody.from_mesh, only=("density",))), own=("name",))
+#: A driven body's ``motion`` table (its position and rotation are the body's).
+BODY_MOTION = Table((Source(BaseMotion, only=("velocity", "angular_velocity")),))
+JOINT = Table((Source(Joint),))
+#: The tables of a system file only.
+SYSTEM_TABLES = ("system", "body", "joint")
+
+#: The tables, by name (``[[...]]`` arrays of tables: cable, marker, load, body, joint;
+#: in a system file, rod too, as :data:`SYSTEM_ROD`).
 TABLES = {"rod": ROD, "material": MATERIAL, "medium": MEDIUM, "cable": CABLE, "marker": MARKER,
           "load": None, "base": BASE, "discretization": DISCRETIZATION, "solver": SOLVER,
-          "output": OUTPUT}
-ARRAYS = ("cable", "marker", "load")
+          "output": OUTPUT, "system": SYSTEM, "body": BODY, "joint": JOINT}
+ARRAYS = ("cable", "marker", "load", "body", "joint")
 TOP = Table((Source(Model, only=("gravity",)),), own=("name", "description", "arm", "scenario")
             + tuple(TABLES))
 ARMS = ("paper",)

@@ -17,7 +17,9 @@ class KeyLines:
     """Line numbers of the tables and keys of a TOML text (tomllib gives none).
 
     Paths are tuples: ``("rod", "radius")``, ``("cable", 2, "anchor")`` for the
-    third ``[[cable]]``. Lines inside multi-line arrays and strings are skipped.
+    third ``[[cable]]``, ``("rod", 1, "cable", 0)`` for the first ``[[rod.cable]]``
+    of the second ``[[rod]]`` (a table under an array of tables belongs to its
+    last entry, as in TOML). Lines inside multi-line arrays and strings are skipped.
     """
 
     def __init__(self, text):
@@ -28,11 +30,13 @@ class KeyLines:
                 depth, in_string, _ = _scan(line, depth, in_string)
                 continue
             if match := _ARRAY_HEADER.match(line):
-                name = _split_key(match.group(1))
-                counts[name] = counts.get(name, -1) + 1
-                table = name + (counts[name],)
+                *parents, name = _split_key(match.group(1))
+                array = _in_arrays(tuple(parents), counts) + (name,)
+                counts[array] = counts.get(array, -1) + 1
+                self.lines.setdefault(array, number)
+                table = array + (counts[array],)
             elif match := _HEADER.match(line):
-                table = _split_key(match.group(1))
+                table = _in_arrays(_split_key(match.group(1)), counts)
             elif match := _ASSIGN.match(line):
                 self.lines.setdefault(table + _split_key(match.group(1)), number)
                 depth, in_string, _ = _scan(match.group(2), 0, None)
@@ -49,6 +53,17 @@ class KeyLines:
                 return self.lines[path]
             path = path[:-1]
         return None
+
+
+def _in_arrays(keys, counts):
+    """The path of the dotted ``keys``, each array of tables met on the way
+    followed by the index of its last entry so far (its count in ``counts``)."""
+    path = ()
+    for key in keys:
+        path += (key,)
+        if path in counts:
+            path += (counts[path],)
+    return path
 
 
 def deepest_line(text):

@@ -19,14 +19,16 @@ import numpy as np
 from scipy.linalg import solve_banded
 
 from ..discretise import centreline, external, rotations
+from ..discretise.assembly import Assembly
 from ..discretise.jacobian import BandedDifferences
 from ..discretise.layout import BlockLayout
 from ..discretise.load_entries import load_scale
 from ..discretise.schemes import DEFAULT_SCHEME, get_scheme
 from ..discretise.system import SemiDiscrete
-from ..errors import EquilibriumError, ParameterError
+from ..errors import EquilibriumError, NotSupportedYet, ParameterError
 from ..loads import P_STIFFNESS
 from ..model import Model
+from ..systems import System
 from .watch import state_problem
 
 #: Unknowns per element, and the equation each row of a block carries:
@@ -56,10 +58,13 @@ def equilibrium(model, t=0.0, *, scheme=None, tol=1e-10, max_iter=40):
 
     Parameters
     ----------
-    model : Model or SemiDiscrete
+    model : Model, SemiDiscrete, System or Assembly
         The model, or its system if one is built already (``simulate`` passes
         its own; a loop over many equilibria of one model saves the build and
-        the Jacobian's structure, kept per system).
+        the Jacobian's structure, kept per system). A :class:`rodmol.System`
+        (or its :class:`~rodmol.discretise.assembly.Assembly`) whose bodies
+        are all fixed or driven: each rod's rest state on its clamp, the
+        bodies at their initial poses (see :func:`system_rest_state`).
     t : float
         Time [s] at which the time-dependent inputs are evaluated.
     scheme : str, optional
@@ -76,7 +81,8 @@ def equilibrium(model, t=0.0, *, scheme=None, tol=1e-10, max_iter=40):
     Returns
     -------
     numpy.ndarray
-        A state vector that is a rest state of the dynamic right-hand side.
+        A state vector that is a rest state of the dynamic right-hand side
+        (of a System: the assembled state, ``Assembly.parts``).
 
     Feedback tensions T(t, state) read the rest state: the tensions are
     iterated (Newton's method on the feedback cables' tensions, each step an
@@ -89,6 +95,8 @@ def equilibrium(model, t=0.0, *, scheme=None, tol=1e-10, max_iter=40):
         If no equilibrium is found (e.g. a buckling load), or the one found
         has degenerate elements (see :mod:`rodmol.solve.watch`).
     """
+    if isinstance(model, (System, Assembly)):
+        return system_rest_state(model, t, scheme=scheme, tol=tol, max_iter=max_iter)
     if isinstance(model, SemiDiscrete):  # a system built already (simulate's): its scheme
         system = model
         if scheme is not None and get_scheme(scheme) != system.scheme:
@@ -103,6 +111,32 @@ def equilibrium(model, t=0.0, *, scheme=None, tol=1e-10, max_iter=40):
     problem = state_problem(system.layout, system.model.ds, t, y)
     if problem:
         raise EquilibriumError(f"the static equilibrium is not a valid state of the rod: {problem}")
+    return y
+
+
+def system_rest_state(system, t=0.0, *, scheme=None, tol=1e-10, max_iter=40):
+    """The rest state of a :class:`rodmol.System` (or its Assembly) whose bodies are all
+    fixed or driven: with every body's pose given, no rod acts on another, so each
+    rod's rest state is a single rod's (:func:`equilibrium`) clamped where its joint
+    puts it; the bodies stay at their initial poses. A free body is refused
+    (NotSupportedYet): its pose is not fixed by the rates' zeros (its pose rates
+    are its velocities, zero at any pose), only by the balance of its loads."""
+    if isinstance(system, System):
+        system = Assembly(system, scheme)
+    elif scheme is not None and get_scheme(scheme) != system.scheme:
+        raise ParameterError(f"`scheme` {scheme!r}: the system given is built with the "
+                             f"{system.scheme.name!r} scheme (leave `scheme` out, or pass the System)")
+    if system.free:
+        names = ", ".join(repr(part.name) for part in system.free)
+        raise NotSupportedYet(f"the equilibrium of a system with a free body ({names}) is not supported yet: "
+                              "its pose would have to balance its loads (weight, buoyancy, its rods); "
+                              "start from initial='straight' and let it settle")
+    y = system.initial_state()
+    for name, rod in system.rods.items():
+        try:
+            y[system.parts[name]] = equilibrium(rod, t, tol=tol, max_iter=max_iter)
+        except EquilibriumError as exc:
+            raise EquilibriumError(f"rod {name!r}: {exc}") from exc
     return y
 
 

@@ -11,7 +11,9 @@ import rodmol
 from rodmol.output.writers import read_pvd
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
-SCENARIOS = sorted(EXAMPLES.glob("*.toml"))
+#: The shipped single-rod scenario files, and the system files (with [[rod]]).
+SCENARIOS = sorted(p for p in EXAMPLES.glob("*.toml") if "[[rod]]" not in p.read_text(encoding="utf-8"))
+SYSTEM_SCENARIOS = sorted(p for p in EXAMPLES.glob("*.toml") if "[[rod]]" in p.read_text(encoding="utf-8"))
 
 
 def rodmol_cli(*args, timeout=120):

@@ -7,10 +7,34 @@ import time
 
 import pytest
 import tomllib
-from cli_helpers import EXAMPLES, SCENARIOS, assert_interrupted_run, assert_valid_series, rodmol_cli, slow_run
+from cli_helpers import (
+    EXAMPLES,
+    SCENARIOS,
+    SYSTEM_SCENARIOS,
+    assert_interrupted_run,
+    assert_valid_series,
+    rodmol_cli,
+    slow_run,
+)
 from views import assert_valid_views
 
 import rodmol
+
+
+@pytest.mark.subprocess
+def test_run_a_system_file_writes_every_part(tmp_path):
+    (scenario,) = SYSTEM_SCENARIOS
+    out = tmp_path / "out"
+    run = rodmol_cli("run", scenario, "--out", out, "--t-end", 0.05, "--quiet")
+    assert run.returncode == 0, run.stderr
+    result = rodmol.load_result(out)
+    assert result.success and result.names == ["right", "left", "head"] and result.t[-1] == pytest.approx(0.05)
+    for rod in result.rods:
+        assert assert_valid_views(out / rod) == pytest.approx(list(result.t))
+    again = rodmol_cli("run", scenario, "--out", out, "--t-end", 0.05, "--quiet")
+    assert again.returncode == 2 and "--overwrite" in again.stderr  # the earlier run is kept
+    plot = rodmol_cli("plot", out)
+    assert plot.returncode == 0 and (out / "tip_path.png").stat().st_size > 10_000
 
 
 def test_version():

@@ -149,3 +149,39 @@ def test_paraview_opens_the_streamed_views_with_moving_geometry(tmp_path):
     pixels = np.asarray(Image.open(png).convert("RGB"), dtype=float)
     drawn = np.any(np.abs(pixels - pixels[0, 0]) > 30, axis=-1).mean()
     assert 0.01 < drawn < 0.9, f"fraction of pixels drawn: {drawn}"
+
+
+BODIES_SCRIPT = textwrap.dedent("""
+    import json, sys
+    from paraview import servermanager
+    from paraview.simple import Xdmf3ReaderS
+    from vtkmodules.util.numpy_support import vtk_to_numpy
+    reader = Xdmf3ReaderS(FileName=[sys.argv[1] + "/bodies.xdmf"])
+    times = list(reader.TimestepValues)
+    reader.UpdatePipeline(times[-1])
+    data = servermanager.Fetch(reader)
+    block = data.GetBlock(0) if data.IsA("vtkMultiBlockDataSet") else data
+    print(json.dumps(dict(times=times, last=vtk_to_numpy(block.GetPoints().GetData()).tolist(),
+                          cells=block.GetNumberOfCells())))
+""")
+
+
+def test_paraview_opens_a_systems_bodies_view_at_the_bodies_poses(tmp_path):
+    from rodmol.output.system_files import body_surface
+
+    arm = rodmol.Model(rodmol.Rod(0.2, 0.008, rodmol.Material(E=1e5, nu=0.5, mu=300.0, rho=1100.0)), 6)
+    head = rodmol.RigidBody(0.3, (2e-4, 3e-4, 4e-4), volume=2e-4)
+    system = rodmol.System({"arm": arm}, {"head": head}, [rodmol.Joint(("head", (0.04, 0.0, 0.0)), ("arm", "base"))],
+                           medium="water", gravity=(0.0, 0.0, -9.81))
+    out = tmp_path / "run"
+    result = rodmol.simulate(system, 0.2, output_dt=0.05, out=out)
+    script = tmp_path / "open.py"
+    script.write_text(BODIES_SCRIPT)
+    run = xserver.run([XVFB, *xserver.XVFB_ARGS, PVPYTHON, str(script), str(out.resolve())], timeout=180)
+    assert run.returncode == 0, run.stderr[-2000:]
+    report = json.loads(run.stdout.strip().splitlines()[-1])
+    np.testing.assert_allclose(report["times"], result.t)
+    points, triangles = body_surface(head)
+    body = result["head"]
+    assert report["cells"] == len(triangles) and abs(body.position[-1, 2]) > 1e-3  # it sank
+    np.testing.assert_allclose(report["last"], body.position[-1] + points @ body.rotation[-1].T, atol=1e-6)

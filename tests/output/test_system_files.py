@@ -1,0 +1,103 @@
+"""A system's run directory: each rod's files as a single rod's, system.h5, bodies.xdmf."""
+
+import numpy as np
+import pytest
+
+import rodmol
+from rodmol.bodies import mesh_properties
+from rodmol.errors import NotSupportedYet, ParameterError
+from rodmol.output.system_files import body_surface
+
+
+def two_arms():
+    material = rodmol.Material(E=1e5, nu=0.5, mu=300.0, rho=1080.0)
+    rod = rodmol.Rod(0.2, radius=(0.012, 0.006), material=material)
+
+    def arm(side):
+        pull = rodmol.Cable((side * 0.005, 0.0), 0.2, tension=lambda t: 0.3 * min(t / 0.1, 1.0))
+        return rodmol.Model(rod, 6, cables=[pull])
+
+    head = rodmol.RigidBody(mass=0.3, inertia=(2e-4, 3e-4, 4e-4), volume=2.5e-4, centre_of_mass=(0.0, 0.0, 0.01))
+    turn = np.diag([-1.0, -1.0, 1.0])
+    return rodmol.System(
+        rods={"right": arm(1.0), "left arm": arm(-1.0)}, bodies={"head": head},
+        joints=[rodmol.Joint(("head", (0.04, 0.0, 0.0)), ("right", "base")),
+                rodmol.Joint(("head", (-0.04, 0.0, 0.0), turn), ("left arm", "base"))],
+        medium="water", gravity=(0.0, 0.0, -9.81))
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory):
+    out = tmp_path_factory.mktemp("system")
+    return rodmol.simulate(two_arms(), 0.06, output_dt=0.02, out=out), out
+
+
+def test_the_directory_reads_back_as_the_run(written):
+    result, out = written
+    back = rodmol.load_result(out)
+    assert isinstance(back, rodmol.system_result.SystemResult) and back.names == result.names
+    assert back.success and np.array_equal(back.t, result.t) and np.array_equal(back.states, result.states)
+    for field in ("position", "quaternion", "velocity", "angular_velocity", "rotation"):
+        assert np.array_equal(getattr(back["head"], field), getattr(result["head"], field)), field
+    for name in result.rods:  # each rod's own run directory (a name unfit for a file gets a key)
+        assert np.allclose(back[name].positions, result[name].positions, rtol=0, atol=1e-12)
+        assert np.array_equal(back[name].tensions, result[name].tensions)
+    assert (out / "right" / "rod.xdmf").is_file() and (out / "rod_1" / "rod.xdmf").is_file()
+    with pytest.raises(ParameterError, match="needs the System"):
+        back.momentum()
+
+
+def test_the_bodies_view_draws_the_body_at_its_pose(written):
+    import h5py
+
+    result, out = written
+    view = (out / "bodies.xdmf").read_text()
+    assert view.count('<Grid Name="head" GridType="Uniform">') == len(result.t)
+    points, triangles = body_surface(result.assembly.bodies["head"].body)
+    with h5py.File(out / "system.h5") as handle:
+        placed = handle["view/head_points"][()]
+        assert np.array_equal(handle["view/head_triangles"][()], triangles)
+    head = result["head"]
+    expected = head.position[:, None, :] + np.einsum("nij,pj->npi", head.rotation, points)
+    assert np.allclose(placed, expected, atol=1e-7)  # single precision
+
+
+def test_a_body_without_mesh_is_drawn_as_the_ellipsoid_of_its_mass_and_inertia():
+    body = rodmol.RigidBody(2.0, np.diag([0.01, 0.02, 0.025]), centre_of_mass=(0.1, -0.2, 0.3))
+    points, triangles = body_surface(body)
+    volume, centre, inertia = mesh_properties(points, triangles)  # of the drawn, closed surface
+    assert np.allclose(centre, body.centre_of_mass, atol=1e-12)
+    assert np.allclose(body.mass / volume * inertia, body.inertia, rtol=0.02)  # a polyhedron, 16 x 32
+    sphere = rodmol.RigidBody(2.0, (0.02, 0.02, 0.02))
+    assert np.allclose(np.linalg.norm(body_surface(sphere)[0], axis=1), np.sqrt(0.02 / (0.4 * 2.0)))
+
+
+def test_an_earlier_run_is_kept_and_resume_is_refused(written):
+    result, out = written
+    with pytest.raises(ParameterError, match="overwrite"):
+        rodmol.simulate(two_arms(), 0.02, output_dt=0.02, out=out)
+    with pytest.raises(NotSupportedYet, match="resume"):
+        rodmol.simulate(two_arms(), 0.06, output_dt=0.02, out=out, resume=True)
+    assert np.array_equal(rodmol.load_result(out).t, result.t)  # untouched
+
+
+def test_plot_draws_every_part(written, tmp_path):
+    from rodmol.output.pictures import plot
+
+    result, _ = written
+    paths = plot(result, tmp_path)
+    assert len(paths) == 3 and all(p.stat().st_size > 10_000 for p in paths)
+
+
+def test_render_draws_every_rod_and_body(written, tmp_path):
+    pytest.importorskip("pyvista")
+    from PIL import Image
+
+    from rodmol.output.pictures import render
+
+    _, out = written
+    (png,) = render(rodmol.load_result(out), tmp_path, size=(320, 240), frames=0)
+    pixels = np.asarray(Image.open(png).convert("RGB"), dtype=float)
+    body = np.all(np.abs(pixels - (0.8 * 255, 0.55 * 255, 0.35 * 255)) < 60, axis=-1).mean()  # the head's colour
+    drawn = np.any(np.abs(pixels - pixels[0, 0]) > 30, axis=-1).mean()
+    assert body > 0.002 and drawn > body + 0.01  # the head, and the rods besides

@@ -1,0 +1,172 @@
+"""System files: [system], [[rod]] with its nested tables, [[body]], [[joint]]."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rodmol
+from rodmol.scenario import tables
+from rodmol.scenario.file import ScenarioError, load_scenario, parse_scenario
+from rodmol.scenario.toml_lines import KeyLines
+
+ROOT = Path(__file__).resolve().parents[2]
+TWO_ARMS = ROOT / "examples" / "two_arms.toml"
+
+
+def two_arms_in_python():
+    """examples/two_arms.toml written in Python (docs/systems.md's example, N = 8 and 10)."""
+    material = rodmol.Material(E=1e5, nu=0.5, mu=300.0, rho=1080.0)
+    rod = rodmol.Rod(0.2, radius=(0.012, 0.006), material=material)
+
+    def arm(side, n):
+        pull = rodmol.Cable((side * 0.005, 0.0), 0.2, tension=((0.0, 0.0), (0.1, 0.3)), name="cable 1")
+        return rodmol.Model(rod, n, cables=[pull])
+
+    head = rodmol.RigidBody(mass=0.3, inertia=(2e-4, 2e-4, 2e-4), volume=2.5e-4,
+                            added_mass=(0.1, 0.1, 0.1, 0.0, 0.0, 0.0), drag=(0.5, 0.5, 0.5, 1e-3, 1e-3, 1e-3))
+    turn = np.diag([-1.0, -1.0, 1.0])
+    return rodmol.System(
+        rods={"right": arm(1.0, 8), "left": arm(-1.0, 10)}, bodies={"head": head},
+        joints=[rodmol.Joint(("head", (0.04, 0.0, 0.0)), ("right", "base")),
+                rodmol.Joint(("head", (-0.04, 0.0, 0.0), turn), ("left", "base"))],
+        medium="water", gravity=(0.0, 0.0, -9.81))
+
+
+def test_the_example_file_is_the_python_system_and_runs_the_same():
+    spec = load_scenario(TWO_ARMS, overrides={"solver.t_end": 0.02})
+    system, expected = spec.model, two_arms_in_python()
+    assert isinstance(system, rodmol.System) and spec.solver["initial"] == "straight"
+    assert {k: m.n_elements for k, m in system.rods.items()} == {"right": 8, "left": 10}
+    assert [c.offset for m in system.rods.values() for c in m.cables] == [(0.005, 0.0), (-0.005, 0.0)]
+    assert system.medium == expected.medium and np.array_equal(system.gravity, expected.gravity)
+    for name in expected.rods:
+        (body, point, rotation), (body_e, point_e, rotation_e) = system.clamps[name], expected.clamps[name]
+        assert body == body_e and np.array_equal(point, point_e) and np.array_equal(rotation, rotation_e)
+    assert np.array_equal(system.bodies["head"].mass_matrix, expected.bodies["head"].mass_matrix)
+    from_file = spec.simulate()
+    from_python = rodmol.simulate(expected, 0.02, output_dt=spec.solver["output_dt"], initial="straight")
+    assert from_file.success and from_python.success
+    assert np.array_equal(from_file.states, from_python.states)
+    assert from_file["head"].position[-1, 2] < 0.0  # it sinks: heavier than the water it displaces
+
+
+def test_a_table_under_an_array_of_tables_is_placed_in_its_last_entry():
+    lines = KeyLines("[[rod]]\nname = 'a'\n[rod.material]\nE = 1\n[[rod]]\n[[rod.cable]]\n"
+                     "anchor = 1\n[[rod.cable]]\n[[body]]\n[[rod.load]]\ns = 2\n")
+    assert lines.find(("rod", 0, "material", "E")) == 4
+    assert lines.find(("rod", 1, "cable", 0, "anchor")) == 7
+    assert lines.find(("rod", 1, "cable", 1)) == 8
+    assert lines.find(("rod", 1, "load", 0, "s")) == 11  # after [[body]]: the last [[rod]]'s
+
+
+BAD = """\
+medium = "water"
+[system]
+gravity = [0.0, -9.81]
+[[rod]]
+name = "arm"
+length = 0.2
+radius = 0.01
+[rod.material]
+E = -1.0
+nu = 0.5
+mu = 0.0
+rho = 1000.0
+[[rod.cable]]
+offset = [0.002, 0.0]
+anchor = 0.3
+[[body]]
+name = "head"
+mass = -1.0
+inertia = [1e-4, 1e-4, 1e-4]
+[[joint]]
+a = ["head", [0.0, 0.0, 0.0]]
+b = ["amr", "base"]
+[[rod]]
+name = "arm"
+length = 0.1
+radius = 0.01
+[rod.material]
+E = 1e5
+nu = 0.5
+mu = 0.0
+rho = 1000.0
+[solver]
+t_end = 1.0
+initial = "equilibrium"
+"""
+
+
+def test_every_problem_of_a_system_file_at_once_with_its_line_and_table():
+    with pytest.raises(ScenarioError) as caught:
+        parse_scenario(BAD)
+    found = {(p.line, p.table, p.message.split()[0]) for p in caught.value.problems}
+    assert found == {
+        (1, "", "`medium`"),  # a single-rod key: its place in a system file is named
+        (3, "[system]", "`gravity`"),
+        (9, "[[rod]] #1 [material]", "`E`"),
+        (15, "[[rod]] #1 [[cable]] #1", "`anchor`"),
+        (18, "[[body]] #1", "`mass`"),
+        (20, "[[joint]] #1", "`joints[0]`"),  # names no rod ("did you mean 'arm'?")
+        (24, "[[rod]] #2", "the"),  # the name used twice
+        (34, "[solver]", "the"),  # the equilibrium start, not yet for systems
+    }
+    messages = "\n".join(p.message for p in caught.value.problems)
+    for words in ("[system] medium", "used twice", "not supported yet", "did you mean 'arm'"):
+        assert words in messages
+
+
+def test_a_joint_naming_no_rod_is_placed_at_its_joint():
+    text = TWO_ARMS.read_text().replace('b = ["left", "base"]', 'b = ["lft", "base"]')
+    with pytest.raises(ScenarioError) as caught:
+        parse_scenario(text)
+    (problem,) = caught.value.problems
+    assert problem.table == "[[joint]] #2" and "did you mean 'left'" in problem.message
+    assert text.splitlines()[problem.line - 1] == "[[joint]]" and text.count("[[joint]]") == 2
+
+
+def test_a_body_from_a_mesh_and_a_driven_body(tmp_path):
+    meshio = pytest.importorskip("meshio")
+    corners = np.array([[x, y, z] for x in (0, 0.1) for y in (0, 0.2) for z in (0, 0.3)], dtype=float)
+    faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
+    triangles = [t for a, b, c, d in faces for t in ((a, b, c), (a, c, d))]
+    meshio.write(tmp_path / "box.stl", meshio.Mesh(corners, [("triangle", np.array(triangles))]))
+    text = TWO_ARMS.read_text().split("[[body]]")[0] + """
+[[body]]
+name = "head"
+mesh = "box.stl"
+density = 500.0
+position = [0.0, 0.0, 1.0]
+
+[[body]]
+name = "cart"
+mass = 1.0
+inertia = [1.0, 1.0, 1.0]
+position = [0.0, 2.0, 0.0]
+motion = { velocity = [0.1, 0.0, 0.0] }
+
+[[joint]]
+a = ["head", [0.04, 0.0, 0.0]]
+b = ["right", "base"]
+
+[[joint]]
+a = ["cart", [0.0, 0.0, 0.0]]
+b = ["left", "base"]
+"""
+    system = parse_scenario(text, base_dir=tmp_path).model
+    head, cart = system.bodies["head"], system.bodies["cart"]
+    assert head.mass == pytest.approx(500.0 * 0.1 * 0.2 * 0.3, rel=1e-12)
+    assert head.volume == pytest.approx(0.006, rel=1e-12)
+    assert np.allclose(head.centre_of_mass, (0.05, 0.1, 0.15)) and np.array_equal(head.position, (0, 0, 1))
+    assert cart.driven and np.array_equal(cart.position, (0.0, 2.0, 0.0))
+    assert np.array_equal(cart.motion.velocity(3.0), (0.1, 0.0, 0.0))
+
+
+def test_the_reference_documents_a_system_rods_own_keys():
+    text = (ROOT / "docs" / "scenario-reference.md").read_text(encoding="utf-8")
+    section = text.split("## `[[rod]]` (systems", 1)[1].split("\n## ", 1)[0]
+    rows = {line.split("`")[1] for line in section.splitlines() if line.startswith("| `")}
+    named = set(tables.SYSTEM_ROD.names()) - set(tables.ROD.names())
+    assert rows == named
+    assert all(f"`{key}`" in section for key in tables.ROD.names())
