@@ -82,9 +82,9 @@ def system(data, ctx, n_elements, solver):
     return FAILED if parts_failed else built
 
 
-def _joint(a, b, kind="clamp", name=None):
+def _joint(name=None, **arguments):
     """A Joint from a [[joint]] table (``name``: the reader's numbering; a joint has none)."""
-    return Joint(a, b, kind)
+    return Joint(**arguments)
 
 
 def _named(data, ctx, kind, read):

@@ -170,3 +170,43 @@ def test_the_reference_documents_a_system_rods_own_keys():
     named = set(tables.SYSTEM_ROD.names()) - set(tables.ROD.names())
     assert rows == named
     assert all(f"`{key}`" in section for key in tables.ROD.names())
+
+
+PAYLOAD = """\
+[solver]
+t_end = 0.1
+[system]
+medium = "air"
+[discretization]
+n_elements = 8
+[[rod]]
+name = "beam"
+length = 0.2
+radius = 0.005
+[rod.material]
+E = 1e7
+nu = 0.5
+mu = 1000.0
+rho = 1000.0
+[[body]]
+name = "mass"
+mass = 0.01
+inertia = [1e-6, 1e-6, 1e-6]
+position = [0.2, 0.0, 0.0]
+[[joint]]
+a = ["mass", [0.0, 0.0, 0.0]]
+b = ["beam", "tip"]
+kind = "pin"
+stiffness = 1e6
+damping = 3.0
+"""
+
+
+def test_a_penalty_joint_takes_every_argument_of_joint():
+    """A tip pinned to a payload with its own stiffness and damping: every argument of
+    rodmol.Joint reaches it from the file (the reader re-types none of them)."""
+    system = parse_scenario(PAYLOAD).model
+    (joint,) = system.penalty_joints
+    assert (joint.rod, joint.body, joint.kind) == ("beam", "mass", "pin")
+    hold = system.rods["beam"].loads[joint.load]
+    assert (hold.stiffness, hold.damping) == (1e6, 3.0)
