@@ -5,7 +5,7 @@ A bounded Levenberg-Marquardt loop over the tensions of the actuated cables.
 Each iterate is a static equilibrium (:mod:`rodmol.solve.equilibrium`) warm-
 started from the last one; the sensitivities of the tip to the tensions are
 exact, from the equilibrium's Jacobian by the implicit-function theorem
-(:func:`~rodmol.solve.equilibrium.tension_sensitivity`), not from differences
+(:func:`~rodmol.solve.tension_statics.tension_sensitivity`), not from differences
 of whole solves; each step is a bounded linear least-squares problem
 (``scipy.optimize.lsq_linear``) with the cables' bounds. Displacement-
 controlled cables are solved for their tension too, and the actuator
@@ -24,7 +24,7 @@ from ..discretise.schemes import DEFAULT_SCHEME
 from ..discretise.system import SemiDiscrete, tensions_by_hand
 from ..errors import EquilibriumError, ParameterError
 from ..model import Model
-from ..solve.equilibrium import rest_state, tension_sensitivity
+from ..solve.tension_statics import rest_state, tension_sensitivity
 from ._targets import Targets, check_aims
 
 #: Default reach tolerance [m] on the weighted tip residual.

@@ -9,7 +9,7 @@ from scipy.integrate import solve_ivp
 
 import rodmol
 from rodmol.calibrate import linearize
-from rodmol.solve.equilibrium import tension_sensitivity
+from rodmol.solve.tension_statics import tension_sensitivity
 
 
 @pytest.fixture(scope="module")

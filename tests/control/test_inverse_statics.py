@@ -8,7 +8,7 @@ import pytest
 
 import rodmol
 from rodmol.control import inverse_statics, inverse_statics_path
-from rodmol.solve.equilibrium import tension_sensitivity
+from rodmol.solve.tension_statics import tension_sensitivity
 
 N = 8
 PULLED = {11: 1.0, 12: 0.5, 3: 0.4}
