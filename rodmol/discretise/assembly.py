@@ -31,11 +31,24 @@ forces (and clamp moments) are equal and opposite, acting at the two nodes
 (the couple of the pair, gap x F, is O(F^2 / k)). :mod:`rodmol.discretise.joints`
 holds the joints' parts.
 
+What a free body carries: the rods' velocity nodes stand for their
+``node_lengths``, which leave out the length next to the base node (ds/2
+in the centred scheme, none upwind); on a body that piece, the rod's base
+segment, moves with the clamp, so the body carries it
+(:meth:`BodyPart.carry`): the base section's mass (with the fluid's added
+mass if the rod's model has it) and rotational inertia times that length,
+lumped at the clamp point as the nodes' masses are at theirs, in the mass
+matrix with their parallel-axis terms, and their weight less buoyancy at
+the clamp.
+
 Newton-Euler of a body about its origin, body frame, with the momentum
-P = m (v + w x c) and H = I_o w + m c x v of its own mass:
+(P, H) = M_r (v, w) of its own mass and its base segments (M_r: the 6x6
+mass matrix without the body's added mass, as P = m (v + w x c),
+H = I_o w + m c x v for the body alone):
 M [v_t, w_t] = [F - w x P, T - w x H - v x P], where the 6x6 mass matrix M
-adds the added mass (its gyroscopic terms are left out), F, T the rods'
-wrenches, weight minus buoyancy at the centre of mass and quadratic drag.
+adds the body's added mass (its gyroscopic terms are left out), F, T the
+rods' wrenches, weight minus buoyancy (the body's at its centre of mass,
+the segments' at their clamps) and quadratic drag.
 """
 
 import numpy as np
@@ -74,7 +87,9 @@ def clamp_velocities(points, turns, v, w):
 class BodyPart:
     """One rigid body's place in the state, its constant data and its rods'
     clamps stacked for the coupling (points (n, 3) [m] and rotations (n, 3, 3),
-    base to body frame)."""
+    base to body frame). ``mass_matrix`` (6, 6), ``rigid_mass`` (the same
+    without the body's added mass) and ``params`` (:func:`pack_body`'s row)
+    include the rods' base segments it carries (:meth:`carry`)."""
 
     def __init__(self, name, body, start, fluid_density):
         self.name, self.body = name, body
@@ -349,7 +364,8 @@ class Assembly:
         """Total linear momentum [kg m/s] and angular momentum about the
         global origin [kg m^2/s] of the bodies and rods, global, at the state
         ``y``: the nodes' as their mass per length times the length each
-        stands for, at their integrated positions."""
+        stands for, at their integrated positions; a free body's with the
+        rods' base segments it carries (:meth:`BodyPart.carry`)."""
         linear, angular = np.zeros(3), np.zeros(3)
         for name, sd in self.rods.items():
             y_rod, lay = y[self.parts[name]], sd.layout
