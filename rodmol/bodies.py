@@ -94,10 +94,7 @@ class RigidBody:
         start = motion if isinstance(motion, BaseMotion) else pose
         put(self, "position", np.array(start.position, dtype=float))
         put(self, "rotation", np.array(start.rotation, dtype=float))
-        c, m = self.centre_of_mass, self.mass
-        about_origin = self.inertia + m * (np.dot(c, c) * np.eye(3) - np.outer(c, c))
-        cross_c = np.array([[0.0, -c[2], c[1]], [c[2], 0.0, -c[0]], [-c[1], c[0], 0.0]])
-        matrix = np.block([[m * np.eye(3), -m * cross_c], [m * cross_c, about_origin]])
+        matrix = mass_matrix_about_origin(self.mass * np.eye(3), self.inertia, self.centre_of_mass)
         put(self, "mass_matrix", matrix + added)
 
     @property
@@ -130,6 +127,20 @@ class RigidBody:
         volume, centre, inertia = mesh_properties(mesh.points, np.concatenate(triangles))
         return cls(density * volume, density * inertia, volume=volume, centre_of_mass=centre,
                    mesh=str(path), **options)
+
+
+def mass_matrix_about_origin(translational, rotational, point):
+    """The 6x6 mass matrix about the body origin (velocities (v, w) of the
+    origin, body frame) of a rigid part at ``point`` [m] (body frame) with the
+    3x3 ``translational`` mass [kg] (m I for a plain mass; anisotropic with an
+    added mass) and the 3x3 ``rotational`` inertia [kg m^2] about the point:
+    its kinetic energy is 1/2 (v_p M_t v_p + w J w) with v_p = v + w x p,
+    which gives the parallel-axis terms."""
+    translational, rotational = np.asarray(translational, dtype=float), np.asarray(rotational, dtype=float)
+    p = np.asarray(point, dtype=float)
+    cross_p = np.array([[0.0, -p[2], p[1]], [p[2], 0.0, -p[0]], [-p[1], p[0], 0.0]])
+    return np.block([[translational, -translational @ cross_p],
+                     [cross_p @ translational, rotational - cross_p @ translational @ cross_p]])
 
 
 def mesh_properties(points, triangles):

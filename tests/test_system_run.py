@@ -93,12 +93,47 @@ def test_free_body_and_rod_in_vacuum_keep_zero_momentum_to_the_tolerance():
 
 
 def test_free_fall_gains_the_momentum_of_the_total_weight():
+    """The whole rod's mass from its volume: the head carries the base half cell."""
     g = np.array([0.0, 0.0, -9.81])
     run = _free_head(_one_arm(), 1e-6, gravity=g, t_end=0.1)
-    arm = run.assembly.rods["arm"]
-    mass = 0.05 + np.sum(arm.sampled.mass[:, 0] * arm.node_lengths)
+    mass = 0.05 + 1080.0 * np.pi * 0.01**2 * 0.2
     linear, _ = run.momentum()
     np.testing.assert_allclose(linear, mass * g * run.t[:, None], atol=1e-5 * mass * 9.81 * 0.1)
+
+
+def test_a_free_body_and_its_rod_fall_at_g_unstrained_and_unturned():
+    """In vacuum everything falls at g: the head (its centre of mass off its
+    origin, the arm clamped off it at an angle) with the arm's base half cell
+    it carries; a mass without its weight, or a weight away from its mass,
+    would strain the arm or turn the head."""
+    g = np.array([0.0, -3.0, -9.0])
+    arm = rodmol.Model(rodmol.Rod(0.2, radius=(0.01, 0.005), material=MATERIAL), 8)
+    run = _free_head({"arm": (arm, np.array([0.02, 0.0, 0.01]), _rz(0.3))}, 1e-8, gravity=g, t_end=0.1)
+    head, arm = run["head"], run["arm"]
+    np.testing.assert_allclose(np.einsum("nij,nj->ni", head.rotation, head.velocity), g * run.t[:, None],
+                               rtol=0, atol=1e-9)
+    np.testing.assert_allclose(head.angular_velocity, 0.0, atol=1e-9)
+    u = arm.integrated_positions  # a rigid translation: every node as the base
+    np.testing.assert_allclose(u - u[:, :1], np.broadcast_to(u[0] - u[0, :1], u.shape), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(u[:, 0] - u[0, 0], 0.5 * g * run.t[:, None] ** 2, rtol=0, atol=1e-8)
+
+
+def test_a_neutrally_buoyant_rod_on_a_neutrally_buoyant_body_stays_at_rest_in_water():
+    """Rod and body of the water's density (the rod's added mass on, the head's
+    centre of mass off its origin, the arm clamped off it at an angle): no net
+    force anywhere, so nothing moves, to rounding."""
+    water = rodmol.MEDIA["water"].rho
+    rod = rodmol.Rod(0.2, radius=(0.01, 0.005), material=rodmol.Material(E=1e5, nu=0.5, mu=300.0, rho=water))
+    head = rodmol.RigidBody(water * 5e-5, (2e-5, 3e-5, 4e-5), volume=5e-5, centre_of_mass=(0.0, 0.004, 0.0))
+    system = rodmol.System({"arm": rodmol.Model(rod, 8)}, {"head": head},
+                           [rodmol.Joint(("head", (0.02, 0.0, 0.01), _rz(0.3)), ("arm", "base"))],
+                           medium="water", gravity=(0.0, -3.0, -9.81))
+    run = rodmol.simulate(system, 0.5, output_dt=0.1)
+    assert run.success
+    np.testing.assert_allclose(run["head"].velocity, 0.0, atol=1e-14)
+    np.testing.assert_allclose(run["head"].angular_velocity, 0.0, atol=1e-13)
+    np.testing.assert_allclose(run["arm"].velocity, 0.0, atol=1e-14)
+    np.testing.assert_allclose(run["head"].position, 0.0, atol=1e-14)
 
 
 def test_mirrored_pair_of_arms_leaves_the_head_unrotated():
@@ -181,7 +216,7 @@ def test_sinking_body_starts_at_its_net_weight_over_its_mass_and_ends_at_its_ter
                            medium=fluid, gravity=(0.0, 0.0, -g))
     run = rodmol.simulate(system, 1.0, rtol=1e-7, output_times=[0.002])
     weight = (mass - 1000.0 * volume) * g
-    rod_mass = 1000.0 * np.pi * 0.005**2 * 0.1 * (1 - 0.5 / 6)  # the nodes' (half a cell at the base is not)
+    rod_mass = 1000.0 * np.pi * 0.005**2 * 0.1  # the nodes' and the base half cell the body carries
     speed = -run["body"].velocity[:, 2]
     assert speed[1] / 0.002 == pytest.approx(weight / (mass + added + rod_mass), rel=2e-3)
     assert speed[-1] == pytest.approx(np.sqrt(weight / drag), rel=1e-4)

@@ -31,21 +31,36 @@ forces (and clamp moments) are equal and opposite, acting at the two nodes
 (the couple of the pair, gap x F, is O(F^2 / k)). :mod:`rodmol.discretise.joints`
 holds the joints' parts.
 
+What a free body carries: the rods' velocity nodes stand for their
+``node_lengths``, which leave out the length next to the base node (ds/2
+in the centred scheme, none upwind); on a body that piece, the rod's base
+segment, moves with the clamp, so the body carries it
+(:meth:`BodyPart.carry`): the base section's mass (with the fluid's added
+mass if the rod's model has it) and rotational inertia times that length,
+lumped at the clamp point as the nodes' masses are at theirs, in the mass
+matrix with their parallel-axis terms, and their weight less buoyancy at
+the clamp.
+
 Newton-Euler of a body about its origin, body frame, with the momentum
-P = m (v + w x c) and H = I_o w + m c x v of its own mass:
+(P, H) = M_r (v, w) of its own mass and its base segments (M_r: the 6x6
+mass matrix without the body's added mass, as P = m (v + w x c),
+H = I_o w + m c x v for the body alone):
 M [v_t, w_t] = [F - w x P, T - w x H - v x P], where the 6x6 mass matrix M
-adds the added mass (its gyroscopic terms are left out), F, T the rods'
-wrenches, weight minus buoyancy at the centre of mass and quadratic drag.
+adds the body's added mass (its gyroscopic terms are left out), F, T the
+rods' wrenches, weight minus buoyancy (the body's at its centre of mass,
+the segments' at their clamps) and quadratic drag.
 """
 
 import numpy as np
 from scipy import sparse
 
+from ..bodies import mass_matrix_about_origin
 from .joints import JointPart, RecordedJoints, RodJointPart, block_entries
 from .layout import BlockLayout
 from .physics import quaternion_rate
-from .rigid import clamp_wrench, free_body_rates, pack_body
+from .rigid import NET_MASS, NET_MOMENT, clamp_wrench, free_body_rates, pack_body
 from .rotations import from_matrix, matrices
+from .sampling import section_masses
 from .stencil import WORK_TOTAL
 from .system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE, SemiDiscrete, field_scales
 
@@ -72,7 +87,9 @@ def clamp_velocities(points, turns, v, w):
 class BodyPart:
     """One rigid body's place in the state, its constant data and its rods'
     clamps stacked for the coupling (points (n, 3) [m] and rotations (n, 3, 3),
-    base to body frame)."""
+    base to body frame). ``mass_matrix`` (6, 6), ``rigid_mass`` (the same
+    without the body's added mass) and ``params`` (:func:`pack_body`'s row)
+    include the rods' base segments it carries (:meth:`carry`)."""
 
     def __init__(self, name, body, start, fluid_density):
         self.name, self.body = name, body
@@ -80,8 +97,9 @@ class BodyPart:
         self.layout = BlockLayout(1, dict(BODY_FIELDS if body.free else POSE_FIELDS))
         self.slice = slice(start, start + self.layout.size)
         self.fields = {f: slice(start + s.start, start + s.stop) for f, s in self.layout.slices().items()}
-        self.inverse_mass = np.linalg.inv(body.mass_matrix)
-        self.rigid_mass = body.mass_matrix - body.added_mass  # its own, for the momentum
+        self.mass_matrix = body.mass_matrix.copy()  # with the rods' base segments (clamp)
+        self.inverse_mass = np.linalg.inv(self.mass_matrix)
+        self.rigid_mass = body.mass_matrix - body.added_mass  # gyroscopic terms and momentum: no body added mass
         self.rods, self.systems = [], []
         self.works = []  # each rod kernel's scratch: cell 0's total stress after a call (stencil.rhs)
         self.points, self.turns = np.zeros((0, 3)), np.zeros((0, 3, 3))
@@ -92,6 +110,7 @@ class BodyPart:
     def clamp(self, name, sd, start, point, turn):
         """Hold the base of rod ``name`` (its system ``sd``, its state from ``start``)."""
         self.shares = np.append(self.shares, sd.scheme.base_share * sd.model.ds)
+        self.carry(sd, point, turn)
         self.rods.append(name)
         self.systems.append(sd)
         self.works.append(sd.kernel_arguments()[-1])
@@ -101,6 +120,22 @@ class BodyPart:
         sl, first = sd.layout.slices(), start + sd.layout.header
         index = np.r_[first + sl["q"].start:first + sl["q"].stop, first + sl["k"].start:first + sl["k"].stop]
         self.strains = np.vstack([self.strains, index])
+
+    def carry(self, sd, point, turn):
+        """Add to the body the base segment of the rod of system ``sd``
+        clamped at ``point`` [m] with ``turn`` (base to body frame): the
+        length of rod its velocity nodes leave out (the base node's,
+        ``Scheme.node_lengths``: ds/2 centred, none upwind) with the base
+        section's masses, lumped at the clamp as the nodes' are at theirs."""
+        length = max(sd.model.rod.length - float(np.sum(sd.node_lengths)), 0.0)
+        mass, _, inertia, net_mass = (length * a[0] for a in section_masses(sd.model, [0.0]))
+        turn = np.asarray(turn, dtype=float)
+        segment = mass_matrix_about_origin(turn @ np.diag(mass) @ turn.T, turn @ np.diag(inertia) @ turn.T, point)
+        self.mass_matrix += segment
+        self.inverse_mass = np.linalg.inv(self.mass_matrix)
+        self.rigid_mass += segment  # its added mass too, as the rods' nodes count theirs
+        self.params[NET_MASS] += net_mass
+        self.params[NET_MOMENT:NET_MOMENT + 3] += net_mass * np.asarray(point, dtype=float)
 
     def base_velocities(self, v, w):
         """(n, 6) base velocities of the rods for the body velocities (v, w) (:func:`clamp_velocities`)."""
@@ -329,7 +364,8 @@ class Assembly:
         """Total linear momentum [kg m/s] and angular momentum about the
         global origin [kg m^2/s] of the bodies and rods, global, at the state
         ``y``: the nodes' as their mass per length times the length each
-        stands for, at their integrated positions."""
+        stands for, at their integrated positions; a free body's with the
+        rods' base segments it carries (:meth:`BodyPart.carry`)."""
         linear, angular = np.zeros(3), np.zeros(3)
         for name, sd in self.rods.items():
             y_rod, lay = y[self.parts[name]], sd.layout

@@ -21,17 +21,21 @@ from .physics import (
 )
 
 #: Entries of a body's parameter row: net mass [kg] (minus the displaced
-#: fluid), centre of mass (3) [m], drag coefficients (6), body frame.
-NET_MASS, CENTRE, DRAG = 0, 1, 4
-N_BODY_PARAMS = 10
+#: fluid), centre of mass (3) [m] (where the drag acts), drag coefficients
+#: (6), and the net mass's first moment about the origin (3) [kg m] (where
+#: the weight less buoyancy acts), body frame. The net mass and its moment
+#: include what the body carries (the rods' base segments).
+NET_MASS, CENTRE, DRAG, NET_MOMENT = 0, 1, 4, 10
+N_BODY_PARAMS = 13
 
 
 def pack_body(body, fluid_density):
-    """The parameter row of ``body`` in a fluid of ``fluid_density`` [kg/m^3]."""
+    """The parameter row of ``body`` alone in a fluid of ``fluid_density`` [kg/m^3]."""
     row = np.empty(N_BODY_PARAMS)
     row[NET_MASS] = body.mass - fluid_density * body.volume
     row[CENTRE:CENTRE + 3] = body.centre_of_mass
     row[DRAG:DRAG + 6] = body.drag
+    row[NET_MOMENT:NET_MOMENT + 3] = row[NET_MASS] * body.centre_of_mass
     return row
 
 
@@ -63,15 +67,17 @@ def clamp_wrench(stress, strains, shares, turns, points):
 @jit
 def free_body_rates(state, params, rigid, inverse, gravity, force, torque, smoothing2, restoring, out):
     """Rates of a free body's block (x, Q, v, w) into ``out`` (13,): ``state``
-    its block, ``params`` its :func:`pack_body` row, ``rigid`` and
-    ``inverse`` its own 6x6 mass matrix and the inverse of the one with the
-    added mass, ``gravity`` (3,) global, ``force``, ``torque`` the rods'
+    its block, ``params`` its :func:`pack_body` row (with what it carries),
+    ``rigid`` its 6x6 mass matrix without its own added mass (the carried
+    rods' base segments with theirs, as their nodes) and ``inverse`` the
+    inverse of the one with all added mass, ``gravity`` (3,) global, ``force``, ``torque`` the rods'
     wrench about the origin (body frame)."""
     quat = (state[3], state[4], state[5], state[6])
     v, w = _row3(state, 7), _row3(state, 10)
     r = rotation(quat)
     c = _row3(params, CENTRE)
-    weight = scale(params[NET_MASS], to_local(r, gravity))
+    g = to_local(r, gravity)
+    weight = scale(params[NET_MASS], g)
     v_c = add(v, cross(w, c))
     drag = (-params[DRAG] * v_c[0] * np.sqrt(v_c[0] * v_c[0] + smoothing2),
             -params[DRAG + 1] * v_c[1] * np.sqrt(v_c[1] * v_c[1] + smoothing2),
@@ -79,9 +85,8 @@ def free_body_rates(state, params, rigid, inverse, gravity, force, torque, smoot
     spin = (-params[DRAG + 3] * w[0] * np.sqrt(w[0] * w[0] + smoothing2),
             -params[DRAG + 4] * w[1] * np.sqrt(w[1] * w[1] + smoothing2),
             -params[DRAG + 5] * w[2] * np.sqrt(w[2] * w[2] + smoothing2))
-    at_centre = add(weight, drag)
-    total_f = add(at_centre, force)
-    total_t = add(add(cross(c, at_centre), spin), torque)
+    total_f = add(add(weight, drag), force)
+    total_t = add(add(add(cross(c, drag), cross(_row3(params, NET_MOMENT), g)), spin), torque)
     vw = (v[0], v[1], v[2], w[0], w[1], w[2])
     p = np.zeros(6)
     for i in range(6):

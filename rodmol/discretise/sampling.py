@@ -32,6 +32,21 @@ def rest_strains(model, s):
     return model.rod.rest_strains_at(np.asarray(s, dtype=float))
 
 
+def section_masses(model, s):
+    """The sections' masses at arc lengths ``s`` [m], local frame: ``mass``
+    (len(s), 3) [kg/m] (with the added mass), ``added`` (len(s), 3) [kg/m],
+    rotational ``inertia`` (len(s), 3) [kg m] and ``net_mass`` (len(s),)
+    [kg/m] (minus the displaced fluid). The velocity nodes sample them
+    (:class:`Sampled`), and so does a body carrying a rod's base
+    (:mod:`rodmol.discretise.assembly`)."""
+    s = np.asarray(s, dtype=float)
+    rod, med = model.rod, model.medium
+    rho, a = rod.material.rho, rod.area(s)
+    coeff = np.array([0.0, med.By, med.Bz]) if model.added_mass else np.zeros(3)
+    added = med.rho * a[:, None] * coeff
+    return rho * a[:, None] + added, added, rho * rod.second_moments(s), (rho - med.rho) * a
+
+
 def cable_weights(model):
     """(n_cables, N) fraction of each strain node's cell on the cable's path:
     moving the anchor inside a cell shifts its concentrated load smoothly
@@ -53,15 +68,10 @@ class Sampled:
 
     def __init__(self, model):
         n, rod, med = model.n_elements, model.rod, model.medium
-        rho = rod.material.rho
         s_vel = model.s_nodes[1:]
         self.kl, self.kth, self.vl, self.vth = cell_properties(model, model.s_nodes[:-1])
-        a, r = rod.area(s_vel), rod.radius_at(s_vel)
-        coeff = np.array([0.0, med.By, med.Bz]) if model.added_mass else np.zeros(3)
-        self.added = med.rho * a[:, None] * coeff
-        self.mass = rho * a[:, None] + self.added
-        self.inertia = rho * rod.second_moments(s_vel)
-        self.net_mass = (rho - med.rho) * a
+        r = rod.radius_at(s_vel)
+        self.mass, self.added, self.inertia, self.net_mass = section_masses(model, s_vel)
         if not model.drag:
             self.drag_coefficient = np.zeros((n, 3))
         elif model.drag_law == "componentwise":

@@ -2,9 +2,11 @@
 composed layout and Jacobian pattern."""
 
 import numpy as np
+import pytest
 
 import rodmol
 from rodmol.discretise.assembly import Assembly
+from rodmol.discretise.rigid import NET_MASS, NET_MOMENT
 from rodmol.discretise.system_preconditioner import SystemPreconditioner
 
 
@@ -115,3 +117,37 @@ def test_schur_preconditioner_inverts_the_newton_matrix_of_a_loop():
                             *[np.linalg.solve(np.eye(13) - gamma * precond._jac[b], r[assembly.parts[b]])
                               for b in ("bar", "ring")]])
     assert np.abs((apart - v) / scale).max() > 100 * error
+
+
+def test_a_free_body_carries_the_base_half_cell_of_each_rod_clamped_to_it():
+    """The head carries the half cell (ds/2, centred) of arms a and b next to
+    it, lumped at their clamps: its mass matrix gains their kinetic energy
+    1/2 (v_p Rj M Rj^T v_p + w Rj J Rj^T w), v_p = v + w x p, with the
+    section's mass (rho A, plus the water's 1.5 rho_w A across the rod) and
+    rotational inertia rho (2I, I, I); its net weight gains (rho - rho_w) A
+    ds/2 at each clamp. The upwind scheme's nodes stand for the whole rod:
+    the body carries nothing."""
+    system = _system()
+    head, part = system.bodies["head"], Assembly(system).bodies["head"]
+    rho, water, r, half = 1080.0, 1022.0, 0.01, 0.2 / 4 / 2
+    area, second = np.pi * r**2, np.pi * r**4 / 4
+    mass, inertia = np.diag([rho, rho + 1.5 * water, rho + 1.5 * water]) * area * half, \
+        rho * np.diag([2 * second, second, second]) * half
+    clamps = [(np.array([0.02, 0.0, 0.0]), np.eye(3)), (np.array([-0.02, 0.0, 0.0]), np.diag([-1.0, -1.0, 1.0]))]
+    rng = np.random.default_rng(3)
+    for _ in range(3):
+        v, w = rng.normal(size=3), rng.normal(size=3)
+        vw = np.concatenate([v, w])
+        energy = 0.5 * vw @ head.mass_matrix @ vw
+        for p, turn in clamps:
+            v_p = v + np.cross(w, p)
+            energy += 0.5 * (v_p @ turn @ mass @ turn.T @ v_p + w @ turn @ inertia @ turn.T @ w)
+        assert 0.5 * vw @ part.mass_matrix @ vw == pytest.approx(energy, rel=1e-13)
+        assert 0.5 * vw @ (part.mass_matrix - part.rigid_mass) @ vw == pytest.approx(0.5 * vw @ head.added_mass @ vw)
+    net = (rho - water) * area * half
+    assert part.params[NET_MASS] == pytest.approx(head.mass - water * head.volume + 2 * net, rel=1e-13)
+    np.testing.assert_allclose(part.params[NET_MOMENT:NET_MOMENT + 3],
+                               (head.mass - water * head.volume) * np.array(head.centre_of_mass), rtol=1e-13)
+    upwind = Assembly(system, "upwind").bodies["head"]
+    np.testing.assert_allclose(upwind.mass_matrix, head.mass_matrix, rtol=0, atol=1e-15)
+    assert upwind.params[NET_MASS] == pytest.approx(head.mass - water * head.volume, rel=1e-13)
