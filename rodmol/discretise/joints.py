@@ -33,7 +33,7 @@ class JointPart:
         model = sd.model
         hold = model.loads[joint.load]
         entry = _entry(model, joint.load)
-        self.joint, self.sd, self.part, self.entry = joint, sd, part, entry
+        self.joint, self.part, self.entry = joint, part, entry
         self.kind = KERNELS[hold.kernel].code
         self.row, self.value = sd.entry_params[entry], sd.entry_values[entry]
         self.node = _node(sd, rod_start, hold.s)
@@ -84,7 +84,7 @@ class RodJointPart:
     def __init__(self, joint, sd, rod_start, partner, partner_start):
         model, other = sd.model, partner.model
         hold, partner_hold = model.loads[joint.load], other.loads[joint.partner_load]
-        self.joint, self.sd, self.entry = joint, sd, _entry(model, joint.load)
+        self.joint, self.entry = joint, _entry(model, joint.load)
         self.kind = KERNELS[hold.kernel].code
         self.row, self.value = sd.entry_params[self.entry], sd.entry_values[self.entry]
         self.node = _node(sd, rod_start, hold.s)
