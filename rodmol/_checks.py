@@ -75,6 +75,20 @@ def non_negative(name, value, unit=""):
     return x
 
 
+def rotation(name, value, tol=1e-6):
+    """Return ``value`` as a proper 3x3 rotation matrix (orthonormal to ``tol``, det +1);
+    ``name`` is the parameter's name in the message."""
+    try:
+        r = np.asarray(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        r = None
+    if r is None or r.shape != (3, 3) or not np.all(np.isfinite(r)):
+        raise ParameterError(f"`{name}` must be a 3x3 matrix of finite numbers, got {short(value)}")
+    if not (np.allclose(r.T @ r, np.eye(3), atol=tol) and np.linalg.det(r) > 0.0):
+        raise ParameterError(f"`{name}` must be a rotation matrix (orthonormal, det +1), got {short(value)}")
+    return r
+
+
 def vector3(name, value):
     """Return ``value`` as a finite float array of shape (3,)."""
     try:

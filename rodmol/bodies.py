@@ -89,8 +89,9 @@ class RigidBody:
         elif self.position is not None or self.rotation is not None:
             raise ParameterError("a driven body (`motion` a BaseMotion) starts at the BaseMotion's "
                                  "position and rotation: leave `position` and `rotation` out")
-        pose = BaseMotion(position=self.position if self.position is not None else (0.0, 0.0, 0.0),
-                          rotation=self.rotation if self.rotation is not None else _IDENTITY)
+        pose = BaseMotion(
+            position=(0.0, 0.0, 0.0) if self.position is None else _checks.vector3("position", self.position),
+            rotation=_IDENTITY if self.rotation is None else _checks.rotation("rotation", self.rotation, tol=1e-9))
         start = motion if isinstance(motion, BaseMotion) else pose
         put(self, "position", np.array(start.position, dtype=float))
         put(self, "rotation", np.array(start.rotation, dtype=float))
@@ -117,6 +118,10 @@ class RigidBody:
         import meshio
 
         density = _checks.positive("density", density, " kg/m^3")
+        given = sorted(set(options) & {"mass", "inertia", "volume", "centre_of_mass", "mesh"})
+        if given:
+            raise ParameterError(f"`{given[0]}` comes from the mesh and its density: leave it out of "
+                                 f"RigidBody.from_mesh, got {given[0]}={_checks.short(options[given[0]])}")
         try:
             mesh = meshio.read(path)
         except Exception as exc:  # noqa: BLE001 (any reader failure, named with the file)
@@ -180,10 +185,13 @@ def _inertia(value):
     ok = arr is not None and arr.shape == (3, 3) and np.all(np.isfinite(arr))
     if ok and np.allclose(arr, arr.T, rtol=1e-9, atol=1e-12 * np.max(np.abs(arr))):
         arr = 0.5 * (arr + arr.T)
-        if np.all(np.linalg.eigvalsh(arr) > 0.0):
+        principal = np.linalg.eigvalsh(arr)
+        # A rigid body's principal moments obey the triangle inequality (I_i <= I_j + I_k).
+        if np.all(principal > 0.0) and 2.0 * principal.max() <= principal.sum() * (1.0 + 1e-9):
             return arr
     raise ParameterError("`inertia` must be three positive numbers or a symmetric positive definite 3x3 "
-                         f"tensor [kg m^2], got {_checks.short(value)}")
+                         "tensor [kg m^2] whose principal moments obey I_i <= I_j + I_k (a rigid body's), "
+                         f"got {_checks.short(value)}")
 
 
 def _six(name, value, square):

@@ -10,8 +10,6 @@ a hold at the tip gives a rod held at both ends (docs/model.md, "Held points").
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
 from . import _checks
 from .errors import ParameterError
 
@@ -19,21 +17,6 @@ from .errors import ParameterError
 #: stiffness E A / ds (docs/model.md: the measured drift and cost).
 HOLD_STIFFNESS_FACTOR = 100.0
 HOLD_KINDS = ("pin", "clamp")
-
-
-def _rotation_matrix(name, value):
-    """``value`` as a proper 3x3 rotation matrix (orthonormal to 1e-6, det +1)."""
-    try:
-        r = np.asarray(value, dtype=float)
-    except (TypeError, ValueError, OverflowError):
-        r = None
-    if r is None or r.shape != (3, 3) or not np.all(np.isfinite(r)):
-        raise ParameterError(f"{name}: `rotation` must be a 3x3 matrix of finite numbers, "
-                             f"got {_checks.short(value)}")
-    if not (np.allclose(r.T @ r, np.eye(3), atol=1e-6) and np.linalg.det(r) > 0.0):
-        raise ParameterError(f"{name}: `rotation` must be a rotation matrix (orthonormal, det +1), "
-                             f"got {_checks.short(value)}")
-    return r
 
 
 @dataclass(frozen=True)
@@ -84,7 +67,7 @@ class Hold:
             if self.kind != "clamp":
                 raise ParameterError(f"{name}: `rotation` is held by kind='clamp' only (a pin turns "
                                      f"freely), got kind={self.kind!r}")
-            object.__setattr__(self, "rotation", _rotation_matrix(name, self.rotation))
+            object.__setattr__(self, "rotation", _checks.rotation(f"{name} rotation", self.rotation))
         if self.stiffness is not None:
             object.__setattr__(self, "stiffness", _checks.positive(f"{name} stiffness", self.stiffness,
                                                                     " N/m"))

@@ -32,7 +32,6 @@ from .parameters import Medium
 JOINT_KINDS = ("clamp", "pin")
 #: Named ends of a rod a joint may hold (else an arc length s [m], a velocity node).
 ROD_ENDS = ("base", "tip")
-_IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
 
 
 @dataclass(frozen=True)
@@ -93,7 +92,7 @@ def _end(name, value):
             return ("rod", value[0], _checks.positive(f"{name}` arc length `s", where, " m"))
     if isinstance(value, tuple) and len(value) in (2, 3) and isinstance(value[0], str):
         point = _checks.vector3(f"{name}` point `", value[1])
-        rotation = np.array(BaseMotion(rotation=value[2]).rotation) if len(value) == 3 else None
+        rotation = _checks.rotation(f"joint end {name} rotation", value[2], tol=1e-9) if len(value) == 3 else None
         return ("body", value[0], point, rotation)
     raise ParameterError(f"joint end `{name}` must be 'world', (body_name, point[, rotation]) or "
                          f"(rod_name, 'base' | 'tip' | s), got {_checks.short(value)}")

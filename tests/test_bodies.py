@@ -116,3 +116,20 @@ def test_system_graph_checks():
     moving = _arm().replace(base=rodmol.BaseMotion(velocity=lambda t: (0, 0, 0)))
     with pytest.raises(rodmol.ParameterError, match="`base` must be the default"):
         rodmol.System({"arm": moving}, {"head": head}, [on_head])
+
+
+def test_a_bodys_pose_inertia_and_mesh_options_are_refused_by_their_own_names(tmp_path):
+    path = tmp_path / "box.stl"
+    meshio.write(path, meshio.Mesh(_CORNERS * 0.1, [("triangle", _CUBE)]), binary=False)
+    with pytest.raises(rodmol.ParameterError, match="`mass` comes from the mesh"):
+        rodmol.RigidBody.from_mesh(path, 1000.0, mass=2.0)
+    with pytest.raises(rodmol.ParameterError, match="`position` must have three components"):
+        rodmol.RigidBody(1.0, (1.0, 1.0, 1.0), position=(0.0, 0.0))
+    with pytest.raises(rodmol.ParameterError, match="`rotation` must be a rotation matrix"):
+        rodmol.RigidBody(1.0, (1.0, 1.0, 1.0), rotation=2 * np.eye(3))
+    with pytest.raises(rodmol.ParameterError, match=r"I_i <= I_j \+ I_k"):  # no rigid body has these
+        rodmol.RigidBody(1.0, (1.0, 1.0, 5.0))
+    rodmol.RigidBody(1.0, (1.0, 1.0, 2.0))  # a flat plate's: the limit
+    with pytest.raises(rodmol.ParameterError, match="`joint end a rotation` must be a rotation matrix"):
+        rodmol.System({"arm": rodmol.paper_arm(4)}, {"head": rodmol.RigidBody(1.0, (1.0, 1.0, 1.0))},
+                      [rodmol.Joint(("head", (0.0, 0.0, 0.0), np.ones((3, 3))), ("arm", "base"))])

@@ -6,13 +6,16 @@ held points of recorded frames for its Result."""
 import numpy as np
 
 from ..errors import ParameterError
-from ..loads import KERNELS
+from ..loads import KERNELS, P_DAMPING, P_STIFFNESS, P_TURN_DAMPING, P_TURN_STIFFNESS
 from .layout import FIELDS
 from .load_entries import count
 from .physics import quaternion_product
 from .rigid import joint_wrench
 from .rotations import from_matrix
 from .system import SemiDiscrete
+
+#: The columns of a hold's parameter row that make its law: both sides of a joint between rods share them.
+SHARED_LAW = [P_STIFFNESS, P_DAMPING, P_TURN_STIFFNESS, P_TURN_DAMPING]
 
 
 def block_entries(*fields):
@@ -30,7 +33,7 @@ class JointPart:
         model = sd.model
         hold = model.loads[joint.load]
         entry = _entry(model, joint.load)
-        self.joint, self.sd, self.part, self.entry = joint, sd, part, entry
+        self.joint, self.part, self.entry = joint, part, entry
         self.kind = KERNELS[hold.kernel].code
         self.row, self.value = sd.entry_params[entry], sd.entry_values[entry]
         self.node = _node(sd, rod_start, hold.s)
@@ -81,13 +84,17 @@ class RodJointPart:
     def __init__(self, joint, sd, rod_start, partner, partner_start):
         model, other = sd.model, partner.model
         hold, partner_hold = model.loads[joint.load], other.loads[joint.partner_load]
-        self.joint, self.sd, self.entry = joint, sd, _entry(model, joint.load)
+        self.joint, self.entry = joint, _entry(model, joint.load)
         self.kind = KERNELS[hold.kernel].code
         self.row, self.value = sd.entry_params[self.entry], sd.entry_values[self.entry]
         self.node = _node(sd, rod_start, hold.s)
         self.partner_node = _node(partner, partner_start, partner_hold.s)
         self.partner_fields = self.partner_node + block_entries("u", "Q", "v", "w")
         partner_row = partner.entry_params[_entry(other, joint.partner_load)]
+        # One law for both sides, or the pair is not equal and opposite: each hold took its own
+        # rod's defaults (k from E A / ds, c from its node's mass, k_r from its radius).
+        shared = np.minimum(self.row[SHARED_LAW], partner_row[SHARED_LAW])
+        self.row[SHARED_LAW] = partner_row[SHARED_LAW] = shared
         q_p = partner_row[3:7]
         self.turn = np.array(quaternion_product((q_p[0], -q_p[1], -q_p[2], -q_p[3]), tuple(self.row[3:7])))
         self.point = np.zeros(3)
