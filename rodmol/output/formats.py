@@ -23,6 +23,7 @@ from .._files import output_directory
 from ..errors import ParameterError
 from ..system_result import SystemResult
 from . import h5result, npz, run_files, stream, system_files, writers
+from . import system_stream  # noqa: F401  (registers the sink of a System's out=DIR)
 
 
 @dataclass(frozen=True)
