@@ -78,6 +78,8 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
         raise ParameterError(f"`t_end` must be after the start t0 = {t0!r} s, got {t_end!r} s")
     output_dt = _checks.positive("output_dt", OUTPUT_DT if output_dt is None else output_dt, " s")
     assembly = Assembly(system, scheme)
+    if resume:
+        getattr(sink, "check", lambda assembly: None)(assembly)
     t_out = options.output_times(t0, t_end, output_dt, output_times, assembly.size) if sink is None \
         else sink.t_out
     if initial is None or (isinstance(initial, str) and initial == "straight"):

@@ -167,7 +167,12 @@ def read_system(directory):
     rods = {name: (lambda key=key: h5result.read_result(directory / key / h5result.INDEX))
             for name, key in info["rods"].items()}
     bodies = {name: (lambda key=key: _body(t, fields[key])) for name, key in info["bodies"].items()}
-    return SystemResult(None, t, states, info["success"], info["message"], info["stats"], saved=(rods, bodies))
+    message = info["message"]
+    if not info.get("complete", True):
+        message = (f"the run was stopped before it finished (killed?): {len(t)} frames up to t = "
+                   f"{t[-1] if len(t) else 0.0:.6g} s were kept; resume it with simulate(..., out=DIR, resume=True)")
+    return SystemResult(None, t, states, info["success"] and info.get("complete", True), message, info["stats"],
+                        saved=(rods, bodies))
 
 
 def _body(t, fields):

@@ -78,10 +78,7 @@ class SystemRunWriter:
             self.t_out = np.asarray(t_out, dtype=float)
         keys = _keys(assembly.rods, "rod")
         if self._resumed is not None:
-            if self._resumed != keys or self.states[0].shape[1] != assembly.size:
-                raise ParameterError(f"cannot resume the run in {str(self.directory)!r}: it is a run of the "
-                                     f"rods {list(self._resumed)} with {self.states[0].shape[1]} states, this "
-                                     f"system has the rods {list(keys)} with {assembly.size}")
+            self.check(assembly)
             for name, key in keys.items():
                 writer = RunWriter(self.directory / key, resume=True)
                 writer.roll_back(self.restart[0])
@@ -113,6 +110,14 @@ class SystemRunWriter:
         for writer in self.rods.values():
             writer.end(success, message, stats)
         return self._write_index(success, message, stats, complete=True)
+
+    def check(self, assembly):
+        """Resuming: refuse an assembly that is not the one of the run in the directory."""
+        keys, size = _keys(assembly.rods, "rod"), self.states[0].shape[1]
+        if self._resumed != keys or size != assembly.size:
+            raise ParameterError(f"cannot resume the run in {str(self.directory)!r}: it is a run of the rods "
+                                 f"{list(self._resumed)} with {size} states, this system has the rods "
+                                 f"{list(keys)} with {assembly.size}")
 
     def record_settings(self, settings):
         """The run's settings (JSON values), recorded in the index for a resumed run."""
