@@ -52,19 +52,15 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
         raise NotSupportedYet(f"`backend` {backend!r} is not supported yet for systems: use 'cvode'")
     sink, first = None, 0
     if resume:  # the run's directory first: its settings fill in what the call leaves out
-        if initial is not None or t0 is not None:
-            raise ParameterError("a resumed run starts from its last restart point: give neither `initial` "
-                                 "nor `t0`")
         sink = _sink(out, True, False)
         recorded = sink.settings or {}
+        _check_plan(sink.t_out, recorded, initial, t0, t_end, output_dt, output_times)
         scheme = recorded.get("scheme") if scheme is None else scheme
         rtol = recorded.get("rtol") if rtol is None else rtol
         atol = recorded.get("atol") if atol is None else atol
         backend_options = backend_options or recorded.get("backend_options") or {}
         first, initial = sink.restart[0], sink.restart[1]
         t0 = float(sink.t_out[first])
-        if t_end != sink.t_out[-1]:
-            raise ParameterError(f"`t_end` = {t_end!r} s: the run being resumed ends at {float(sink.t_out[-1])!r} s")
     checked = options.backend_options("cvode", cvode_system, backend_options)
     progress, max_wall_time = options.progress(progress), options.max_wall_time(max_wall_time)
     if isinstance(initial, SystemResult):
@@ -98,7 +94,9 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
         sink = _sink(out, False, bool(overwrite))
     if sink is not None:
         getattr(sink, "record_settings", lambda settings: None)(
-            dict(scheme=scheme.name, rtol=rtol, atol=atol.tolist(), backend_options=dict(backend_options)))
+            dict(scheme=scheme.name, rtol=rtol, atol=atol.tolist(), backend_options=dict(backend_options),
+                 initial=recorded.get("initial") if resume else
+                 "straight" if initial is None else initial if isinstance(initial, str) else "state"))
     owned = progress is True
     if owned:
         from ._progress import Progress
@@ -120,6 +118,24 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
     if not success:
         warnings.warn(message, RuntimeWarning, stacklevel=3)
     return result
+
+
+def _check_plan(plan, recorded, initial, t0, t_end, output_dt, output_times):
+    """Refuse a resumed call asking for another start or other output times than the run's
+    ``plan`` (the same as it recorded, as a scenario file gives them again, is fine)."""
+    if initial is not None and not (isinstance(initial, str) and initial == recorded.get("initial", initial)):
+        raise ParameterError(f"a resumed run starts from its last restart point: `initial` "
+                             f"{_checks.short(initial)} is not the run's ({recorded.get('initial')!r})")
+    if t0 is not None and t0 != plan[0]:
+        raise ParameterError(f"`t0` = {t0!r} s: the run being resumed started at {float(plan[0])!r} s")
+    if t_end != plan[-1]:
+        raise ParameterError(f"`t_end` = {t_end!r} s: the run being resumed ends at {float(plan[-1])!r} s")
+    if output_dt is not None or output_times is not None:
+        asked = options.output_times(float(plan[0]), t_end, OUTPUT_DT if output_dt is None else output_dt,
+                                     output_times, 1)
+        if len(asked) != len(plan) or not np.allclose(asked, plan, rtol=0, atol=1e-12 * max(1.0, t_end)):
+            raise ParameterError(f"cannot resume: the run's output times are {len(plan)} from "
+                                 f"{float(plan[0]):g} to {float(plan[-1]):g} s, this call asks for {len(asked)}")
 
 
 class _Chunked:

@@ -85,8 +85,10 @@ def test_resume_refuses_what_it_cannot_continue(two_arms, tmp_path, killed_syste
     killed_system(partial(run, two_arms()), tmp_path, 1, chunk_frames=CHUNK)
     with pytest.raises(ParameterError, match="ends at 0.1 s"):
         rodmol.simulate(two_arms(), 0.2, out=tmp_path, resume=True)
-    with pytest.raises(ParameterError, match="neither `initial`"):
-        rodmol.simulate(two_arms(), T_END, out=tmp_path, resume=True, initial="straight")
+    with pytest.raises(ParameterError, match="not the run's"):
+        rodmol.simulate(two_arms(), T_END, out=tmp_path, resume=True, initial="equilibrium")
+    with pytest.raises(ParameterError, match="output times"):
+        rodmol.simulate(two_arms(), T_END, out=tmp_path, resume=True, output_dt=0.02)
     with pytest.raises(ParameterError, match="rods"):  # another system
         rodmol.simulate(rodmol.System(rods={"right": two_arms().rods["right"]}), T_END, out=tmp_path, resume=True)
     with pytest.raises(ParameterError, match="`resume` or `overwrite=True`"):
