@@ -5,7 +5,7 @@ importing the floors above it. The sink protocol is
 :mod:`rodmol.solve.chunked`'s."""
 
 _factory = []  # the one registered factory: (directory, resume=, overwrite=) -> sink
-_system_factory = []  # (directory, overwrite=) -> writer(SystemResult), for a System's out=DIR
+_system_factory = []  # (directory, resume=, overwrite=) -> sink, for a System's out=DIR
 
 
 def register_directory(factory):
@@ -21,13 +21,13 @@ def directory_sink(directory, *, resume, overwrite):
 
 
 def register_system_writer(factory):
-    """Make ``factory(directory, overwrite=bool)`` the writer of a System's ``out=DIR``: it
-    checks the directory (before the run) and returns ``write(result)`` (after it)."""
+    """Make ``factory(directory, resume=bool, overwrite=bool)`` the sink of a System's ``out=DIR``
+    (the protocol of :mod:`rodmol.solve.chunked`, its frames the assembled states)."""
     _system_factory[:] = [factory]
 
 
-def system_writer(directory, *, overwrite):
-    """The registered writer of a System's run into ``directory`` (see :func:`register_system_writer`)."""
+def system_writer(directory, *, resume, overwrite):
+    """The registered sink of a System's run into ``directory`` (see :func:`register_system_writer`)."""
     if not _system_factory:
-        raise RuntimeError("no system writer is registered: import rodmol (rodmol.output.system_files registers it)")
-    return _system_factory[0](directory, overwrite=overwrite)
+        raise RuntimeError("no system writer is registered: import rodmol (rodmol.output.system_stream registers it)")
+    return _system_factory[0](directory, resume=resume, overwrite=overwrite)

@@ -1,11 +1,13 @@
 """A run of a :class:`rodmol.System` (rods and rigid bodies), reached through
 :func:`rodmol.simulate`: in memory, from rest, with CVODE; with ``out=DIR``
-its files are written once it ended (:mod:`rodmol.output.system_files`,
-through :func:`rodmol.run_sinks.system_writer`).
+its frames are streamed in chunks while it goes, through the single rod's
+chunked run (:func:`rodmol.solve.chunked.run_chunked`) into the sink
+:func:`rodmol.run_sinks.system_writer` makes
+(:class:`rodmol.output.system_stream.SystemRunWriter`), and ``resume=True``
+continues a killed run from its last restart point.
 
 Not yet for systems (each raises :class:`rodmol.errors.NotSupportedYet`):
-the equilibrium start with a free body, streaming while the run goes,
-``resume`` and the other backends. ``progress`` is reported at the output times only.
+the equilibrium start with a free body, ``resume="force"`` and the other backends. ``progress`` is reported at the output times only.
 """
 
 import warnings
@@ -17,7 +19,9 @@ from .discretise.assembly import Assembly
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
 from .errors import NotSupportedYet, ParameterError
 from .solve import options
+from .solve.chunked import run_chunked
 from .solve.equilibrium import equilibrium
+from .solve.outputs import RawSolution
 from .solve.system_cvode import cvode_system
 from .system_result import SystemResult
 
@@ -33,14 +37,30 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
     :func:`rodmol.solve.equilibrium.system_rest_state`), from a state
     vector (``SystemResult.states[k]``) or from the last frame of an earlier
     SystemResult (at its last time unless ``t0`` is given); the other
-    arguments as for :func:`rodmol.simulate`. Returns a
-    :class:`rodmol.system_result.SystemResult`."""
-    if resume is not False:
-        raise NotSupportedYet("`resume` is not supported yet for systems (their files are written after the run)")
-    if out is None and overwrite is not False:
-        raise ParameterError("`overwrite` needs `out`")
+    arguments as for :func:`rodmol.simulate`. With ``out``, the frames are
+    streamed chunk by chunk (:mod:`rodmol.output.system_stream`) and
+    ``resume=True`` continues a killed or interrupted run there from its last
+    restart point, with its recorded settings where the call gives none.
+    Returns a :class:`rodmol.system_result.SystemResult`."""
+    if resume is not True and resume is not False:
+        raise ParameterError(f"`resume` must be False or True for a system, got {_checks.short(resume)}")
+    if out is None and (overwrite is not False or resume):
+        raise ParameterError("`overwrite` and `resume=True` need `out`, the run's directory")
+    if resume and overwrite:
+        raise ParameterError("give either `resume` or `overwrite=True`, not both")
     if backend not in (None, "cvode"):
         raise NotSupportedYet(f"`backend` {backend!r} is not supported yet for systems: use 'cvode'")
+    sink, first = None, 0
+    if resume:  # the run's directory first: its settings fill in what the call leaves out
+        sink = _sink(out, True, False)
+        recorded = sink.settings or {}
+        _check_plan(sink.t_out, recorded, initial, t0, t_end, output_dt, output_times)
+        scheme = recorded.get("scheme") if scheme is None else scheme
+        rtol = recorded.get("rtol") if rtol is None else rtol
+        atol = recorded.get("atol") if atol is None else atol
+        backend_options = backend_options or recorded.get("backend_options") or {}
+        first, initial = sink.restart[0], sink.restart[1]
+        t0 = float(sink.t_out[first])
     checked = options.backend_options("cvode", cvode_system, backend_options)
     progress, max_wall_time = options.progress(progress), options.max_wall_time(max_wall_time)
     if isinstance(initial, SystemResult):
@@ -54,7 +74,10 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
         raise ParameterError(f"`t_end` must be after the start t0 = {t0!r} s, got {t_end!r} s")
     output_dt = _checks.positive("output_dt", OUTPUT_DT if output_dt is None else output_dt, " s")
     assembly = Assembly(system, scheme)
-    t_out = options.output_times(t0, t_end, output_dt, output_times, assembly.size)
+    if resume:
+        getattr(sink, "check", lambda assembly: None)(assembly)
+    t_out = options.output_times(t0, t_end, output_dt, output_times, assembly.size) if sink is None \
+        else sink.t_out
     if initial is None or (isinstance(initial, str) and initial == "straight"):
         y0 = assembly.initial_state()
     elif isinstance(initial, str) and initial == "equilibrium":  # bodies fixed or driven only
@@ -67,25 +90,77 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
     atol = rtol * assembly.atol_scale() if atol is None else _sized("atol", atol, assembly.size)
     if np.any(atol <= 0):
         raise ParameterError("`atol` must be > 0")
-    writer = None if out is None else run_sinks.system_writer(out, overwrite=bool(overwrite))
+    if out is not None and sink is None:  # after every check: with `overwrite`, this clears the earlier run
+        sink = _sink(out, False, bool(overwrite))
+    if sink is not None:
+        getattr(sink, "record_settings", lambda settings: None)(
+            dict(scheme=scheme.name, rtol=rtol, atol=atol.tolist(), backend_options=dict(backend_options),
+                 initial=recorded.get("initial") if resume else
+                 "straight" if initial is None else initial if isinstance(initial, str) else "state"))
     owned = progress is True
     if owned:
         from ._progress import Progress
 
         progress = Progress()
+    solver = dict(rtol=rtol, atol=atol, progress=progress, max_wall_time=max_wall_time, **checked)
     try:
-        t, y, success, message, stats, error = cvode_system(assembly, y0, t_out, rtol=rtol, atol=atol,
-                                                            progress=progress, max_wall_time=max_wall_time,
-                                                            **checked)
+        if sink is None:
+            t, y, success, message, stats, error = cvode_system(assembly, y0, t_out, **solver)
+            result = SystemResult(assembly, t, y, success, message, stats, error)
+        else:  # in chunks into the sink, whose SystemResult it is
+            success, message, stats, error = run_chunked(_run, _Chunked(assembly), y0, t_out, sink, first,
+                                                         **solver)
+            result = sink.end(success, message, stats)
+            result.error = error
     finally:
         if owned:
             progress.close()
     if not success:
         warnings.warn(message, RuntimeWarning, stacklevel=3)
-    result = SystemResult(assembly, t, y, success, message, stats, error)
-    if writer is not None:
-        writer(result)
     return result
+
+
+def _check_plan(plan, recorded, initial, t0, t_end, output_dt, output_times):
+    """Refuse a resumed call asking for another start or other output times than the run's
+    ``plan`` (the same as it recorded, as a scenario file gives them again, is fine)."""
+    if initial is not None and not (isinstance(initial, str) and initial == recorded.get("initial", initial)):
+        raise ParameterError(f"a resumed run starts from its last restart point: `initial` "
+                             f"{_checks.short(initial)} is not the run's ({recorded.get('initial')!r})")
+    if t0 is not None and t0 != plan[0]:
+        raise ParameterError(f"`t0` = {t0!r} s: the run being resumed started at {float(plan[0])!r} s")
+    if t_end != plan[-1]:
+        raise ParameterError(f"`t_end` = {t_end!r} s: the run being resumed ends at {float(plan[-1])!r} s")
+    if output_dt is not None or output_times is not None:
+        asked = options.output_times(float(plan[0]), t_end, OUTPUT_DT if output_dt is None else output_dt,
+                                     output_times, 1)
+        if len(asked) != len(plan) or not np.allclose(asked, plan, rtol=0, atol=1e-12 * max(1.0, t_end)):
+            raise ParameterError(f"cannot resume: the run's output times are {len(plan)} from "
+                                 f"{float(plan[0]):g} to {float(plan[-1]):g} s, this call asks for {len(asked)}")
+
+
+class _Chunked:
+    """The assembly as :func:`rodmol.solve.chunked.run_chunked` sees it. Its frames are
+    not checked again against the rods' inputs (``inputs_vary``): a rod's inputs are
+    evaluated when its Result is built, and a failing one stops the run there."""
+
+    inputs_vary = False
+
+    def __init__(self, assembly):
+        self.assembly = assembly
+
+
+def _run(chunked, y0, t_out, **solver):
+    """:func:`cvode_system` as a backend of the chunked run (a RawSolution)."""
+    return RawSolution(*cvode_system(chunked.assembly, y0, t_out, **solver))
+
+
+def _sink(out, resume, overwrite):
+    """The sink of ``out``: a sink as given (one with ``chunk_frames``), else a directory's."""
+    if hasattr(out, "chunk_frames"):
+        if resume and not hasattr(out, "restart"):
+            raise ParameterError("`resume=True`: this sink cannot resume (no restart point)")
+        return out
+    return run_sinks.system_writer(out, resume=resume, overwrite=overwrite)
 
 
 def _sized(name, value, size, scalar=True):

@@ -110,10 +110,11 @@ def _run(args):
 
 
 def _run_system(args, spec, out):
-    """``rodmol run`` of a system file: the run, then its files (written once it ended)."""
-    if args.resume or args.resume_anyway:
-        raise NotSupportedYet("`--resume` is not supported yet for systems (their files are written after "
-                              "the run)")
+    """``rodmol run`` of a system file: the run, its files streamed while it goes (``--resume``
+    continues a killed one)."""
+    if args.resume_anyway:
+        raise NotSupportedYet("`--resume-anyway` is not supported yet for systems: use `--resume` (with the "
+                              "run's own settings)")
     if (args.format or spec.output.format) != "xdmf":
         raise ParameterError("a system's run is written as `--format xdmf` only")
     say = (lambda *a, **k: None) if args.quiet else print
@@ -124,7 +125,7 @@ def _run_system(args, spec, out):
     started = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # the summary gives the message
-        result = spec.simulate(progress=progress, out=out, overwrite=args.overwrite)
+        result = spec.simulate(progress=progress, out=out, overwrite=args.overwrite, resume=bool(args.resume))
     if progress:
         progress.close()
     state = "finished" if result.success else f"failed: {result.message}"

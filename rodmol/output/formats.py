@@ -22,7 +22,15 @@ from .._checks import did_you_mean
 from .._files import output_directory
 from ..errors import ParameterError
 from ..system_result import SystemResult
-from . import h5result, npz, run_files, stream, system_files, writers
+from . import (
+    h5result,
+    npz,
+    run_files,
+    stream,
+    system_files,
+    system_stream,  # noqa: F401  (registers the sink of a System's out=DIR)
+    writers,
+)
 
 
 @dataclass(frozen=True)

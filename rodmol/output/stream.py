@@ -305,11 +305,20 @@ class RunWriter:
             raise ParameterError(f"nothing to resume in {str(self.directory)!r}: no frames were kept")
         self._roll_back()
 
-    def _roll_back(self):
-        """Keep the chunks up to the last restart point (a frame index that is a multiple of
-        ``chunk_frames``); ``restart``: (its index, time, state)."""
+    def roll_back(self, point):
+        """Resuming: restart from the earlier restart point ``point`` (a frame index, a multiple
+        of ``chunk_frames``, at or before :meth:`resume_point`'s), dropping the chunks after it
+        (a system's run restarts all its rods from the frame its own index reached)."""
+        if point % self.chunk_frames or point > self.restart[0]:
+            raise ParameterError(f"cannot restart {str(self.directory)!r} at frame {point}: its restart "
+                                 f"points are multiples of {self.chunk_frames} up to {self.restart[0]}")
+        self._roll_back(point)
+
+    def _roll_back(self, point=None):
+        """Keep the chunks up to the restart point ``point`` (a frame index that is a multiple of
+        ``chunk_frames``; None: the last one); ``restart``: (its index, time, state)."""
         last = len(self.t) - 1
-        point = last - last % self.chunk_frames
+        point = last - last % self.chunk_frames if point is None else point
         kept, frames = {}, 0
         for name, n in self.chunks.items():
             if frames + n - 1 > point:
@@ -319,8 +328,9 @@ class RunWriter:
         chunk, row = (list(kept)[-1], -1) if kept else (list(self.chunks)[0], 0)
         with damaged(self.directory / chunk):
             t, state = h5result.frame_state(self.directory, chunk, row)
-        self._dropped = [name for name in self.chunks if name not in kept]
-        self.record.drop(self._dropped)
+        dropped = [name for name in self.chunks if name not in kept]
+        self._dropped += dropped
+        self.record.drop(dropped)
         self.chunks, self.t = kept, self.t[:frames]
         self.restart = (point, t, state)
 

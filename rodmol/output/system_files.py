@@ -17,8 +17,9 @@ A system's run directory (``simulate(system, ..., out=DIR)``,
   single rod's (``result.h5``, ``rod.xdmf``, ``cables.xdmf``, ``markers.xdmf``;
   :mod:`rodmol.output.stream`).
 
-Unlike a single rod's, it is written after the run, not streamed, so a run
-cannot be resumed from it.
+``simulate(system, ..., out=DIR)`` streams it while the run goes
+(:mod:`rodmol.output.system_stream`); :func:`write_system` writes a finished
+result at once.
 """
 
 import html
@@ -28,13 +29,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import run_sinks
 from .._files import output_directory
 from ..errors import ParameterError
 from ..system_result import BodyResult, SystemResult
 from . import h5result, stream, xdmf
 from .parts import view_step
-from .run_files import SYSTEM, refuse_replacing
+from .run_files import SYSTEM
 
 INDEX, BODIES_VIEW = SYSTEM
 FORMAT = "rodmol-system"
@@ -89,15 +89,23 @@ def write_system(result, directory, every=None):
     replacing an earlier run there; returns the path of ``system.h5``.
     ``every``: show every n-th frame in the views (and the last)."""
     directory = output_directory(directory, "directory")
-    rods, bodies = _keys(result.rods, "rod"), _keys(result.bodies, "body")
+    rods = _keys(result.rods, "rod")
     for name, key in rods.items():
         stream.write_xdmf(result[name], directory / key, every)
+    return write_index(directory, result, view_step(len(result.t), every))
+
+
+def write_index(directory, result, step, **extra):
+    """Write ``system.h5`` and ``bodies.xdmf`` of the SystemResult ``result`` (with its
+    assembly) into ``directory``, the views showing every ``step``-th frame and the last;
+    ``extra`` goes into the index's ``info`` (a streamed run's plan and settings).
+    Returns the path of ``system.h5``."""
+    rods, bodies = _keys(result.rods, "rod"), _keys(result.bodies, "body")
     t = result.t
-    step = view_step(len(t), every)
     shown = sorted(set(range(0, len(t), step)) | {len(t) - 1})
     surfaces = {name: surface_of(result, name) for name in result.bodies}
     info = dict(format=FORMAT, success=bool(result.success), message=str(result.message),
-                stats=_plain(result.stats), rods=rods, bodies=bodies, shown=shown)
+                stats=_plain(result.stats), rods=rods, bodies=bodies, shown=shown, **extra)
 
     def fill(handle):
         handle.attrs["format"] = FORMAT
@@ -124,6 +132,21 @@ def write_system(result, directory, every=None):
     return directory / INDEX
 
 
+def read_info(directory):
+    """(info, t, states) of the index ``system.h5`` in ``directory`` (a damaged file: a ParameterError)."""
+    import h5py
+
+    path = Path(directory) / INDEX
+    try:
+        with h5py.File(path, "r") as handle:
+            info = json.loads(handle.attrs["info"])
+            if info.get("format") != FORMAT:
+                raise ParameterError(f"{str(path)!r} is not the index of a system's run")
+            return info, handle["t"][()], handle["states"][()]
+    except (OSError, KeyError, ValueError) as exc:
+        raise h5result.damaged(path, exc) from exc
+
+
 def read_system(directory):
     """The :class:`SystemResult` of a system's run directory (its rods read on first access)."""
     import h5py
@@ -144,7 +167,12 @@ def read_system(directory):
     rods = {name: (lambda key=key: h5result.read_result(directory / key / h5result.INDEX))
             for name, key in info["rods"].items()}
     bodies = {name: (lambda key=key: _body(t, fields[key])) for name, key in info["bodies"].items()}
-    return SystemResult(None, t, states, info["success"], info["message"], info["stats"], saved=(rods, bodies))
+    message = info["message"]
+    if not info.get("complete", True):
+        message = (f"the run was stopped before it finished (killed?): {len(t)} frames up to t = "
+                   f"{t[-1] if len(t) else 0.0:.6g} s were kept; resume it with simulate(..., out=DIR, resume=True)")
+    return SystemResult(None, t, states, info["success"] and info.get("complete", True), message, info["stats"],
+                        saved=(rods, bodies))
 
 
 def _body(t, fields):
@@ -173,20 +201,3 @@ def _plain(stats):
     """``stats`` with numpy numbers made plain (JSON)."""
     return {k: (v.item() if isinstance(v, np.generic) else v) for k, v in dict(stats).items()
             if isinstance(v, (int, float, str, bool, np.generic))}
-
-
-class SystemWriter:
-    """The writer of a System's ``out=DIR`` (:func:`rodmol.run_sinks.system_writer`):
-    made before the run (the directory checked, an earlier run refused unless
-    ``overwrite``), called with the result after it."""
-
-    def __init__(self, directory, *, overwrite):
-        self.directory = output_directory(directory, "out")
-        refuse_replacing(self.directory, overwrite, "`resume` (not supported yet for systems)",
-                         "`overwrite=True` (`--overwrite`)")
-
-    def __call__(self, result):
-        return write_system(result, self.directory)
-
-
-run_sinks.register_system_writer(SystemWriter)

@@ -33,6 +33,8 @@ def test_run_a_system_file_writes_every_part(tmp_path):
         assert assert_valid_views(out / rod) == pytest.approx(list(result.t))
     again = rodmol_cli("run", scenario, "--out", out, "--t-end", 0.05, "--quiet")
     assert again.returncode == 2 and "--overwrite" in again.stderr  # the earlier run is kept
+    resumed = rodmol_cli("run", scenario, "--out", out, "--t-end", 0.05, "--resume", "--quiet")
+    assert resumed.returncode == 2 and "finished" in resumed.stderr  # streamed, but nothing left to do
     plot = rodmol_cli("plot", out)
     assert plot.returncode == 0 and (out / "tip_path.png").stat().st_size > 10_000
 

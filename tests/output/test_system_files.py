@@ -5,29 +5,12 @@ import pytest
 
 import rodmol
 from rodmol.bodies import mesh_properties
-from rodmol.errors import NotSupportedYet, ParameterError
+from rodmol.errors import ParameterError
 from rodmol.output.system_files import body_surface
 
 
-def two_arms():
-    material = rodmol.Material(E=1e5, nu=0.5, mu=300.0, rho=1080.0)
-    rod = rodmol.Rod(0.2, radius=(0.012, 0.006), material=material)
-
-    def arm(side):
-        pull = rodmol.Cable((side * 0.005, 0.0), 0.2, tension=lambda t: 0.3 * min(t / 0.1, 1.0))
-        return rodmol.Model(rod, 6, cables=[pull])
-
-    head = rodmol.RigidBody(mass=0.3, inertia=(2e-4, 3e-4, 4e-4), volume=2.5e-4, centre_of_mass=(0.0, 0.0, 0.01))
-    turn = np.diag([-1.0, -1.0, 1.0])
-    return rodmol.System(
-        rods={"right": arm(1.0), "left arm": arm(-1.0)}, bodies={"head": head},
-        joints=[rodmol.Joint(("head", (0.04, 0.0, 0.0)), ("right", "base")),
-                rodmol.Joint(("head", (-0.04, 0.0, 0.0), turn), ("left arm", "base"))],
-        medium="water", gravity=(0.0, 0.0, -9.81))
-
-
 @pytest.fixture(scope="module")
-def written(tmp_path_factory):
+def written(tmp_path_factory, two_arms):
     out = tmp_path_factory.mktemp("system")
     return rodmol.simulate(two_arms(), 0.06, output_dt=0.02, out=out), out
 
@@ -72,11 +55,11 @@ def test_a_body_without_mesh_is_drawn_as_the_ellipsoid_of_its_mass_and_inertia()
     assert np.allclose(np.linalg.norm(body_surface(sphere)[0], axis=1), np.sqrt(0.02 / (0.4 * 2.0)))
 
 
-def test_an_earlier_run_is_kept_and_resume_is_refused(written):
+def test_an_earlier_run_is_kept_and_a_finished_one_is_not_resumed(written, two_arms):
     result, out = written
     with pytest.raises(ParameterError, match="overwrite"):
         rodmol.simulate(two_arms(), 0.02, output_dt=0.02, out=out)
-    with pytest.raises(NotSupportedYet, match="resume"):
+    with pytest.raises(ParameterError, match="finished"):
         rodmol.simulate(two_arms(), 0.06, output_dt=0.02, out=out, resume=True)
     assert np.array_equal(rodmol.load_result(out).t, result.t)  # untouched
 
