@@ -189,11 +189,20 @@ def is_system(path):
 
 
 def _keys(names, kind):
-    """{name: key}: a file name for each part, its own name if that is a plain one."""
-    keys = {}
+    """{name: key}: a file name for each part: its own name if that is a plain one
+    and not the run's own files' (``system.h5``, ``bodies.xdmf``), else ``kind_i``
+    (i its index), made unique against every other key."""
+    plain = [n for n in names if re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.-]*", n) and n not in SYSTEM]
+    keys, taken = {}, set(plain) | set(SYSTEM)
     for i, name in enumerate(names):
-        plain = re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.-]*", name) and name not in keys.values()
-        keys[name] = name if plain else f"{kind}_{i}"
+        if name in plain and name not in keys.values():
+            keys[name] = name
+            continue
+        key = f"{kind}_{i}"
+        while key in taken:
+            key += "_"
+        keys[name] = key
+        taken.add(key)
     return keys
 
 

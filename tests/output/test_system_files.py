@@ -84,3 +84,12 @@ def test_render_draws_every_rod_and_body(written, tmp_path):
     body = np.all(np.abs(pixels - (0.8 * 255, 0.55 * 255, 0.35 * 255)) < 60, axis=-1).mean()  # the head's colour
     drawn = np.any(np.abs(pixels - pixels[0, 0]) > 30, axis=-1).mean()
     assert body > 0.002 and drawn > body + 0.01  # the head, and the rods besides
+
+
+def test_every_part_gets_its_own_file_name_and_none_is_the_runs_own():
+    from rodmol.output.system_files import SYSTEM, _keys
+
+    for names in (["rod_1", "a b"], ["system.h5", "bodies.xdmf", "arm"], ["rod_0_", "x/y", "rod_0"]):
+        keys = _keys(names, "rod")
+        assert len(set(keys.values())) == len(names) and not set(keys.values()) & set(SYSTEM), keys
+        assert all(keys[n] == n for n in names if n.isidentifier() and n not in SYSTEM)
