@@ -58,15 +58,11 @@ from ..bodies import mass_matrix_about_origin
 from .joints import JointPart, RecordedJoints, RodJointPart, block_entries
 from .layout import BlockLayout
 from .physics import quaternion_rate
-from .rigid import NET_MASS, NET_MOMENT, clamp_wrench, free_body_rates, pack_body
+from .rigid import BODY_FIELDS, NET_MASS, NET_MOMENT, POSE_FIELDS, clamp_wrench, free_body_rates, pack_body
 from .rotations import from_matrix, matrices
 from .sampling import section_masses
 from .stencil import WORK_TOTAL
 from .system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE, SemiDiscrete, field_scales
-
-#: Fields of a free body's block; a fixed or driven body holds the pose only.
-BODY_FIELDS = {"x": 3, "Q": 4, "v": 3, "w": 3}
-POSE_FIELDS = {"x": 3, "Q": 4}
 
 
 def _cross(a, b):

@@ -6,7 +6,7 @@ import numpy as np
 
 from ..loads import P_HELD_SPIN, P_HELD_VELOCITY
 from .external import hold
-from .layout import QUAT, U, V, W
+from .layout import QUAT, BlockLayout, U, V, W
 from .physics import (
     add,
     cross,
@@ -27,6 +27,14 @@ from .physics import (
 #: include what the body carries (the rods' base segments).
 NET_MASS, CENTRE, DRAG, NET_MOMENT = 0, 1, 4, 10
 N_BODY_PARAMS = 13
+#: Fields of a free body's block in the state: the origin's position x [m] and the quaternion Q
+#: (global), its velocity v [m/s] and angular velocity w [rad/s] (body frame); a fixed or driven
+#: body's block holds the pose only (:data:`POSE_FIELDS`).
+BODY_FIELDS = {"x": 3, "Q": 4, "v": 3, "w": 3}
+POSE_FIELDS = {"x": 3, "Q": 4}
+FREE_BODY = BlockLayout(1, BODY_FIELDS)
+# Integer offsets for the compiled functions (numba freezes module-level ints).
+BX, BQ, BV, BW = (FREE_BODY.slices()[f].start for f in BODY_FIELDS)
 
 
 def pack_body(body, fluid_density):
@@ -66,14 +74,14 @@ def clamp_wrench(stress, strains, shares, turns, points):
 
 @jit
 def free_body_rates(state, params, rigid, inverse, gravity, force, torque, smoothing2, restoring, out):
-    """Rates of a free body's block (x, Q, v, w) into ``out`` (13,): ``state``
+    """Rates of a free body's block (x, Q, v, w) into ``out`` (``FREE_BODY.size``,): ``state``
     its block, ``params`` its :func:`pack_body` row (with what it carries),
     ``rigid`` its 6x6 mass matrix without its own added mass (the carried
     rods' base segments with theirs, as their nodes) and ``inverse`` the
     inverse of the one with all added mass, ``gravity`` (3,) global, ``force``, ``torque`` the rods'
     wrench about the origin (body frame)."""
-    quat = (state[3], state[4], state[5], state[6])
-    v, w = _row3(state, 7), _row3(state, 10)
+    quat = (state[BQ], state[BQ + 1], state[BQ + 2], state[BQ + 3])
+    v, w = _row3(state, BV), _row3(state, BW)
     r = rotation(quat)
     c = _row3(params, CENTRE)
     g = to_local(r, gravity)
@@ -100,13 +108,13 @@ def free_body_rates(state, params, rigid, inverse, gravity, force, torque, smoot
         acc = 0.0
         for j in range(6):
             acc += inverse[i, j] * rhs[j]
-        out[7 + i] = acc
+        out[BV + i] = acc
     x_t = to_global(r, v)
     q_t = quaternion_rate(quat, w, restoring)
     for i in range(3):
-        out[i] = x_t[i]
+        out[BX + i] = x_t[i]
     for i in range(4):
-        out[3 + i] = q_t[i]
+        out[BQ + i] = q_t[i]
 
 
 @jit
@@ -124,9 +132,9 @@ def joint_wrench(kind, row, value, y, node, body, point, turn):
     returns the reaction on the body: the force and moment [N, N m] about
     its origin, body frame, equal and opposite to the node's, the force
     acting where the node is (so momentum and angular momentum are kept)."""
-    x_b = (body[0], body[1], body[2])
-    q_b = (body[3], body[4], body[5], body[6])
-    v_b, w_b = _row3(body, 7), _row3(body, 10)
+    x_b = _row3(body, BX)
+    q_b = (body[BQ], body[BQ + 1], body[BQ + 2], body[BQ + 3])
+    v_b, w_b = _row3(body, BV), _row3(body, BW)
     r_b = rotation(q_b)
     target = add(x_b, to_global(r_b, _row3(point, 0)))
     for i in range(3):

@@ -19,7 +19,7 @@ joints are eliminated by their Schur complement: with N = I - gamma J split
 into the rods (r) and those bodies (b), N_rb holding each joint node's
 velocity rows against its body's entries and N_br the body's rows against
 the node's u, Q, v, w (both by differences), S = N_bb - N_br N_rr^-1 N_rb
-(dense, 13 rows per body) is formed at each setup from one rod solve per
+(dense, one block of ``rigid.FREE_BODY.size`` rows per body) is formed at each setup from one rod solve per
 body column and joined rod; a solve is z_r' = N_rr^-1 r_r, z_b = S^-1
 (r_b - N_br z_r'), z_r = z_r' - N_rr^-1 N_rb z_b.
 """
@@ -27,6 +27,7 @@ body column and joined rod; a solve is z_r' = N_rr^-1 r_r, z_b = S^-1
 import numpy as np
 
 from .joints import block_entries
+from .rigid import FREE_BODY
 
 #: A joint node's rows (its velocities) and columns (what the joint reads), within its element block.
 JOINT_ROWS, JOINT_COLUMNS = block_entries("v", "w"), block_entries("u", "Q", "v", "w")
@@ -51,10 +52,10 @@ class SystemPreconditioner:
         self._scale, self.gamma = scale, np.nan
         # The Schur complement's bodies (free, with penalty joints) and their offsets in S.
         self.coupled = [p for p in self.bodies if p.body.free and p.joints]
-        self._offset = dict(zip((p.name for p in self.coupled), 13 * np.arange(len(self.coupled))))
-        self._rod_to_body = {id(j): np.zeros((len(JOINT_ROWS), 13)) for p in self.coupled for j in p.joints}
-        self._body_to_rod = {id(j): np.zeros((13, len(JOINT_COLUMNS))) for p in self.coupled for j in p.joints}
-        self._schur = np.eye(13 * len(self.coupled))
+        self._offset = dict(zip((p.name for p in self.coupled), FREE_BODY.size * np.arange(len(self.coupled))))
+        self._rod_to_body = {id(j): np.zeros((len(JOINT_ROWS), FREE_BODY.size)) for p in self.coupled for j in p.joints}
+        self._body_to_rod = {id(j): np.zeros((FREE_BODY.size, len(JOINT_COLUMNS))) for p in self.coupled for j in p.joints}
+        self._schur = np.eye(FREE_BODY.size * len(self.coupled))
         self.jac_evals = self.setups = self.solves = 0
 
     def setup(self, t, y, fy, jok, jnew, gamma):
@@ -121,10 +122,10 @@ class SystemPreconditioner:
 
     def _factor_schur(self, gamma):
         """S = N_bb - N_br N_rr^-1 N_rb over the coupled bodies, inverted."""
-        schur = np.zeros_like(self._schur)
+        schur, size = np.zeros_like(self._schur), FREE_BODY.size
         for part in self.coupled:
             o = self._offset[part.name]
-            schur[o:o + 13, o:o + 13] = np.eye(13) - gamma * self._jac[part.name]
+            schur[o:o + size, o:o + size] = np.eye(size) - gamma * self._jac[part.name]
         for part in self.coupled:
             o = self._offset[part.name]
             by_rod = {}
@@ -132,14 +133,14 @@ class SystemPreconditioner:
                 by_rod.setdefault(joint.joint.rod, []).append(joint)
             for rod, joints in by_rod.items():
                 start = self.assembly.parts[rod].start
-                for k in range(13):
+                for k in range(size):
                     x = self._rod_solve(rod, [(j, -gamma * self._rod_to_body[id(j)][:, k]) for j in joints])
                     for other in self.coupled:  # every body joined to this rod reads x at its joint nodes
                         for joint in other.joints:
                             if joint.joint.rod == rod:
                                 oo = self._offset[other.name]
                                 n_br = -gamma * self._body_to_rod[id(joint)]
-                                schur[oo:oo + 13, o + k] -= n_br @ x[joint.node - start + JOINT_COLUMNS]
+                                schur[oo:oo + size, o + k] -= n_br @ x[joint.node - start + JOINT_COLUMNS]
         self._schur = np.linalg.inv(schur)
 
     def solve(self, t, y, fy, r, z, gamma, delta, lr):
@@ -159,14 +160,14 @@ class SystemPreconditioner:
         for part in self.coupled:
             o = self._offset[part.name]
             for joint in part.joints:
-                rhs[o:o + 13] -= -g * self._body_to_rod[id(joint)] @ z[joint.node + JOINT_COLUMNS]
+                rhs[o:o + FREE_BODY.size] -= -g * self._body_to_rod[id(joint)] @ z[joint.node + JOINT_COLUMNS]
         z_b = self._schur @ rhs
         by_rod = {}
         for part in self.coupled:
             o = self._offset[part.name]
-            z[part.slice] = z_b[o:o + 13]
+            z[part.slice] = z_b[o:o + FREE_BODY.size]
             for joint in part.joints:
-                by_rod.setdefault(joint.joint.rod, []).append((joint, -g * self._rod_to_body[id(joint)] @ z_b[o:o + 13]))
+                by_rod.setdefault(joint.joint.rod, []).append((joint, -g * self._rod_to_body[id(joint)] @ z_b[o:o + FREE_BODY.size]))
         for rod, rows_values in by_rod.items():
             z[parts[rod]] -= self._rod_solve(rod, rows_values)
         self.solves += 1
