@@ -1,11 +1,12 @@
 """A run of a :class:`rodmol.System` (rods and rigid bodies), reached through
-:func:`rodmol.simulate`: in memory, from rest, with CVODE; with ``out=DIR``
+:func:`rodmol.simulate`: in memory, from rest, with CVODE, or with the single rod's ``"galpha"`` and ``"rk23"``
+backends (through :class:`rodmol.solve.system_stepping.SteppedSystem`); with ``out=DIR``
 its files are written once it ended (:mod:`rodmol.output.system_files`,
 through :func:`rodmol.run_sinks.system_writer`).
 
 Not yet for systems (each raises :class:`rodmol.errors.NotSupportedYet`):
-the equilibrium start with a free body, streaming while the run goes,
-``resume`` and the other backends. ``progress`` is reported at the output times only.
+the equilibrium start with a free body, streaming while the run goes
+and ``resume``. ``progress`` is reported at the output times only.
 """
 
 import warnings
@@ -17,8 +18,11 @@ from .discretise.assembly import Assembly
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
 from .errors import NotSupportedYet, ParameterError
 from .solve import options
+from .solve.backends import get_backend
 from .solve.equilibrium import equilibrium
+from .solve.galpha import generalized_alpha
 from .solve.system_cvode import cvode_system
+from .solve.system_stepping import SteppedSystem, auto_dt
 from .system_result import SystemResult
 
 OUTPUT_DT = 0.01
@@ -39,9 +43,9 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
         raise NotSupportedYet("`resume` is not supported yet for systems (their files are written after the run)")
     if out is None and overwrite is not False:
         raise ParameterError("`overwrite` needs `out`")
-    if backend not in (None, "cvode"):
-        raise NotSupportedYet(f"`backend` {backend!r} is not supported yet for systems: use 'cvode'")
-    checked = options.backend_options("cvode", cvode_system, backend_options)
+    backend = "cvode" if backend is None else backend
+    run = cvode_system if backend == "cvode" else get_backend(backend)
+    checked = options.backend_options(backend, run, backend_options)
     progress, max_wall_time = options.progress(progress), options.max_wall_time(max_wall_time)
     if isinstance(initial, SystemResult):
         t0 = float(initial.t[-1]) if t0 is None else t0
@@ -74,9 +78,16 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
 
         progress = Progress()
     try:
-        t, y, success, message, stats, error = cvode_system(assembly, y0, t_out, rtol=rtol, atol=atol,
-                                                            progress=progress, max_wall_time=max_wall_time,
-                                                            **checked)
+        if run is cvode_system:
+            t, y, success, message, stats, error = cvode_system(assembly, y0, t_out, rtol=rtol, atol=atol,
+                                                                progress=progress, max_wall_time=max_wall_time,
+                                                                **checked)
+        else:
+            if run is generalized_alpha and checked.get("dt", "auto") == "auto":
+                checked["dt"] = auto_dt(assembly)
+            raw = run(SteppedSystem(assembly), y0, t_out, rtol=rtol, atol=atol, progress=progress,
+                      max_wall_time=max_wall_time, **checked)
+            t, y, success, message, stats, error = raw.t, raw.y, raw.success, raw.message, raw.stats, raw.error
     finally:
         if owned:
             progress.close()
