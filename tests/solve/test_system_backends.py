@@ -14,14 +14,16 @@ GRAVITY_OFF = (0.0, 0.0, 0.0)
 TILT = np.array([[1.0, 0.0, 0.0], [0.0, 0.8, -0.6], [0.0, 0.6, 0.8]])
 
 
-def _head_with_two_arms(mu=300.0, tension=0.2):
+def _head_with_two_arms(mu=300.0, tension=0.2, left=None):
     """Two 0.2 m arms, each pulled by a cable on its +y side (none if ``tension``
-    is None), clamped off a free 50 g head at different points and angles, in vacuum."""
+    is None; the left arm's ``left`` if given), clamped off a free 50 g head at
+    different points and angles, in vacuum."""
     material = rodmol.Material(E=1e5, nu=0.5, mu=mu, rho=1080.0)
     arms, joints = {}, []
     for name, point, turn in (("right", (0.02, 0.0, 0.0), np.eye(3)),
                               ("left", (-0.02, 0.0, 0.01), np.diag([-1.0, -1.0, 1.0]) @ TILT)):
-        cables = [] if tension is None else [rodmol.Cable((0.005, 0.0), 0.2, name="c", tension=tension)]
+        pull = left if name == "left" and left is not None else tension
+        cables = [] if pull is None else [rodmol.Cable((0.005, 0.0), 0.2, name="c", tension=pull)]
         arms[name] = rodmol.Model(rodmol.Rod(0.2, radius=0.01, material=material), 8, cables=cables)
         joints.append(rodmol.Joint(("head", point, turn), (name, "base")))
     head = rodmol.RigidBody(0.05, (2e-5, 3e-5, 4e-5), centre_of_mass=(0.0, 0.004, 0.0))
@@ -108,6 +110,18 @@ def test_system_jacobian_matches_dense_differences():
         z[j] += step
         dense[:, j] = (assembly(0.04, z) - fy) / step
     np.testing.assert_allclose(jacobian.dense(0.04, y), dense, rtol=1e-6, atol=1e-6 * np.abs(dense).max())
+
+
+@pytest.mark.parametrize("backend", ["rk23", "galpha"])
+def test_an_overloaded_arm_stops_the_run_naming_it(backend):
+    """Every rod's state is watched on its own part: the left arm, pulled by
+    100 N, turns by more than a quarter turn per element and the run ends
+    there with the frames before, naming it."""
+    system = _head_with_two_arms(left=lambda t: 100.0 * min(t / 0.05, 1.0))
+    with pytest.warns(RuntimeWarning, match="rod 'left': element 7 turns by"):
+        run = rodmol.simulate(system, 0.2, output_dt=0.01, backend=backend)
+    assert not run.success and 0.0 < run.t[-1] < 0.05
+    assert np.all(np.isfinite(run.states))
 
 
 @pytest.mark.parametrize("backend, option, value, words", [
