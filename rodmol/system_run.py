@@ -1,13 +1,15 @@
 """A run of a :class:`rodmol.System` (rods and rigid bodies), reached through
-:func:`rodmol.simulate`: in memory, from rest, with CVODE; with ``out=DIR``
-its frames are streamed in chunks while it goes, through the single rod's
+:func:`rodmol.simulate`: in memory, from rest, with CVODE or the single rod's
+``"galpha"`` and ``"rk23"`` backends (through
+:class:`rodmol.solve.system_stepping.SteppedSystem`); with ``out=DIR`` its
+frames are streamed in chunks while it goes, through the single rod's
 chunked run (:func:`rodmol.solve.chunked.run_chunked`) into the sink
 :func:`rodmol.run_sinks.system_writer` makes
 (:class:`rodmol.output.system_stream.SystemRunWriter`), and ``resume=True``
 continues a killed run from its last restart point.
 
-Not yet for systems (each raises :class:`rodmol.errors.NotSupportedYet`):
-the equilibrium start with a free body, ``resume="force"`` and the other backends. ``progress`` is reported at the output times only.
+``resume="force"`` is refused for systems (their model is not fingerprinted
+yet). ``progress`` is reported at the output times only.
 """
 
 import warnings
@@ -17,12 +19,15 @@ import numpy as np
 from . import _checks, run_sinks
 from .discretise.assembly import Assembly
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
-from .errors import NotSupportedYet, ParameterError
+from .errors import ParameterError
 from .solve import options
+from .solve.backends import get_backend
 from .solve.chunked import run_chunked
 from .solve.equilibrium import equilibrium
+from .solve.galpha import generalized_alpha
 from .solve.outputs import RawSolution
 from .solve.system_cvode import cvode_system
+from .solve.system_stepping import SteppedSystem, auto_dt
 from .system_result import SystemResult
 
 OUTPUT_DT = 0.01
@@ -48,8 +53,6 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
         raise ParameterError("`overwrite` and `resume=True` need `out`, the run's directory")
     if resume and overwrite:
         raise ParameterError("give either `resume` or `overwrite=True`, not both")
-    if backend not in (None, "cvode"):
-        raise NotSupportedYet(f"`backend` {backend!r} is not supported yet for systems: use 'cvode'")
     sink, first = None, 0
     if resume:  # the run's directory first: its settings fill in what the call leaves out
         sink = _sink(out, True, False)
@@ -58,10 +61,13 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
         scheme = recorded.get("scheme") if scheme is None else scheme
         rtol = recorded.get("rtol") if rtol is None else rtol
         atol = recorded.get("atol") if atol is None else atol
+        backend = recorded.get("backend") if backend is None else backend
         backend_options = backend_options or recorded.get("backend_options") or {}
         first, initial = sink.restart[0], sink.restart[1]
         t0 = float(sink.t_out[first])
-    checked = options.backend_options("cvode", cvode_system, backend_options)
+    backend = "cvode" if backend is None else backend
+    run = cvode_system if backend == "cvode" else get_backend(backend)
+    checked = options.backend_options(backend, run, backend_options)
     progress, max_wall_time = options.progress(progress), options.max_wall_time(max_wall_time)
     if isinstance(initial, SystemResult):
         t0 = float(initial.t[-1]) if t0 is None else t0
@@ -74,6 +80,8 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
         raise ParameterError(f"`t_end` must be after the start t0 = {t0!r} s, got {t_end!r} s")
     output_dt = _checks.positive("output_dt", OUTPUT_DT if output_dt is None else output_dt, " s")
     assembly = Assembly(system, scheme)
+    if run is generalized_alpha and checked.get("dt", "auto") == "auto":
+        checked["dt"] = auto_dt(assembly)
     if resume:
         getattr(sink, "check", lambda assembly: None)(assembly)
     t_out = options.output_times(t0, t_end, output_dt, output_times, assembly.size) if sink is None \
@@ -94,7 +102,8 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
         sink = _sink(out, False, bool(overwrite))
     if sink is not None:
         getattr(sink, "record_settings", lambda settings: None)(
-            dict(scheme=scheme.name, rtol=rtol, atol=atol.tolist(), backend_options=dict(backend_options),
+            dict(scheme=scheme.name, rtol=rtol, atol=atol.tolist(), backend=backend,
+                 backend_options=dict(backend_options),
                  initial=recorded.get("initial") if resume else
                  "straight" if initial is None else initial if isinstance(initial, str) else "state"))
     owned = progress is True
@@ -105,10 +114,11 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
     solver = dict(rtol=rtol, atol=atol, progress=progress, max_wall_time=max_wall_time, **checked)
     try:
         if sink is None:
-            t, y, success, message, stats, error = cvode_system(assembly, y0, t_out, **solver)
-            result = SystemResult(assembly, t, y, success, message, stats, error)
+            raw = _run(_Chunked(assembly, run), y0, t_out, **solver)
+            success, message = raw.success, raw.message
+            result = SystemResult(assembly, raw.t, raw.y, success, message, raw.stats, raw.error)
         else:  # in chunks into the sink, whose SystemResult it is
-            success, message, stats, error = run_chunked(_run, _Chunked(assembly), y0, t_out, sink, first,
+            success, message, stats, error = run_chunked(_run, _Chunked(assembly, run), y0, t_out, sink, first,
                                                          **solver)
             result = sink.end(success, message, stats)
             result.error = error
@@ -139,19 +149,23 @@ def _check_plan(plan, recorded, initial, t0, t_end, output_dt, output_times):
 
 
 class _Chunked:
-    """The assembly as :func:`rodmol.solve.chunked.run_chunked` sees it. Its frames are
-    not checked again against the rods' inputs (``inputs_vary``): a rod's inputs are
-    evaluated when its Result is built, and a failing one stops the run there."""
+    """The assembly and its backend ``run`` as :func:`rodmol.solve.chunked.run_chunked`
+    sees them. Its frames are not checked again against the rods' inputs
+    (``inputs_vary``): a rod's inputs are evaluated when its Result is built, and a
+    failing one stops the run there."""
 
     inputs_vary = False
 
-    def __init__(self, assembly):
-        self.assembly = assembly
+    def __init__(self, assembly, run):
+        self.assembly, self.run = assembly, run
 
 
 def _run(chunked, y0, t_out, **solver):
-    """:func:`cvode_system` as a backend of the chunked run (a RawSolution)."""
-    return RawSolution(*cvode_system(chunked.assembly, y0, t_out, **solver))
+    """The backend on the assembly (a RawSolution): CVODE's own system run, or a single
+    rod's integrator on the assembly seen as one system (:class:`SteppedSystem`)."""
+    if chunked.run is cvode_system:
+        return RawSolution(*cvode_system(chunked.assembly, y0, t_out, **solver))
+    return chunked.run(SteppedSystem(chunked.assembly), y0, t_out, **solver)
 
 
 def _sink(out, resume, overwrite):

@@ -32,9 +32,6 @@ SINGLE_ROD_KEYS = {"arm": "a [[rod]] written out in full", "scenario": "Python (
                    "material": "[rod.material]", "cable": "[[rod.cable]]", "marker": "[[rod.marker]]",
                    "load": "[[rod.load]]", "base": "[rod.base]", "medium": "[system] medium",
                    "gravity": "[system] gravity"}
-#: [solver] values a system's run does not take yet, with the reason.
-NOT_YET = {("backend", "galpha"): "only the `cvode` backend runs systems yet",
-           ("backend", "rk23"): "only the `cvode` backend runs systems yet"}
 
 
 def is_system(data):
@@ -50,9 +47,6 @@ def system(data, ctx, n_elements, solver):
     for key, place in SINGLE_ROD_KEYS.items():
         if key in data:
             ctx.add((key,), f"`{key}` belongs to a single-rod file: in a system file use {place}")
-    for (key, value), message in NOT_YET.items():
-        if solver.get(key) == value:
-            ctx.add(("solver", key), message)
     free = [entry.get("name") for entry in (data.get("body") if isinstance(data.get("body"), list) else [])
             if isinstance(entry, dict) and entry.get("motion", "free") == "free"]
     if solver.get("initial") == "equilibrium" and free:

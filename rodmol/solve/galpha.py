@@ -36,7 +36,7 @@ import numpy as np
 from ..errors import ParameterError
 from .newton_matrix import CONVERGED, DIVERGED, NOT_FINITE, SLOW, newton_matrix
 from .outputs import Outputs, run_steps, step_size_stats
-from .watch import STALL_STEP, Watch
+from .watch import STALL_STEP, watch_for
 
 #: Steps per first bending period of the rod when ``dt="auto"`` (period
 #: error of the midpoint rule about (2 pi / 100)^2 / 12 = 0.03%).
@@ -96,7 +96,7 @@ def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_
     alpha_m, alpha_f, gamma = coefficients(float(rho_inf))
     kappa = alpha_m * (1.0 - gamma) / gamma - (1.0 - alpha_m)  # weight of ydot_n in b
 
-    watch = Watch(system, t_out, max_wall_time, progress)
+    watch = watch_for(system, t_out, max_wall_time, progress)
     out = Outputs(t_out, y0, progress, system.layout, "generalized-alpha", watch)
     scale = np.broadcast_to(atol, (system.size,)) / rtol
     matrix = newton_matrix(system, scale)

@@ -4,7 +4,7 @@ import numpy as np
 from scipy.integrate import RK23
 
 from .outputs import Outputs, run_steps, step_size_stats
-from .watch import Watch
+from .watch import watch_for
 
 
 def rk23(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, max_step=np.inf):
@@ -19,7 +19,7 @@ def rk23(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, ma
         evals[0] += 1
         return system(t, y)
 
-    watch = Watch(system, t_out, max_wall_time, progress)
+    watch = watch_for(system, t_out, max_wall_time, progress)
     out = Outputs(t_out, y0, progress, system.layout, "RK23", watch)
     sizes = []
 

@@ -115,6 +115,15 @@ def _describe(layout, ds, t, code, i, value):
     return None
 
 
+def watch_for(system, t_span, max_wall_time=None, progress=None):
+    """The :class:`Watch` of a backend's ``system``: its own if it has one
+    (``system.watch``, a system of rods and bodies), else a rod's."""
+    own = getattr(system, "watch", None)
+    if own is not None:
+        return own(t_span, max_wall_time, progress)
+    return Watch(system, t_span, max_wall_time, progress)
+
+
 class Watch:
     """The per-step checks of one integration (see the module docstring).
 

@@ -210,3 +210,11 @@ def test_a_penalty_joint_takes_every_argument_of_joint():
     assert (joint.rod, joint.body, joint.kind) == ("beam", "mass", "pin")
     hold = system.rods["beam"].loads[joint.load]
     assert (hold.stiffness, hold.damping) == (1e6, 3.0)
+
+
+@pytest.mark.parametrize("backend", ["galpha", "rk23"])
+def test_a_system_file_runs_with_the_galpha_and_rk23_backends(backend):
+    text = TWO_ARMS.read_text().replace("t_end = 0.5", f't_end = 0.02\nbackend = "{backend}"')
+    run = parse_scenario(text).simulate()
+    assert run.success and run.t[-1] == pytest.approx(0.02)
+    assert ("dt" in run.stats) == (backend == "galpha")  # the backend named in the file ran
