@@ -194,21 +194,36 @@ class FreeRestEquations:
         return y
 
 
+def floating(system):
+    """The names of the free bodies of a :class:`rodmol.System` that no chain of
+    rods and joints holds to the world (a fixed or driven body, a rod's base
+    clamped to the world, a penalty joint to the world)."""
+    edges = [(rod, "world" if clamp[0] is None else clamp[0]) for rod, clamp in system.clamps.items()]
+    edges += [(rod, "world") for rod in system.rods if rod not in system.clamps]
+    for joint in system.penalty_joints:
+        edges.append((joint.rod, joint.partner if joint.partner is not None else joint.body or "world"))
+    held = {"world"} | {name for name, body in system.bodies.items() if not body.free}
+    grown = True
+    while grown:
+        grown = False
+        for a, b in edges:
+            if (a in held) != (b in held):
+                held |= {a, b}
+                grown = True
+    return [name for name, body in system.bodies.items() if body.free and name not in held]
+
+
 def free_rest_state(assembly, t, tol, max_iter):
     """The rest state of ``assembly`` (an :class:`Assembly` with free bodies) at t:
     :class:`FreeRestEquations` by load continuation from the undeformed rods at
-    the bodies' initial poses. A free body held by nothing (no rod clamped to
-    it, no joint) has no rest under a net weight: refused."""
-    for part in assembly.free:
-        loose = not part.rods and not part.joints
-        net = part.params[NET_MASS] * np.linalg.norm(assembly.system.gravity)
-        if loose and net != 0.0:
-            raise EquilibriumError(f"body {part.name!r} is free and held by nothing (no rod clamped to it, "
-                                   f"no joint): its weight less buoyancy, {net:.3g} N, has no rest "
-                                   "(fix it, drive it or join it to a rod)")
-        if loose:
-            raise EquilibriumError(f"body {part.name!r} is free, held by nothing and weightless: every pose "
-                                   "is at rest, none is the equilibrium (fix it or join it to a rod)")
+    the bodies' initial poses. A free body that nothing holds to the world
+    (:func:`floating`) has no rest, or no single one: refused."""
+    loose = floating(assembly.system)
+    if loose:
+        names = ", ".join(map(repr, loose))
+        raise EquilibriumError(f"free body {names} is held by nothing: no chain of rods and joints holds it to "
+                               "the world, so its weight less buoyancy has no rest, or every pose is one "
+                               "(fix it, drive it, or join it to the world or a rod held there)")
     equations = FreeRestEquations(assembly, t)
     try:
         z = continuation(equations.residual, equations.unknowns(), equations.tolerance(tol), max_iter,

@@ -66,5 +66,5 @@ def test_free_body_held_by_nothing_has_no_equilibrium():
     rod = rodmol.Model(rodmol.Rod(ROD_L, radius=ROD_R, material=rodmol.Material(E=ROD_E, nu=0.5, rho=ROD_RHO)), 4)
     loose = rodmol.System({"rod": rod}, {"payload": rodmol.RigidBody(PAYLOAD_M, (1e-4, 1e-4, 1e-4))},
                           gravity=(0.0, -G, 0.0))
-    with pytest.raises(rodmol.EquilibriumError, match="'payload' is free and held by nothing"):
+    with pytest.raises(rodmol.EquilibriumError, match="free body 'payload' is held by nothing"):
         rodmol.equilibrium(loose)
