@@ -4,7 +4,7 @@ its files are written once it ended (:mod:`rodmol.output.system_files`,
 through :func:`rodmol.run_sinks.system_writer`).
 
 Not yet for systems (each raises :class:`rodmol.errors.NotSupportedYet`):
-the equilibrium start with a free body, streaming while the run goes,
+streaming while the run goes,
 ``resume`` and the other backends. ``progress`` is reported at the output times only.
 """
 
@@ -29,7 +29,7 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
                     out=None, resume=False, overwrite=False, **backend_options):
     """Integrate ``system`` from rest (``initial="straight"``: every rod
     straight at its base, every body at rest at its pose), from its static
-    equilibrium (``"equilibrium"``, bodies fixed or driven only:
+    equilibrium (``"equilibrium"``, free bodies included:
     :func:`rodmol.solve.equilibrium.system_rest_state`), from a state
     vector (``SystemResult.states[k]``) or from the last frame of an earlier
     SystemResult (at its last time unless ``t0`` is given); the other
@@ -57,7 +57,7 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
     t_out = options.output_times(t0, t_end, output_dt, output_times, assembly.size)
     if initial is None or (isinstance(initial, str) and initial == "straight"):
         y0 = assembly.initial_state()
-    elif isinstance(initial, str) and initial == "equilibrium":  # bodies fixed or driven only
+    elif isinstance(initial, str) and initial == "equilibrium":
         y0 = equilibrium(assembly, t0)
     elif isinstance(initial, str):
         raise ParameterError(f"unknown `initial` {_checks.short(initial)}; use 'straight', 'equilibrium' "

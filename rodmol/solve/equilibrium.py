@@ -62,9 +62,8 @@ def equilibrium(model, t=0.0, *, scheme=None, tol=1e-10, max_iter=40):
         The model, or its system if one is built already (``simulate`` passes
         its own; a loop over many equilibria of one model saves the build and
         the Jacobian's structure, kept per system). A :class:`rodmol.System`
-        (or its :class:`~rodmol.discretise.assembly.Assembly`) whose bodies
-        are all fixed or driven: each rod's rest state on its clamp, the
-        bodies at their initial poses (see :func:`system_rest_state`).
+        (or its :class:`~rodmol.discretise.assembly.Assembly`): the rods'
+        rest states and the free bodies' poses (see :func:`system_rest_state`).
     t : float
         Time [s] at which the time-dependent inputs are evaluated.
     scheme : str, optional
