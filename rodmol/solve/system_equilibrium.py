@@ -16,9 +16,10 @@ values) are ramped by the continuation of :func:`continuation`; the joints'
 held points follow the bodies at every step.
 
 The coupled Jacobian is not banded (a body's rows read its rods' first cells
-and joint nodes), so it is taken by dense differences and solved densely: the
-cost grows as the cube of the number of unknowns (fine for the legs of a
-parallel robot or a payload at N of a few tens; see docs/systems.md).
+and joint nodes): :class:`CoupledDifferences` takes it in few evaluations and
+it is factorised densely, so the cost grows as the cube of the number of
+unknowns (fine for the legs of a parallel robot or a payload at N of a few
+tens; see docs/systems.md).
 """
 
 import numpy as np
@@ -100,7 +101,8 @@ class FreeRestEquations:
         self.assembly, self.t = assembly, t
         self.rods = {name: RestEquations(sd, t) for name, sd in assembly.rods.items()}
         self.y = assembly.initial_state()  # fixed and driven bodies keep their initial poses
-        gravity = np.linalg.norm(assembly.system.gravity)
+        self._gravity = np.asarray(assembly.system.gravity, dtype=float)
+        gravity = np.linalg.norm(self._gravity)
         self.scale = (sum(eq.scale for eq in self.rods.values())
                       + sum(abs(p.params[NET_MASS]) * gravity for p in assembly.free)) or 1.0
         self.length = max(sd.model.rod.length for sd in assembly.rods.values())
@@ -173,7 +175,7 @@ class FreeRestEquations:
         out = np.empty(self.size)
         for name, eq in self.rods.items():  # held=1: a joint's gap is where the bodies are, not a load
             out[self.slices[name]] = eq.residual(z[self.slices[name]], lam, held=1.0)
-        gravity = lam * assembly._gravity
+        gravity = lam * self._gravity
         for part in assembly.free:
             wrench = reactions[part.name]
             if part.rods:
