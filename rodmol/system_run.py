@@ -38,7 +38,7 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
                     out=None, resume=False, overwrite=False, **backend_options):
     """Integrate ``system`` from rest (``initial="straight"``: every rod
     straight at its base, every body at rest at its pose), from its static
-    equilibrium (``"equilibrium"``, bodies fixed or driven only:
+    equilibrium (``"equilibrium"``, free bodies included:
     :func:`rodmol.solve.equilibrium.system_rest_state`), from a state
     vector (``SystemResult.states[k]``) or from the last frame of an earlier
     SystemResult (at its last time unless ``t0`` is given); the other
@@ -88,7 +88,7 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
         else sink.t_out
     if initial is None or (isinstance(initial, str) and initial == "straight"):
         y0 = assembly.initial_state()
-    elif isinstance(initial, str) and initial == "equilibrium":  # bodies fixed or driven only
+    elif isinstance(initial, str) and initial == "equilibrium":
         y0 = equilibrium(assembly, t0)
     elif isinstance(initial, str):
         raise ParameterError(f"unknown `initial` {_checks.short(initial)}; use 'straight', 'equilibrium' "

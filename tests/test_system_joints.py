@@ -4,6 +4,8 @@ parallel robot against a shooting solution of the Cosserat rod equations,
 a closed loop that keeps its momentum, and a tip held to the world that is
 the rod's own Hold."""
 
+import functools
+
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -131,6 +133,7 @@ def _hat(u):
     return np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])
 
 
+@functools.cache  # two tests read it
 def parallel_robot_shooting():
     """The platform's equilibrium pose (position [m], rotation vector) by
     shooting, after Till et al.: each leg a Cosserat rod ODE from its base,
@@ -314,3 +317,59 @@ def test_rods_of_different_sections_joined_tip_to_tip_keep_zero_momentum():
     scale = 1080.0 * np.pi * 1e-4 * 0.2 * np.abs(run["thin"].velocity).max()
     assert np.abs(run["thin"].velocity).max() > 1e-3  # it moves
     assert np.abs(linear).max() < 1e-5 * scale and np.abs(angular).max() < 1e-5 * scale * 0.2
+
+
+def _parallel_robot(n, mu=2e6):
+    material = rodmol.Material(E=LEG_E, nu=LEG_NU, mu=mu, rho=LEG_RHO)
+    leg = rodmol.Rod(LEG_L, radius=LEG_R, material=material)
+    legs = {f"leg{i}": rodmol.Model(leg, n, base=rodmol.BaseMotion(position=tuple(p), rotation=UP))
+            for i, p in enumerate(LEG_POINTS)}
+    platform = rodmol.RigidBody(PLATFORM_M, (1e-3, 1e-3, 2e-3), centre_of_mass=PLATFORM_COM,
+                                position=(0.0, 0.0, LEG_L))
+    joints = [rodmol.Joint(("platform", tuple(p)), (f"leg{i}", "tip")) for i, p in enumerate(LEG_POINTS)]
+    return rodmol.System(legs, {"platform": platform}, joints, gravity=tuple(ROBOT_GRAVITY))
+
+
+def test_parallel_robot_equilibrium_is_the_settled_pose_and_the_shooting_one():
+    position, rotation = parallel_robot_shooting()
+    system = _parallel_robot(8)
+    rest = rodmol.equilibrium(system)
+    part = Assembly(system).bodies["platform"]
+    pose = rest[part.fields["x"]]
+    turned = Rotation.from_quat(np.roll(rest[part.fields["Q"]], -1)).as_rotvec()
+    displacement = position - (0.0, 0.0, LEG_L)
+    # The grid's error at N = 8, measured: 1.23e-2 of the displacement, 7.5e-3 of the rotation (the
+    # settled run's at N = 8, test above).
+    assert np.linalg.norm(pose - position) < 2e-2 * np.linalg.norm(displacement)
+    assert np.linalg.norm(turned - rotation) < 1.5e-2 * np.linalg.norm(rotation)
+    # The settled run on the same grid: the same discrete statics, what is left of its settling.
+    run = rodmol.simulate(system, 1.5, output_dt=0.5)
+    assert run.success
+    # Measured: 2.4e-5 of the displacement, 1.3e-4 of the rotation.
+    np.testing.assert_allclose(run["platform"].position[-1], pose, atol=1e-4 * np.linalg.norm(displacement))
+    settled = Rotation.from_matrix(run["platform"].rotation[-1]).as_rotvec()
+    np.testing.assert_allclose(settled, turned, atol=5e-4 * np.linalg.norm(rotation))
+    # Started from it, a run stays put (measured: 1.6e-12 of the displacement).
+    still = rodmol.simulate(system, 0.1, initial="equilibrium", output_dt=0.05)
+    assert still.success
+    np.testing.assert_allclose(still["platform"].position, np.tile(pose, (len(still.t), 1)),
+                               atol=1e-9 * np.linalg.norm(displacement))
+
+
+def test_two_half_beams_joined_at_their_tips_rest_as_one_clamped_clamped_beam():
+    # The equilibrium solves joined rods together: each alone would rest with its tip held where it
+    # is at rest (the straight beam), 6 mm above the joined beams' sag.
+    span, n = 0.5, 16
+    material = rodmol.Material(E=1e7, nu=0.5, mu=7e4, rho=1000.0)
+    half = rodmol.Rod(span / 2, radius=0.01, material=material)
+    right = rodmol.BaseMotion(position=(span, 0.0, 0.0), rotation=np.diag([-1.0, -1.0, 1.0]))
+    system = rodmol.System({"left": rodmol.Model(half, n // 2), "right": rodmol.Model(half, n // 2, base=right)},
+                           joints=[rodmol.Joint(("left", "tip"), ("right", "tip"))], gravity=(0.0, -9.81, 0.0))
+    rest = rodmol.equilibrium(system)
+    parts = Assembly(system).parts
+    middle = rodmol.StateLayout(n // 2).field(rest[parts["left"]], "u")[-1]
+    whole = rodmol.Model(rodmol.Rod(span, radius=0.01, material=material), n, gravity=(0.0, -9.81, 0.0),
+                         loads=[rodmol.Hold(span, "clamp")])
+    one = rodmol.StateLayout(n).field(rodmol.equilibrium(whole), "u")[n // 2 - 1]
+    assert middle[1] < -0.005
+    np.testing.assert_allclose(middle, one, atol=2e-5)  # measured 6.3e-6 m

@@ -214,6 +214,12 @@ class BandedDifferences:
             self._groups.append((layout.header + block * members + entry, rows[ok], cols[ok], diagonal[ok]))
         self._shape = (lo + up + 1, size)
 
+    @property
+    def groups(self):
+        """The column groups: (columns perturbed together, and for each entry
+        they reach its row, its column and its diagonal in the band storage)."""
+        return self._groups
+
     def __call__(self, fun, z, f0):
         """dfun/dz at ``z`` (``f0`` = fun(z)) in ``solve_banded`` storage."""
         ab = np.zeros(self._shape)

@@ -16,7 +16,7 @@ the compiled Jacobian of the dynamics takes them), and it is factorised with
 import weakref
 
 import numpy as np
-from scipy.linalg import solve_banded
+from scipy.linalg import lu_factor, lu_solve, solve_banded
 
 from ..discretise import centreline, external, rotations
 from ..discretise.assembly import Assembly
@@ -25,7 +25,7 @@ from ..discretise.layout import BlockLayout
 from ..discretise.load_entries import load_scale
 from ..discretise.schemes import DEFAULT_SCHEME, get_scheme
 from ..discretise.system import SemiDiscrete
-from ..errors import EquilibriumError, NotSupportedYet, ParameterError
+from ..errors import EquilibriumError, ParameterError
 from ..loads import P_STIFFNESS
 from ..model import Model
 from ..systems import System
@@ -62,9 +62,8 @@ def equilibrium(model, t=0.0, *, scheme=None, tol=1e-10, max_iter=40):
         The model, or its system if one is built already (``simulate`` passes
         its own; a loop over many equilibria of one model saves the build and
         the Jacobian's structure, kept per system). A :class:`rodmol.System`
-        (or its :class:`~rodmol.discretise.assembly.Assembly`) whose bodies
-        are all fixed or driven: each rod's rest state on its clamp, the
-        bodies at their initial poses (see :func:`system_rest_state`).
+        (or its :class:`~rodmol.discretise.assembly.Assembly`): the rods'
+        rest states and the free bodies' poses (see :func:`system_rest_state`).
     t : float
         Time [s] at which the time-dependent inputs are evaluated.
     scheme : str, optional
@@ -115,22 +114,24 @@ def equilibrium(model, t=0.0, *, scheme=None, tol=1e-10, max_iter=40):
 
 
 def system_rest_state(system, t=0.0, *, scheme=None, tol=1e-10, max_iter=40):
-    """The rest state of a :class:`rodmol.System` (or its Assembly) whose bodies are all
-    fixed or driven: with every body's pose given, no rod acts on another, so each
-    rod's rest state is a single rod's (:func:`equilibrium`) clamped where its joint
-    puts it; the bodies stay at their initial poses. A free body is refused
-    (NotSupportedYet): its pose is not fixed by the rates' zeros (its pose rates
-    are its velocities, zero at any pose), only by the balance of its loads."""
+    """The rest state of a :class:`rodmol.System` (or its Assembly). With every
+    body fixed or driven and no joint between two rods, no rod acts on another,
+    so each rod's rest state is a single rod's (:func:`equilibrium`) clamped
+    where its joint puts it; the bodies stay at their initial poses. Rods
+    joined to each other are solved together, as with a free body, whose pose is not fixed
+    by the rates' zeros (its pose rates are its velocities, zero at any pose)
+    but by the balance of its loads: the rods and the free bodies' poses are
+    solved together (:func:`rodmol.solve.system_equilibrium.free_rest_state`),
+    an EquilibriumError if a free body is held by nothing."""
     if isinstance(system, System):
         system = Assembly(system, scheme)
     elif scheme is not None and get_scheme(scheme) != system.scheme:
         raise ParameterError(f"`scheme` {scheme!r}: the system given is built with the "
                              f"{system.scheme.name!r} scheme (leave `scheme` out, or pass the System)")
-    if system.free:
-        names = ", ".join(repr(part.name) for part in system.free)
-        raise NotSupportedYet(f"the equilibrium of a system with a free body ({names}) is not supported yet: "
-                              "its pose would have to balance its loads (weight, buoyancy, its rods); "
-                              "start from initial='straight' and let it settle")
+    if system.free or system.rod_joints:  # coupled; same floor: the coupled equations build on this module's
+        from .system_equilibrium import free_rest_state
+
+        return free_rest_state(system, t, tol, max_iter)
     y = system.initial_state()
     for name, rod in system.rods.items():
         try:
@@ -264,6 +265,16 @@ class RestEquations:
             out[grid.node[e] - 1, self._sl["q"]] = max(elastic, floor * hold_density * model.rod.length)
         return out.ravel()
 
+    @property
+    def base(self):
+        """(position [m], quaternion) of the base, global: the clamp the rod is at rest on."""
+        return self._u0, self._quat0
+
+    def place(self, position, quaternion):
+        """Clamp the base at ``position`` [m] with ``quaternion`` (base to global frame),
+        both global: a free body's pose moves its rods' bases (:mod:`.system_equilibrium`)."""
+        self._u0, self._quat0 = position, quaternion
+
     def unknowns(self, y):
         """The static unknowns z of a state vector ``y``."""
         return np.hstack([self.layout.field(y, f) for f in STATIC_FIELDS]).ravel()
@@ -328,11 +339,19 @@ def _rest_state(system, t, tol, max_iter, tensions=None, start=None):
     def at(x, lam):
         return residual(x, min(lam, 1.0), held=max(lam - 1.0, 0.0) if end > 1.0 else None)
 
-    lam, step = 0.0, 1.0
     if start is not None:
         z_warm = _newton(residual, equations.unknowns(start), tol, max_iter, jacobian)
         if z_warm is not None:
-            z, lam = z_warm, end
+            return equations.state(z_warm)
+    z = continuation(at, z, tol, max_iter, jacobian, t, end)
+    return equations.state(z)
+
+
+def continuation(at, z, tol, max_iter, jacobian, t, end=1.0):
+    """The root of ``at(z, lam)`` at ``lam = end``, followed from the root ``z`` at
+    lam = 0 by damped Newton steps (:func:`_newton`) whose length halves on
+    failure: loads ``lam`` <= 1, then held displacements ``lam - 1``."""
+    lam, step = 0.0, 1.0
     while lam < end:
         target = min(end, lam + step)
         z_new = _newton(lambda x, lam=target: at(x, lam), z, tol, max_iter, jacobian)
@@ -346,26 +365,41 @@ def _rest_state(system, t, tol, max_iter, tensions=None, start=None):
                 raise EquilibriumError(
                     f"no static equilibrium found beyond {what} at t = {t} s "
                     "(the rod may buckle under these loads)")
-    return equations.state(z)
+    return z
 
 
 def _newton(fun, z, tol, max_iter, jacobian):
-    """Damped Newton on a banded system (``jacobian``: its :class:`BandedDifferences`);
-    None if it does not converge."""
+    """Damped Newton with the difference Jacobian ``jacobian``: banded
+    (:class:`BandedDifferences`), the step accepted when it lowers |R|, or
+    dense (``bands`` None: a system's coupled equations), the step accepted
+    when it lowers the Newton correction |J^-1 R| (Deuflhard's natural
+    monotonicity test: blind to the rows' scales, where a stiff penalty
+    joint's rows would otherwise make |R| rise along every step); None if it
+    does not converge."""
     f = fun(z)
     norm = np.linalg.norm(f)
     for _ in range(max_iter):
         if np.all(np.abs(f) < tol):
             return z
         try:
-            dz = solve_banded(jacobian.bands, jacobian(fun, z, f), -f)
+            matrix = jacobian(fun, z, f)
+            if jacobian.bands is None:
+                factors = lu_factor(matrix, check_finite=False)
+
+                def measure(g, factors=factors):
+                    return np.linalg.norm(lu_solve(factors, g, check_finite=False))
+
+                dz = -lu_solve(factors, f, check_finite=False)
+                norm = np.linalg.norm(dz)
+            else:
+                measure, dz = np.linalg.norm, solve_banded(jacobian.bands, matrix, -f)
         except (np.linalg.LinAlgError, ValueError):
             return None
         alpha = 1.0
         while True:
             z_try = z + alpha * dz
             f_try = fun(z_try)
-            norm_try = np.linalg.norm(f_try)
+            norm_try = measure(f_try) if np.all(np.isfinite(f_try)) else np.inf
             if np.isfinite(norm_try) and norm_try <= (1.0 - 1e-4 * alpha) * norm:
                 break
             alpha *= 0.5
