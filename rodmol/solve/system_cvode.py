@@ -26,6 +26,7 @@ import numpy as np
 from ..discretise.system_preconditioner import SystemPreconditioner
 from ..errors import NotSupportedYet, ParameterError
 from .outputs import cause
+from .watch import state_problem
 
 #: Linear solvers of a system run.
 SYSTEM_LINEAR_SOLVERS = ("sparse", "gmres", "dense")
@@ -103,6 +104,10 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
         if not r.success:
             message = f"CVODE stopped after t = {reached:.6g} s: {r.message}"
             break
+        broken = _broken(assembly, float(t_k), r.y)
+        if broken:  # as a single rod's run: the frames before, and where and why
+            message = f"CVODE stopped after t = {reached:.6g} s: {broken}"
+            break
         frames.append(np.array(r.y))
         jac_evals = int(r.njev)
         if progress is not None:
@@ -119,3 +124,15 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
     if precond is not None:
         stats.update(jac_evals=precond.jac_evals, prec_setups=precond.setups, prec_solves=precond.solves)
     return t, y, success, message, stats, error
+
+
+def _broken(assembly, t, y):
+    """What is wrong with the system's state ``y`` at ``t`` [s] (a rod's part checked as a
+    single rod's state, :func:`rodmol.solve.watch.state_problem`), or None."""
+    for name, sd in assembly.rods.items():
+        problem = state_problem(sd.layout, sd.model.ds, t, y[assembly.parts[name]])
+        if problem:
+            return f"rod {name!r}: {problem}"
+    if not np.all(np.isfinite(y)):
+        return f"the state of a body became non-finite at t = {t:.6g} s: the solution blew up"
+    return None

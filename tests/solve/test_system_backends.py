@@ -129,13 +129,13 @@ def test_system_jacobian_matches_dense_differences():
     np.testing.assert_allclose(jacobian.dense(0.04, y), dense, rtol=1e-6, atol=1e-6 * np.abs(dense).max())
 
 
-@pytest.mark.parametrize("backend", ["rk23", "galpha"])
+@pytest.mark.parametrize("backend", ["rk23", "galpha", "cvode"])
 def test_an_overloaded_arm_stops_the_run_naming_it(backend):
     """Every rod's state is watched on its own part: the left arm, pulled by
     100 N, turns by more than a quarter turn per element and the run ends
     there with the frames before, naming it."""
     system = _head_with_two_arms(left=lambda t: 100.0 * min(t / 0.05, 1.0))
-    with pytest.warns(RuntimeWarning, match="rod 'left': element 7 turns by"):
+    with pytest.warns(RuntimeWarning, match=r"rod 'left': element \d+ turns by"):
         run = rodmol.simulate(system, 0.2, output_dt=0.01, backend=backend)
     assert not run.success and 0.0 < run.t[-1] < 0.05
     assert np.all(np.isfinite(run.states))
