@@ -29,7 +29,7 @@ from ..discretise.joints import RodJointPart
 from ..discretise.rigid import NET_MASS, free_body_rates
 from ..discretise.system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE
 from ..errors import EquilibriumError
-from .equilibrium import STATIC_FIELDS, RestEquations, continuation
+from .rest_equations import STATIC_FIELDS, RestEquations, continuation
 from .watch import state_problem
 
 #: A free body's pose unknowns: position (3) and rotation increment (3).

@@ -6,7 +6,8 @@ them, from the equilibrium's own equations (:mod:`rodmol.solve.equilibrium`)."""
 import numpy as np
 from scipy.linalg import solve_banded
 
-from .equilibrium import RestEquations, _rest_state
+from .equilibrium import _rest_state
+from .rest_equations import RestEquations
 
 
 def tension_sensitivity(system, y, tensions, t=0.0):

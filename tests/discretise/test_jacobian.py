@@ -18,7 +18,7 @@ from rodmol.discretise import external, load_entries, preconditioner
 from rodmol.discretise.layout import FIELDS, HEADER, merge
 from rodmol.discretise.schemes import SCHEMES
 from rodmol.discretise.system import SemiDiscrete
-from rodmol.solve.equilibrium import RestEquations
+from rodmol.solve.rest_equations import RestEquations
 
 L = paper_rod().length
 N = 8

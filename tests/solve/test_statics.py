@@ -20,7 +20,7 @@ from scipy.integrate import solve_bvp
 import rodmol
 from rodmol.discretise.load_entries import load_scale
 from rodmol.discretise.sampling import Sampled
-from rodmol.solve.equilibrium import RestEquations
+from rodmol.solve.rest_equations import RestEquations
 
 # Table I of the paper (the same numbers rodmol.arm.paper_rod() uses; restated
 # here so that the reference does not read them from rodmol).
