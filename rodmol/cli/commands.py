@@ -129,9 +129,12 @@ def _run_system(args, spec, out):
     if progress:
         progress.close()
     state = "finished" if result.success else f"failed: {result.message}"
-    print(f"rodmol: {spec.name}: {state}; {len(result.t)} output frames to t = {result.t[-1]:g} s in "
-          f"{time.perf_counter() - started:.3g} s, written to {out} (open bodies.xdmf and NAME/rod.xdmf)",
-          file=sys.stdout if result.success else sys.stderr)
+    summary = (f"rodmol: {spec.name}: {state}; {len(result.t)} output frames to t = {result.t[-1]:g} s in "
+               f"{time.perf_counter() - started:.3g} s, written to {out} (open bodies.xdmf and NAME/rod.xdmf)")
+    if result.success:
+        say(summary)  # --quiet: nothing but errors
+    else:
+        print(summary, file=sys.stderr)
     return 0 if result.success else EXIT_FAILED
 
 

@@ -26,7 +26,7 @@ def test_run_a_system_file_writes_every_part(tmp_path):
     (scenario,) = SYSTEM_SCENARIOS
     out = tmp_path / "out"
     run = rodmol_cli("run", scenario, "--out", out, "--t-end", 0.05, "--quiet")
-    assert run.returncode == 0, run.stderr
+    assert run.returncode == 0 and run.stdout == "", (run.stdout, run.stderr)  # --quiet: nothing but errors
     result = rodmol.load_result(out)
     assert result.success and result.names == ["right", "left", "head"] and result.t[-1] == pytest.approx(0.05)
     for rod in result.rods:
