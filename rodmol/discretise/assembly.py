@@ -219,7 +219,8 @@ class Assembly:
         return y
 
     def body_state(self, part, t, y):
-        """A body's (x, Q, v, w) at (t, y) (13,): its pose and velocities (:meth:`body_velocities`)."""
+        """A body's (x, Q, v, w) at (t, y) (``rigid.FREE_BODY.size``,): its pose and velocities
+        (:meth:`body_velocities`)."""
         if part.body.free:
             return np.ascontiguousarray(y[part.slice])
         return np.concatenate([y[part.slice], *self.body_velocities(part, t, y)])
@@ -273,30 +274,35 @@ class Assembly:
         for part in self.free:  # the rods' base velocities first
             for sd, row in zip(part.systems, part.base_velocities(y[part.fields["v"]], y[part.fields["w"]])):
                 sd.base_velocities[:] = row
-        for joint in self.joints:  # and the held points of the penalty joints
-            joint.wrench(y, self.body_state(joint.part, t, y), joint.row, joint.value)
+        reactions = {part.name: np.zeros(6) for part in self.free if part.joints}
+        for joint in self.joints:  # and the held points of the penalty joints, with their bodies' reactions
+            f, m = joint.wrench(y, self.body_state(joint.part, t, y), joint.row, joint.value)
+            if joint.part.name in reactions:
+                reactions[joint.part.name] += (*f, *m)
         for joint in self.rod_joints:
             joint.wrench(y, joint.row, joint.value)
         for name, sd in self.rods.items():
             sl = self.parts[name]
             sd(t, y[sl], out[sl])
         for part in self.bodies.values():
-            self.body_rates(part, t, y, out)
+            self.body_rates(part, t, y, out, reactions.get(part.name))
         return out
 
-    def body_rates(self, part, t, y, out):
+    def body_rates(self, part, t, y, out, reactions=None):
         """The rates of body ``part``'s block at (t, y) into ``out`` (the whole
-        state's rates), after the rods' rates at y (their cell 0's stress)."""
+        state's rates), after the rods' rates at y (their cell 0's stress);
+        ``reactions`` (6,), its penalty joints' force and moment if computed
+        already at y (else here, on scratch rows)."""
         if part.body.free:
             force, torque = self.body_wrench(part, y) if part.rods else ((0.0,) * 3, (0.0,) * 3)
             if part.joints:
-                force, torque = np.array(force), np.array(torque)
-                body = np.ascontiguousarray(y[part.slice])
-                for joint in part.joints:  # on scratch rows: the rods' own rows stay as the last call set them
-                    f, m = joint.wrench(y, body, joint.row.copy(), joint.value.copy())
-                    force += f
-                    torque += m
-                force, torque = tuple(force), tuple(torque)
+                if reactions is None:
+                    reactions, body = np.zeros(6), np.ascontiguousarray(y[part.slice])
+                    for joint in part.joints:  # the rods' own rows stay as the last call set them
+                        f, m = joint.wrench(y, body, joint.row.copy(), joint.value.copy())
+                        reactions += (*f, *m)
+                force = tuple(np.add(force, reactions[:3]))
+                torque = tuple(np.add(torque, reactions[3:]))
             free_body_rates(y[part.slice], part.params, part.rigid_mass, part.inverse_mass, self._gravity,
                             force, torque, DRAG_SMOOTHING_SPEED**2, QUATERNION_RESTORING_RATE, out[part.slice])
             return
