@@ -13,6 +13,7 @@ from scipy.optimize import brentq, curve_fit, root
 from scipy.spatial.transform import Rotation
 
 import rodmol
+from rodmol._differences import central_columns
 from rodmol.discretise.assembly import Assembly
 
 # ---------------------------------------------------------------- the payload
@@ -72,13 +73,7 @@ def _lowest_frequency(system):
     bending frequency, free of any time-integration error."""
     assembly = Assembly(system)
     y, scale = assembly.initial_state(), assembly.atol_scale()
-    jac = np.empty((assembly.size, assembly.size))
-    for j in range(assembly.size):
-        z, h = y.copy(), 1e-6 * scale[j]
-        z[j] += h
-        up = assembly(0.0, z).copy()
-        z[j] -= 2 * h
-        jac[:, j] = (up - assembly(0.0, z)) / (2 * h)
+    jac = central_columns(lambda z: assembly(0.0, z).copy(), y, range(assembly.size), 1e-6 * scale)
     imag = np.abs(np.linalg.eigvals(jac).imag)
     return imag[imag > 1e-3].min()
 
