@@ -217,17 +217,17 @@ def git(*args):
     return subprocess.run(["git", "-C", ROOT, *args], check=True, capture_output=True, text=True).stdout.strip()
 
 
-def _split_commit(argv):
-    """(the other arguments, the --commit REV value or OLD_COMMIT)."""
-    rest, commit, it = [], OLD_COMMIT, iter(argv)
+def split_option(argv, name, default=None):
+    """(the other arguments, the value of ``--name REV`` or ``--name=REV``, else ``default``)."""
+    rest, value, it = [], default, iter(argv)
     for a in it:
-        if a == "--commit":
-            commit = next(it)
-        elif a.startswith("--commit="):
-            commit = a.split("=", 1)[1]
+        if a == f"--{name}":
+            value = next(it)
+        elif a.startswith(f"--{name}="):
+            value = a.split("=", 1)[1]
         else:
             rest.append(a)
-    return rest, commit
+    return rest, value
 
 
 def summary(C, values):
@@ -238,7 +238,7 @@ def summary(C, values):
 def main(argv=None):
     import _common as C  # the parent runs with this checkout (header, file writers)
 
-    argv, commit = _split_commit(sys.argv[1:] if argv is None else list(argv))
+    argv, commit = split_option(sys.argv[1:] if argv is None else list(argv), "commit", OLD_COMMIT)
     args = C.parse_args(__doc__.splitlines()[0], argv)
     if not any(a == "--reps" or a.startswith("--reps=") for a in argv):
         args.reps = C.pick(args, 7, 5, 1)

@@ -30,21 +30,8 @@ import core_speed
 SCRIPT = "rest_strains_speed.py"
 
 
-def _split_base(argv):
-    """(the other arguments, the --base REV value or None)."""
-    rest, base, it = [], None, iter(argv)
-    for a in it:
-        if a == "--base":
-            base = next(it)
-        elif a.startswith("--base="):
-            base = a.split("=", 1)[1]
-        else:
-            rest.append(a)
-    return rest, base
-
-
 def main(argv=None):
-    argv, base = _split_base(sys.argv[1:] if argv is None else list(argv))
+    argv, base = core_speed.split_option(sys.argv[1:] if argv is None else list(argv), "base")
     args = C.parse_args(__doc__.splitlines()[0], argv)
     n, t_end = C.pick(args, 100, 100, 8), C.pick(args, 6.0, 6.0, 0.2)
     calls = C.pick(args, 2000, 1000, 70)
