@@ -6,6 +6,7 @@ import re
 from pathlib import Path
 
 import pytest
+from scenario_texts import MINIMAL
 
 import rodmol
 from rodmol.scenario import tables
@@ -108,16 +109,7 @@ def test_every_documented_default_of_a_key_that_has_one_is_the_constructors():
 def test_every_cable_parameter_reaches_the_cable():
     """Each [[cable]] key (a Cable parameter) lands in the built Cable as the
     Python argument would."""
-    spec = parse_scenario("""
-[rod]
-length = 0.3
-radius = 0.01
-[material]
-E = 1e5
-nu = 0.5
-rho = 1000.0
-[solver]
-t_end = 1.0
+    spec = parse_scenario(MINIMAL + """
 [[cable]]
 name = "c"
 offset = [0.02, 0.0]
