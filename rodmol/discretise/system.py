@@ -152,6 +152,7 @@ class SemiDiscrete:
         self._inputs_vary = bool(self.global_coupling or self._timed or self.grid_loads.values
                                  or not self._fixed_base)
         # The kernel's arguments: arrays whose contents update_inputs refreshes in place.
+        self._compiled = False  # kernel_arguments waits for the compiler once
         self._args = (self._params, self._consts, self._offsets, self._weights, self.tension_values,
                       self.base_velocities, self._kinds, self._nodes, self._entry_weights,
                       self._entry_params, self.entry_values, self._work)
@@ -281,7 +282,9 @@ class SemiDiscrete:
         The first call of a process waits for the compiler (or its disk cache):
         building a system compiles nothing, so arguments are checked against it
         first (``rodmol.simulate``)."""
-        compile_signatures()
+        if not self._compiled:
+            compile_signatures()
+            self._compiled = True
         return self._args
 
     def undeformed_state(self):
@@ -296,7 +299,7 @@ class SemiDiscrete:
             out = np.empty(self.size)
         if self._inputs_vary:
             self.update_inputs(t, y)
-        stencil.rhs(y, out, *self.kernel_arguments())
+        stencil.rhs(y, out, *(self._args if self._compiled else self.kernel_arguments()))
         return out
 
     def rest_rates(self, t, y, out, load_factor=1.0, tensions=None, held_factor=None):
