@@ -36,6 +36,14 @@ class MarkerTracks:
     xyz: np.ndarray
     names: tuple
 
+    def until(self, t_end):
+        """The samples at times up to ``t_end`` [s] (inclusive): e.g. to fit
+        or compare only the first seconds of a recording."""
+        keep = self.t <= t_end
+        if not keep.any():
+            raise ParameterError(f"`t_end` = {t_end!r} s is before the first sample (t = {self.t[0]} s)")
+        return MarkerTracks(self.t[keep], self.xyz[keep], self.names)
+
 
 @dataclass(frozen=True)
 class PixelTracks:

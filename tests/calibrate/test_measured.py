@@ -37,6 +37,16 @@ def test_tracks_round_trip_with_missing_samples(tmp_path):
     assert np.allclose(c_xyz, xyz[:, 0]) and np.allclose(c_uv, uv[:, 0])
 
 
+def test_tracks_until_keep_the_samples_up_to_the_time_and_refuse_an_empty_cut():
+    t = np.arange(5) * 0.5
+    xyz = np.arange(30.0).reshape(5, 2, 3)
+    cut = MarkerTracks(t, xyz, ("a", "b")).until(1.0)
+    assert np.array_equal(cut.t, [0.0, 0.5, 1.0]) and np.array_equal(cut.xyz, xyz[:3])
+    assert cut.names == ("a", "b")
+    with pytest.raises(ParameterError, match="t_end"):
+        MarkerTracks(t + 1.0, xyz, ("a", "b")).until(0.5)
+
+
 def test_tracks_without_header_get_default_names(tmp_path):
     (tmp_path / "m.csv").write_text("# a comment\n0,1,2,3\n\n0.1,1,2,3.5\n")
     tracks = read_marker_tracks(tmp_path / "m.csv")
