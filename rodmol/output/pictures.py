@@ -34,27 +34,28 @@ def render(result, directory, size=(960, 720), frames=60, progress=None):
     plotter = pv.Plotter(off_screen=True, window_size=list(size))
     plotter.set_background("white")
 
-    def draw(k):
+    def draw(k):  # render=False: one render per frame, not one per part (each costs ~0.1 s off-screen)
         for i, part in enumerate(rods):
             rod = rod_mesh(part, k)
             rod.point_data["bending curvature [1/m]"] = bending[i][k]
             plotter.add_mesh(rod.tube(scalars="radius [m]", absolute=True, n_sides=32), name=f"body {i}",
                              scalars="bending curvature [1/m]", clim=[0.0, top], cmap="viridis",
-                             smooth_shading=True, opacity=0.55, scalar_bar_args=dict(color="black"))
+                             smooth_shading=True, opacity=0.55, scalar_bar_args=dict(color="black"), render=False)
             cables = cables_mesh(part, k)
             if cables.n_cells:
                 pulled = cables.cell_data["tension [N]"] > 0
                 colours = np.where(pulled[:, None], [[0.85, 0.1, 0.1]], [[0.6, 0.6, 0.6]])
                 cables.cell_data["colour"] = (255 * colours).astype(np.uint8)
-                plotter.add_mesh(cables, name=f"cables {i}", scalars="colour", rgb=True, line_width=3)
+                plotter.add_mesh(cables, name=f"cables {i}", scalars="colour", rgb=True, line_width=3,
+                                 render=False)
             if len(part.meta.get("markers", [])):
                 plotter.add_mesh(markers_mesh(part, k), name=f"markers {i}", color="black", point_size=10,
-                                 render_points_as_spheres=True)
+                                 render_points_as_spheres=True, render=False)
         for i, (body, (corners, triangles)) in enumerate(bodies):
             faces = np.hstack([np.full((len(triangles), 1), 3), triangles]).ravel()
             plotter.add_mesh(pv.PolyData(_placed(body, (corners, triangles), k), faces), name=f"rigid {i}",
-                             color=(0.8, 0.55, 0.35), smooth_shading=False)
-        plotter.add_text(f"t = {result.t[k]:.2f} s", name="time", color="black", font_size=12)
+                             color=(0.8, 0.55, 0.35), smooth_shading=False, render=False)
+        plotter.add_text(f"t = {result.t[k]:.2f} s", name="time", color="black", font_size=12, render=False)
 
     draw(len(result.t) - 1)
     centre, extent = (low + high) / 2, float(np.linalg.norm(high - low))
@@ -69,8 +70,7 @@ def render(result, directory, size=(960, 720), frames=60, progress=None):
         indices = frame_indices(len(result.t), every)
         images = []
         for k in progress.frames(indices, len(indices), "rendering") if progress else indices:
-            draw(k)
-            plotter.render()
+            draw(k)  # the screenshot renders it
             images.append(Image.fromarray(plotter.screenshot(return_img=True)))
         step_ms = max(20, int(round(1000 * (result.t[-1] - result.t[0]) / max(len(indices) - 1, 1))))
         written.append(Path(directory) / RENDERED[1])

@@ -5,6 +5,7 @@ import re
 import signal
 import time
 
+import numpy as np
 import pytest
 import tomllib
 from cli_helpers import (
@@ -147,6 +148,10 @@ def test_render_and_plot(tmp_path):
     assert plot.returncode == 0, plot.stderr
     for name in ("last_frame.png", "animation.gif", "tip_path.png", "markers.png", "tensions.png"):
         assert (out / name).stat().st_size > 1000, name
+    from PIL import Image, ImageSequence
+
+    frames = [np.asarray(f.convert("RGB")) for f in ImageSequence.Iterator(Image.open(out / "animation.gif"))]
+    assert len(frames) >= 3 and all(np.any(a != b) for a, b in zip(frames, frames[1:]))  # each drawn anew
 
 
 def test_ctrl_c_while_writing_stops_between_frames(tmp_path, monkeypatch):
