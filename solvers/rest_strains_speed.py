@@ -7,7 +7,8 @@ paper's bending test at N = 100 (a straight rod, so both versions compute the
 same numbers): the tree of a base revision (default: the merge base with
 ``main``, extracted with ``git archive`` into a temporary directory) and the
 current working tree run in two long-lived workers of ``core_speed.py`` (the
-same work on both sides: its settings), warmed up first, repetitions
+same work on both sides: its settings; when the base's package files are
+the working tree's, both import the working tree), warmed up first, repetitions
 interleaved (old, new, new, old, ...). Reported: min and median of the
 solver's wall time, of the whole ``simulate`` call, and of the right-hand
 side per call, with the ratios new/old (of the minima, of the medians, and
@@ -37,8 +38,13 @@ def main(argv=None):
     calls = C.pick(args, 2000, 1000, 70)
     git = core_speed.git
     base_sha = git("rev-parse", "--verify", (base or git("merge-base", "HEAD", "main")) + "^{commit}")
+    # The same package files (as right after a merge, or in CI): both workers import the working tree,
+    # whose compiled kernels are cached; an extracted copy would compile them all again for nothing.
+    same_tree = subprocess.run(["git", "-C", core_speed.ROOT, "diff", "--quiet", base_sha, "--", "rodmol"]
+                               ).returncode == 0
+    where = "the working tree itself, the same files" if same_tree else "git archive"
     header = C.header_lines(args, SCRIPT) + [
-        f"old: {base_sha[:10]} (git archive); new: working tree at {git('rev-parse', 'HEAD')[:10]}",
+        f"old: {base_sha[:10]} ({where}); new: working tree at {git('rev-parse', 'HEAD')[:10]}",
         f"bending test, N = {n}, t_end = {t_end:g} s, core_speed.py's worker settings; "
         f"{args.reps} interleaved repetitions per version"]
     tmp = tempfile.mkdtemp(prefix="rodmol-rest-speed-")
@@ -46,9 +52,12 @@ def main(argv=None):
     os.makedirs(old_tree)
     versions, runs, per_call = [], [], []
     try:
-        archive = subprocess.run(["git", "-C", core_speed.ROOT, "archive", base_sha, "rodmol"], check=True,
-                                 capture_output=True).stdout
-        subprocess.run(["tar", "-x", "-C", old_tree], input=archive, check=True)
+        if same_tree:
+            old_tree = core_speed.ROOT
+        else:
+            archive = subprocess.run(["git", "-C", core_speed.ROOT, "archive", base_sha, "rodmol"], check=True,
+                                     capture_output=True).stdout
+            subprocess.run(["tar", "-x", "-C", old_tree], input=archive, check=True)
         for label, tree in (("old", old_tree), ("new", core_speed.ROOT)):
             versions.append(core_speed.Version(label, tree, os.path.join(tmp, f"{label}.stderr")))
             versions[-1].ask(cmd="init", n=n, t_end=t_end)
