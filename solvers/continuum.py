@@ -1,7 +1,7 @@
 """Spatial order of rodmol's static equilibrium against an independent continuum reference.
 
 The reference solves the static Cosserat rod as a boundary value problem with
-``scipy.integrate.solve_bvp`` (relative tolerance 1e-10). It shares no code
+``scipy.integrate.solve_bvp`` (relative tolerance 1e-10; 1e-8 in the smoke run). It shares no code
 with rodmol's discretisation: it reads only the model's parameters (radius
 profile, stiffness diagonals, densities, gravity, cable offsets, anchors and
 tensions, base pose).
@@ -315,16 +315,17 @@ def main(argv=None):
     args = C.parse_args(__doc__.splitlines()[0], argv)
     header = C.header_lines(args, SCRIPT)
     sizes = C.pick(args, [25, 50, 100, 200, 400, 800], [25, 50, 100, 200], [8, 16, 32])
+    tol = C.pick(args, 1e-10, 1e-10, 1e-8)  # the smoke run's errors are ~1e-3 L: a looser reference does
     L = rodmol.arm.LENGTH
     cases = _cases(rodmol, sizes)
     rows, summary, checks = [], [], []
     for case, (t, label, make, anchor) in enumerate(cases):
         with C.Stopwatch() as sw:
-            ref = continuum_equilibrium(make(sizes[0]), t)
-        loose = continuum_equilibrium(make(sizes[0]), t, tol=1e-8)
+            ref = continuum_equilibrium(make(sizes[0]), t, tol=tol)
+        loose = continuum_equilibrium(make(sizes[0]), t, tol=100 * tol)
         drift = float(np.max(np.linalg.norm(loose["positions"] - ref["positions"], axis=1)) / L)
         checks.append(f"case {case} ({label}, t = {t:g} s): {ref['nodes']} mesh nodes, {sw.seconds:.1f} s; "
-                      f"nodes move by {drift:.1e} L between tol 1e-8 and 1e-10")
+                      f"nodes move by {drift:.1e} L between tol {100 * tol:.0e} and {tol:.0e}")
         print(checks[-1], flush=True)
         for scheme, nominal in (("upwind", 1), ("centred", 2)):
             tips, maxima = [], []
@@ -349,7 +350,7 @@ def main(argv=None):
 
     base = os.path.join(args.out, "continuum")
     note = ("paper's arm; errors |u_N - u| / L of rodmol's equilibrium (positions rebuilt from the strains) "
-            "against the continuum reference (solve_bvp, tol 1e-10), at the tip and the largest over the "
+            f"against the continuum reference (solve_bvp, tol {tol:.0e}), at the tip and the largest over the "
             "nodes; 'order' at N is log2(e(N) / e(2N)); tip_error_x_N_p is e N^p with p the scheme's "
             "nominal order (1 upwind, 2 centred); anchor_in_cell: where the cable's anchor lies inside "
             "its cell (0 = on a node)")
