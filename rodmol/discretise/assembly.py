@@ -55,6 +55,7 @@ import numpy as np
 from scipy import sparse
 
 from ..bodies import mass_matrix_about_origin
+from .body_contact import BodyContacts
 from .joints import JointPart, RecordedJoints, RodJointPart, block_entries
 from .layout import BlockLayout
 from .physics import quaternion_rate
@@ -102,6 +103,7 @@ class BodyPart:
         self.shares = np.zeros(0)  # the base node's share of cell 0 [m] (Scheme.base_share ds)
         self.strains = np.zeros((0, 6), dtype=np.int64)  # state indices of (q, k) of each rod's cell 0
         self.joints = []  # its penalty joints (JointPart)
+        self.contacts = BodyContacts(body) if body.contacts else None
 
     def clamp(self, name, sd, start, point, turn):
         """Hold the base of rod ``name`` (its system ``sd``, its state from ``start``)."""
@@ -294,17 +296,19 @@ class Assembly:
         ``reactions`` (6,), its penalty joints' force and moment if computed
         already at y (else here, on scratch rows)."""
         if part.body.free:
-            force, torque = self.body_wrench(part, y) if part.rods else ((0.0,) * 3, (0.0,) * 3)
+            wrench = np.concatenate(self.body_wrench(part, y)) if part.rods else np.zeros(6)
             if part.joints:
                 if reactions is None:
                     reactions, body = np.zeros(6), np.ascontiguousarray(y[part.slice])
                     for joint in part.joints:  # the rods' own rows stay as the last call set them
                         f, m = joint.wrench(y, body, joint.row.copy(), joint.value.copy())
                         reactions += (*f, *m)
-                force = tuple(np.add(force, reactions[:3]))
-                torque = tuple(np.add(torque, reactions[3:]))
+                wrench += reactions
+            if part.contacts is not None:
+                wrench += part.contacts.wrench(y[part.slice])
             free_body_rates(y[part.slice], part.params, part.rigid_mass, part.inverse_mass, self._gravity,
-                            force, torque, DRAG_SMOOTHING_SPEED**2, QUATERNION_RESTORING_RATE, out[part.slice])
+                            tuple(wrench[:3]), tuple(wrench[3:]), DRAG_SMOOTHING_SPEED**2,
+                            QUATERNION_RESTORING_RATE, out[part.slice])
             return
         quat = y[part.fields["Q"]]
         v, w = self.body_velocities(part, t, y)
