@@ -13,6 +13,8 @@ from .loads import SMOOTHING_FRACTION, CapsuleContact, PlaneContact
 #: Motions of a body besides a prescribed :class:`BaseMotion`.
 MOTIONS = ("free", "fixed")
 _IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+#: The units of a contact law on a body, where they differ from a rod's: per contact point, not per length.
+BODY_CONTACT_UNITS = {"stiffness": "N/m", "damping": "N s/m"}
 
 
 @dataclass(frozen=True, eq=False)  # compared by identity: its fields are arrays
