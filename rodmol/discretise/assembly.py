@@ -296,19 +296,20 @@ class Assembly:
         ``reactions`` (6,), its penalty joints' force and moment if computed
         already at y (else here, on scratch rows)."""
         if part.body.free:
-            wrench = np.concatenate(self.body_wrench(part, y)) if part.rods else np.zeros(6)
+            force, torque = self.body_wrench(part, y) if part.rods else ((0.0,) * 3, (0.0,) * 3)
             if part.joints:
                 if reactions is None:
                     reactions, body = np.zeros(6), np.ascontiguousarray(y[part.slice])
                     for joint in part.joints:  # the rods' own rows stay as the last call set them
                         f, m = joint.wrench(y, body, joint.row.copy(), joint.value.copy())
                         reactions += (*f, *m)
-                wrench += reactions
+                force = tuple(np.add(force, reactions[:3]))
+                torque = tuple(np.add(torque, reactions[3:]))
             if part.contacts is not None:
-                wrench += part.contacts.wrench(y[part.slice])
+                contact = part.contacts.wrench(y[part.slice])
+                force, torque = tuple(np.add(force, contact[:3])), tuple(np.add(torque, contact[3:]))
             free_body_rates(y[part.slice], part.params, part.rigid_mass, part.inverse_mass, self._gravity,
-                            tuple(wrench[:3]), tuple(wrench[3:]), DRAG_SMOOTHING_SPEED**2,
-                            QUATERNION_RESTORING_RATE, out[part.slice])
+                            force, torque, DRAG_SMOOTHING_SPEED**2, QUATERNION_RESTORING_RATE, out[part.slice])
             return
         quat = y[part.fields["Q"]]
         v, w = self.body_velocities(part, t, y)
