@@ -102,6 +102,29 @@ def test_box_sliding_with_friction_decelerates_at_mu_g_and_stops():
     np.testing.assert_allclose(run["body"].position[-1, 0], v0**2 / (2 * mu * G) - R * pitch, rtol=1e-3)
 
 
+def test_spinning_ball_set_down_rolls_off_at_two_sevenths_of_its_spin():
+    # Friction acts at the surface point R below the centre and the normal force through the
+    # centre, so the angular momentum about the contact line is kept: I w0 = I w + M R v, and
+    # sliding stops at v = R w, v = I R w0 / (I + M R^2) = 2/7 R w0 for a solid ball.
+    mu, w0 = 0.5, 20.0
+    ball = rodmol.RigidBody(M, (0.4 * M * R * R,) * 3, contacts=(_floor(friction=mu),),
+                            contact_points=[(0.0, 0.0, 0.0)], contact_radius=R,
+                            position=(0.0, 0.0, R - M * G / K - H / 2))
+    system = _system(ball)
+    part = Assembly(system).bodies["body"]
+    y0 = Assembly(system).initial_state()
+    y0[part.fields["w"]] = (0.0, w0, 0.0)
+    rolling = 2.0 / 7.0 * R * w0
+    run = rodmol.simulate(system, 0.2, initial=y0, output_times=np.linspace(0.0, 0.2, 41), rtol=1e-7)
+    assert run.success
+    v = np.einsum("nij,nj->ni", run["body"].rotation, run["body"].velocity)[:, 0]  # global: the ball turns
+    w = run["body"].angular_velocity[:, 1]  # about its y axis, the global one
+    sliding = run.t < 0.9 * rolling / (mu * G)
+    np.testing.assert_allclose(v[sliding], mu * G * run.t[sliding], atol=1e-4 * rolling)
+    np.testing.assert_allclose(v[-5:], rolling, rtol=1e-4)
+    np.testing.assert_allclose(w[-5:] * R, rolling, rtol=1e-4)
+
+
 @pytest.mark.parametrize("damping", [0.0, 0.3 * CRITICAL])
 def test_bouncing_sphere_loses_energy_to_the_damping_only(damping):
     ball = rodmol.RigidBody(M, (0.4 * M * R * R,) * 3, contacts=(_floor(damping=damping),),
