@@ -9,9 +9,10 @@ its base clamped where the body's pose puts the clamp and its penalty joints'
 held points where the bodies (or partner rods) put them, then each free body's
 balance of forces and moments about its origin (body frame): the rods' clamp
 wrenches (:meth:`Assembly.body_wrench`), the penalty joints' reactions, its
-contacts (:mod:`rodmol.discretise.body_contact`) and its weight less buoyancy with the base segments it carries, read from the same
-Newton-Euler rates the dynamics integrate (at v = w = 0 they are M^-1 times the
-wrench, so M times them is the wrench). The loads (gravity, tensions, load
+contacts (:mod:`rodmol.discretise.body_contact`) and its weight less buoyancy
+with the base segments it carries, read from the same Newton-Euler rates the
+dynamics integrate (at v = w = 0 they are M^-1 times the wrench, so M times
+them is the wrench). The loads (gravity, tensions, load
 values) are ramped by the continuation of :func:`continuation`; the joints'
 held points follow the bodies at every step.
 
