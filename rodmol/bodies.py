@@ -8,10 +8,13 @@ import numpy as np
 from . import _checks
 from .base_motion import BaseMotion
 from .errors import ParameterError
+from .loads import SMOOTHING_FRACTION, CapsuleContact, PlaneContact
 
 #: Motions of a body besides a prescribed :class:`BaseMotion`.
 MOTIONS = ("free", "fixed")
 _IDENTITY = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+#: The units of a contact law on a body, where they differ from a rod's: per contact point, not per length.
+BODY_CONTACT_UNITS = {"stiffness": "N/m", "damping": "N s/m"}
 
 
 @dataclass(frozen=True, eq=False)  # compared by identity: its fields are arrays
@@ -54,6 +57,20 @@ class RigidBody:
         or the BaseMotion's).
     rotation : (3, 3) float, optional
         Initial rotation, body to global (default: identity, or the BaseMotion's).
+    contacts : sequence of PlaneContact or CapsuleContact (SphereContact), optional
+        Obstacles the body touches (a free body only), through the rods'
+        contact law at each of its ``contact_points``. For a body the law's
+        numbers are per contact point: ``stiffness`` [N/m] and ``damping``
+        [N s/m] (a rod's are per unit length, N/m^2 and N s/m^2: a point's
+        force is the law's density times 1 m); ``friction`` and ``slip_speed``
+        as for a rod. ``smoothing_depth`` defaults to ``SMOOTHING_FRACTION``
+        of the contact radius, or of the points' extent if the radius is 0.
+    contact_points : (n, 3) float, optional
+        Points [m] of the body frame whose spheres of ``contact_radius``
+        touch the obstacles (a sphere: its centre; a box: its corners;
+        :meth:`from_mesh` takes ``"vertices"``, the mesh's vertices).
+    contact_radius : float or (n,) float
+        Radius [m] of the sphere around each contact point (0: a point).
     """
 
     mass: float
@@ -66,8 +83,13 @@ class RigidBody:
     motion: object = "free"
     position: tuple | None = None
     rotation: tuple | None = None
+    contacts: tuple = ()
+    contact_points: tuple | None = None
+    contact_radius: float = 0.0
     #: The 6x6 mass matrix about the body origin, body frame (with the added mass).
     mass_matrix: np.ndarray = field(init=False, repr=False, compare=False)
+    #: The default smoothing depth [m] of its contacts (see ``contacts``).
+    contact_smoothing: float = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         put = object.__setattr__
@@ -97,6 +119,7 @@ class RigidBody:
         put(self, "rotation", np.array(start.rotation, dtype=float))
         matrix = mass_matrix_about_origin(self.mass * np.eye(3), self.inertia, self.centre_of_mass)
         put(self, "mass_matrix", matrix + added)
+        _contact_geometry(self)
 
     @property
     def driven(self):
@@ -130,8 +153,45 @@ class RigidBody:
         if not triangles:
             raise ParameterError(f"the mesh `path` {str(path)!r} has no triangles")
         volume, centre, inertia = mesh_properties(mesh.points, np.concatenate(triangles))
+        if isinstance(options.get("contact_points"), str) and options["contact_points"] == "vertices":
+            options["contact_points"] = np.asarray(mesh.points, dtype=float)[:, :3]
         return cls(density * volume, density * inertia, volume=volume, centre_of_mass=centre,
                    mesh=str(path), **options)
+
+
+def _contact_geometry(body):
+    """Check and set a body's ``contacts`` (a tuple), ``contact_points`` ((n, 3) [m], body frame),
+    ``contact_radius`` ((n,) [m]) and ``contact_smoothing``, the default smoothing depth [m]."""
+    put = object.__setattr__
+    contacts = _checks.items("contacts", body.contacts, (PlaneContact, CapsuleContact),
+                             "a rodmol.PlaneContact, CapsuleContact or SphereContact")
+    put(body, "contacts", contacts)
+    points = np.zeros((0, 3)) if body.contact_points is None else _checks.floats(body.contact_points)
+    if points is None or points.ndim != 2 or points.shape[1] != 3 or not np.all(np.isfinite(points)):
+        raise ParameterError(f"`contact_points` must be (n, 3) finite numbers [m], body frame, got "
+                             f"{_checks.short(body.contact_points)}")
+    radius = _checks.floats(body.contact_radius)
+    if radius is None or radius.ndim > 1 or (radius.ndim == 1 and radius.shape != (len(points),)):
+        raise ParameterError(f"`contact_radius` must be a number or one per contact point ({len(points)}) [m], "
+                             f"got {_checks.short(body.contact_radius)}")
+    radius = np.broadcast_to(radius, (len(points),)).copy()
+    if not np.all(np.isfinite(radius)) or np.any(radius < 0.0):
+        raise ParameterError(f"`contact_radius` must be >= 0 m, got {_checks.short(body.contact_radius)}")
+    put(body, "contact_points", points)
+    put(body, "contact_radius", radius)
+    extent = np.max(np.linalg.norm(points - points.mean(axis=0), axis=1)) if len(points) else 0.0
+    put(body, "contact_smoothing", SMOOTHING_FRACTION * (radius.max() if np.any(radius > 0.0) else extent)
+        if len(points) else 0.0)
+    if not contacts:
+        return
+    if not body.free:
+        raise ParameterError(f"`contacts` act on a free body only: this one's `motion` is {_checks.short(body.motion)}"
+                             " (a fixed or driven body's motion is prescribed)")
+    if not len(points):
+        raise ParameterError("`contacts` need `contact_points` (the body's points, body frame, that touch them)")
+    if body.contact_smoothing <= 0.0 and any(c.smoothing_depth is None for c in contacts):
+        raise ParameterError("a single contact point of `contact_radius` 0 has no size to smooth the contact over: "
+                             "give the contacts a `smoothing_depth` [m]")
 
 
 def mass_matrix_about_origin(translational, rotational, point):

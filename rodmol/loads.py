@@ -383,3 +383,6 @@ SCENARIO_TYPES = {
     "hold": (Hold, {"s": "m", "position": "m", "rotation": "-", "stiffness": "N/m",
                     "damping": "N s/m", "kind": "-"}),
 }
+#: The contact types of :data:`SCENARIO_TYPES` (a rigid body's ``[[body.contact]]`` takes them too).
+CONTACT_TYPES = tuple(kind for kind, (build, _) in SCENARIO_TYPES.items()
+                      if build in (PlaneContact, CapsuleContact, SphereContact))

@@ -133,3 +133,32 @@ def test_a_bodys_pose_inertia_and_mesh_options_are_refused_by_their_own_names(tm
     with pytest.raises(rodmol.ParameterError, match="`joint end a rotation` must be a rotation matrix"):
         rodmol.System({"arm": rodmol.paper_arm(4)}, {"head": rodmol.RigidBody(1.0, (1.0, 1.0, 1.0))},
                       [rodmol.Joint(("head", (0.0, 0.0, 0.0), np.ones((3, 3))), ("arm", "base"))])
+
+
+_FLOOR = rodmol.PlaneContact((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), stiffness=1e4)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(contacts=_FLOOR, contact_points=[(0, 0, 0)]), "`contacts` must be a sequence"),
+    (dict(contacts=[rodmol.PointForce(0.0, (1, 0, 0))], contact_points=[(0, 0, 0)]), r"`contacts\[0\]`"),
+    (dict(contacts=[_FLOOR]), "`contacts` need `contact_points`"),
+    (dict(contacts=[_FLOOR], contact_points=[(0, 0)]), r"`contact_points` must be \(n, 3\)"),
+    (dict(contacts=[_FLOOR], contact_points=[(0, 0, 0)] * 2, contact_radius=(0.1, 0.1, 0.1)), "`contact_radius`"),
+    (dict(contacts=[_FLOOR], contact_points=[(0, 0, 0)], contact_radius=-0.1), "`contact_radius` must be >= 0"),
+    (dict(contacts=[_FLOOR], contact_points=[(0, 0, 0)]), "give the contacts a `smoothing_depth`"),
+    (dict(contacts=[_FLOOR], contact_points=[(0, 0, 0)], contact_radius=0.1, motion="fixed"), "free body only"),
+])
+def test_bad_contacts_are_refused_naming_the_parameter(kwargs, message):
+    with pytest.raises(rodmol.ParameterError, match=message):
+        rodmol.RigidBody(1.0, (1.0, 1.0, 1.0), **kwargs)
+
+
+@pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning")  # meshio's binary-STL size probe
+def test_a_meshed_body_touches_by_its_vertices_smoothed_over_its_size(tmp_path):
+    path = tmp_path / "box.stl"
+    meshio.write(path, meshio.Mesh(_CORNERS * 0.1, [("triangle", _CUBE)]), binary=False)
+    body = rodmol.RigidBody.from_mesh(path, 1000.0, contacts=[_FLOOR], contact_points="vertices")
+    np.testing.assert_allclose(np.unique(body.contact_points, axis=0), np.unique(_CORNERS * 0.1, axis=0))
+    np.testing.assert_array_equal(body.contact_radius, np.zeros(8))
+    # The corners are 0.1 * sqrt(3) / 2 from their centroid: 1% of that is the default smoothing.
+    assert body.contact_smoothing == pytest.approx(0.01 * 0.1 * np.sqrt(3) / 2, rel=1e-12)

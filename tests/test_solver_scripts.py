@@ -198,6 +198,14 @@ def _loops(out):
     assert all(row["max_drift_over_L"] < 1e-4 for row in sparse), sparse  # the default factor or stiffer
 
 
+def _body_contact(out):
+    example, untouched, resting = rows(out / "body_contact.csv")
+    assert all(row["success"] is True for row in (example, untouched, resting))
+    # a contact that does not touch (none does within the smoke run) adds nothing: the same run, step for step
+    assert untouched["rhs_evals"] == example["rhs_evals"]
+    assert untouched["head_gap_at_rest_mm"] == example["head_gap_at_rest_mm"]
+
+
 SCRIPTS = {
     "scaling.py": (["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"], _scaling),
     "temporal.py": (["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv", "temporal_options.csv"],
@@ -223,6 +231,7 @@ SCRIPTS = {
     "rest_strains_speed.py": (["rest_strains_speed.csv", "rest_strains_speed.md"], _rest_strains_speed),
     "holds.py": (["holds.csv", "holds.md"], _holds),
     "loops.py": (["loops.csv", "loops.md"], _loops),
+    "body_contact.py": (["body_contact.csv", "body_contact.md"], _body_contact),
 }
 
 

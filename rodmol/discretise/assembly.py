@@ -55,6 +55,7 @@ import numpy as np
 from scipy import sparse
 
 from ..bodies import mass_matrix_about_origin
+from .body_contact import BodyContacts
 from .joints import JointPart, RecordedJoints, RodJointPart, block_entries
 from .layout import BlockLayout
 from .physics import quaternion_rate
@@ -102,6 +103,7 @@ class BodyPart:
         self.shares = np.zeros(0)  # the base node's share of cell 0 [m] (Scheme.base_share ds)
         self.strains = np.zeros((0, 6), dtype=np.int64)  # state indices of (q, k) of each rod's cell 0
         self.joints = []  # its penalty joints (JointPart)
+        self.contacts = BodyContacts(body) if body.contacts else None
 
     def clamp(self, name, sd, start, point, turn):
         """Hold the base of rod ``name`` (its system ``sd``, its state from ``start``)."""
@@ -303,6 +305,9 @@ class Assembly:
                         reactions += (*f, *m)
                 force = tuple(np.add(force, reactions[:3]))
                 torque = tuple(np.add(torque, reactions[3:]))
+            if part.contacts is not None:
+                contact = part.contacts.wrench(y[part.slice])
+                force, torque = tuple(np.add(force, contact[:3])), tuple(np.add(torque, contact[3:]))
             free_body_rates(y[part.slice], part.params, part.rigid_mass, part.inverse_mass, self._gravity,
                             force, torque, DRAG_SMOOTHING_SPEED**2, QUATERNION_RESTORING_RATE, out[part.slice])
             return

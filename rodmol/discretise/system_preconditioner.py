@@ -76,7 +76,7 @@ class SystemPreconditioner:
                 jac, steps = self._jac[part.name], self._steps[part.name]
                 for j, index in enumerate(range(part.slice.start, part.slice.stop)):
                     field = self._field_of[part.name][j]
-                    if field == "x" and not part.joints:  # no rate reads its position
+                    if field == "x" and not part.joints and part.contacts is None:  # no rate reads it
                         continue
                     z[index] = y[index] + steps[j]
                     if field in ("x", "Q") and not coupled:  # of the rates kept, only the body's read its pose

@@ -1,4 +1,5 @@
-"""The ``[[load]]`` tables of a scenario file: external loads (:mod:`rodmol.loads`).
+"""The ``[[load]]`` tables of a scenario file: external loads (:mod:`rodmol.loads`),
+and a rigid body's ``[[body.contact]]`` tables, its obstacles.
 
 Each table has a ``type`` (a key of :data:`rodmol.loads.SCENARIO_TYPES`) and
 the arguments of the Python class it builds, checked by that class. Point-load
@@ -9,28 +10,39 @@ scenario file; distributed loads take a constant 3-vector.
 from .. import _checks
 from .arm import build_table, entries
 from .problems import FAILED, failed
-from .tables import LOADS
+from .tables import BODY_CONTACTS, LOADS
 
 
 def loads(data, ctx, at=()):
     """The loads of the ``[[load]]`` tables (in the table at path ``at``), in
     order; FAILED if any has a problem."""
-    tables = entries(data, ctx, "load", at)
+    return _typed(data, ctx, at, "load", LOADS)
+
+
+def contacts(data, ctx, at=()):
+    """The obstacles of the ``[[contact]]`` tables of a body (the table at path
+    ``at``): contact [[load]] types, their law per contact point; FAILED if any has a problem."""
+    return _typed(data, ctx, at, "contact", BODY_CONTACTS)
+
+
+def _typed(data, ctx, at, kind, types):
+    tables = entries(data, ctx, kind, at)
     if tables is FAILED:
         return FAILED
-    built = [_load(ctx, at + ("load", i), entry) for i, entry in enumerate(tables)]
+    built = [_load(ctx, at + (kind, i), entry, types) for i, entry in enumerate(tables)]
     return FAILED if failed(*built) else built
 
 
-def _load(ctx, path, entry):
+def _load(ctx, path, entry, types):
+    kind = path[-2]
     if not isinstance(entry, dict):
-        ctx.add(path[:-1], f"`load` must be an array of tables `[[load]]`, got {entry!r}")
+        ctx.add(path[:-1], f"`{kind}` must be an array of tables `[[{kind}]]`, got {entry!r}")
         return FAILED
     if "type" not in entry:
-        ctx.add(path, f"missing required key `type`; valid types: {', '.join(LOADS)}")
+        ctx.add(path, f"missing required key `type`; valid types: {', '.join(types)}")
         return FAILED
-    kind = ctx.read(entry, path, "type", lambda v: _checks.choice("type", v, tuple(LOADS)))
-    if kind is FAILED:
+    name = ctx.read(entry, path, "type", lambda v: _checks.choice("type", v, tuple(types)))
+    if name is FAILED:
         return FAILED  # its keys depend on the type: they cannot be checked
-    table = LOADS[kind]
-    return build_table(entry, ctx, path, table, table.sources[0].build, hint=f" (for `type = {kind!r}`)")
+    table = types[name]
+    return build_table(entry, ctx, path, table, table.sources[0].build, hint=f" (for `type = {name!r}`)")

@@ -24,6 +24,7 @@ from ..rod import Rod
 from ..systems import Joint, System
 from . import arm as arm_tables
 from . import tables
+from .loads import contacts as contact_tables
 from .loads import loads as load_tables
 from .problems import FAILED, failed
 
@@ -161,7 +162,8 @@ def _rod_problem(entry, path, key, message):
 
 def _body(entry, ctx, path):
     """The RigidBody of one ``[[body]]`` table: ``mass`` and ``inertia``, or a
-    ``mesh`` file and a ``density`` (:meth:`RigidBody.from_mesh`)."""
+    ``mesh`` file and a ``density`` (:meth:`RigidBody.from_mesh`), and its
+    ``[[body.contact]]`` obstacles."""
     meshed = "density" in entry
     required = ("mesh", "density") if meshed else ("mass", "inertia")
     ctx.table(entry, path, tables.BODY, required=required)
@@ -170,8 +172,11 @@ def _body(entry, ctx, path):
             if key in entry:
                 ctx.add(path + (key,), f"`{key}` follows from the `mesh` and `density`: leave it out")
     given = arm_tables.values(tables.BODY, ctx, path, entry)
-    if given is FAILED:
+    contacts = contact_tables(entry, ctx, at=path)
+    if failed(given, contacts):
         return FAILED
+    if contacts:
+        given["contacts"] = contacts
     motion = entry.get("motion")
     if isinstance(motion, dict):  # driven: velocities in the body frame, from the body's pose
         pose = {key: given.pop(key) for key in ("position", "rotation") if key in given}

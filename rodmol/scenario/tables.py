@@ -21,10 +21,10 @@ from pathlib import Path
 
 from ..arm import paper_arm
 from ..base_motion import BaseMotion
-from ..bodies import RigidBody
+from ..bodies import BODY_CONTACT_UNITS, RigidBody
 from ..cables import Cable
 from ..inputs import as_time_input
-from ..loads import SCENARIO_TYPES
+from ..loads import CONTACT_TYPES, SCENARIO_TYPES
 from ..markers import Marker
 from ..model import Model
 from ..output.options import OutputOptions
@@ -40,7 +40,8 @@ UNITS = {"length": "m", "radius": "m", "E": "Pa", "G": "Pa", "mu": "Pa s", "rho"
          "friction": "-", "slip_speed": "m/s", "drag_coefficients": "kg/m^2", "gravity": "m/s^2",
          "position": "m", "velocity": "m/s", "angular_velocity": "rad/s", "t_end": "s",
          "output_dt": "s", "max_wall_time": "s", "rest_curvature": "1/m", "rest_stretch": "-",
-         "mass": "kg", "inertia": "kg m^2", "volume": "m^3", "centre_of_mass": "m", "density": "kg/m^3"}
+         "mass": "kg", "inertia": "kg m^2", "volume": "m^3", "centre_of_mass": "m", "density": "kg/m^3",
+         "contact_points": "m", "contact_radius": "m"}
 
 #: Keys whose value may name a file (CSV table), relative to the scenario file.
 FILE_KEYS = ("tension", "displacement", "force", "moment", "directory", "mesh")
@@ -130,11 +131,17 @@ LOADS = {kind: Table((Source(build),), own=("type",), units=units)
 #: A system file's tables: [system] (its medium, a name or a table as
 #: [medium], and gravity), [[rod]] (a rod's keys, its name and grid, and its
 #: own [material], [[cable]], [[marker]], [[load]] and [base] nested),
-#: [[body]] (a RigidBody, or one filling a mesh of a given density) and [[joint]].
+#: [[body]] (a RigidBody, or one filling a mesh of a given density, its
+#: [[body.contact]] obstacles) and [[joint]].
 SYSTEM = Table((Source(System, only=("medium", "gravity")),))
 SYSTEM_ROD = Table((Source(Rod, skip=("material",)), Source(Model, only=("n_elements",))),
                    own=("name", "material", "cable", "marker", "load", "base"))
-BODY = Table((Source(RigidBody), Source(RigidBody.from_mesh, only=("density",))), own=("name",))
+BODY = Table((Source(RigidBody, skip=("contacts",)), Source(RigidBody.from_mesh, only=("density",))),
+             own=("name", "contact"))
+#: A body's ``[[body.contact]]`` tables (its ``contacts``), by ``type``: the contact
+#: [[load]] types, their law per contact point.
+BODY_CONTACTS = {kind: Table(LOADS[kind].sources, own=("type",), units={**LOADS[kind].units, **BODY_CONTACT_UNITS})
+                 for kind in CONTACT_TYPES}
 #: A driven body's ``motion`` table (its position and rotation are the body's).
 BODY_MOTION = Table((Source(BaseMotion, only=("velocity", "angular_velocity")),))
 JOINT = Table((Source(Joint),))

@@ -8,10 +8,11 @@ orientation, Q = Q_init exp(theta). Equations: each rod's rest equations with
 its base clamped where the body's pose puts the clamp and its penalty joints'
 held points where the bodies (or partner rods) put them, then each free body's
 balance of forces and moments about its origin (body frame): the rods' clamp
-wrenches (:meth:`Assembly.body_wrench`), the penalty joints' reactions and its
-weight less buoyancy with the base segments it carries, read from the same
-Newton-Euler rates the dynamics integrate (at v = w = 0 they are M^-1 times the
-wrench, so M times them is the wrench). The loads (gravity, tensions, load
+wrenches (:meth:`Assembly.body_wrench`), the penalty joints' reactions, its
+contacts (:mod:`rodmol.discretise.body_contact`) and its weight less buoyancy
+with the base segments it carries, read from the same Newton-Euler rates the
+dynamics integrate (at v = w = 0 they are M^-1 times the wrench, so M times
+them is the wrench). The loads (gravity, tensions, load
 values) are ramped by the continuation of :func:`continuation`; the joints'
 held points follow the bodies at every step.
 
@@ -180,6 +181,8 @@ class FreeRestEquations:
             wrench = reactions[part.name]
             if part.rods:
                 wrench = wrench + np.concatenate(assembly.body_wrench(part, y))
+            if part.contacts is not None:
+                wrench = wrench + part.contacts.wrench(self._body(part))
             free_body_rates(self._body(part), part.params, part.rigid_mass, part.inverse_mass, gravity,
                             tuple(wrench[:3]), tuple(wrench[3:]), DRAG_SMOOTHING_SPEED**2,
                             QUATERNION_RESTORING_RATE, self._rates)
@@ -199,7 +202,9 @@ class FreeRestEquations:
 def floating(system):
     """The names of the free bodies of a :class:`rodmol.System` that no chain of
     rods and joints holds to the world (a fixed or driven body, a rod's base
-    clamped to the world, a penalty joint to the world)."""
+    clamped to the world, a penalty joint to the world): contacts do not hold a
+    body at rest (friction acts on sliding only, so on a floor alone every
+    horizontal position is a rest)."""
     edges = [(rod, "world" if clamp[0] is None else clamp[0]) for rod, clamp in system.clamps.items()]
     edges += [(rod, "world") for rod in system.rods if rod not in system.clamps]
     for joint in system.penalty_joints:
@@ -225,7 +230,8 @@ def free_rest_state(assembly, t, tol, max_iter):
         names = ", ".join(map(repr, loose))
         raise EquilibriumError(f"free body {names} is held by nothing: no chain of rods and joints holds it to "
                                "the world, so its weight less buoyancy has no rest, or every pose is one "
-                               "(fix it, drive it, or join it to the world or a rod held there)")
+                               "(fix it, drive it, or join it to the world or a rod held there; its contacts "
+                               "do not hold it at rest: their friction acts on sliding only)")
     equations = FreeRestEquations(assembly, t)
     try:
         z = continuation(equations.residual, equations.unknowns(), equations.tolerance(tol), max_iter,

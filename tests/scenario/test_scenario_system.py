@@ -218,3 +218,47 @@ def test_a_system_file_runs_with_the_galpha_and_rk23_backends(backend):
     run = parse_scenario(text).simulate()
     assert run.success and run.t[-1] == pytest.approx(0.02)
     assert ("dt" in run.stats) == (backend == "galpha")  # the backend named in the file ran
+
+
+BOX_ON_FLOOR = TWO_ARMS.read_text().split("[[body]]")[0] + """
+[[body]]
+name = "head"
+mass = 0.3
+inertia = [2e-4, 2e-4, 2e-4]
+contact_points = [[0.0, 0.0, 0.0], [0.0, 0.0, 0.01]]
+contact_radius = [0.02, 0.01]
+
+[[body.contact]]
+type = "plane_contact"
+point = [0.0, 0.0, -0.02]
+normal = [0.0, 0.0, 1.0]
+stiffness = 1e4
+friction = 0.5
+
+[[body.contact]]
+type = "sphere_contact"
+centre = [0.3, 0.0, 0.0]
+radius = 0.1
+stiffness = 2e4
+damping = 10.0
+
+[[joint]]
+a = ["head", [0.04, 0.0, 0.0]]
+b = ["right", "base"]
+"""
+
+
+def test_a_bodys_contacts_are_its_body_contact_tables():
+    head = parse_scenario(BOX_ON_FLOOR).model.bodies["head"]
+    floor, ball = head.contacts
+    assert isinstance(floor, rodmol.PlaneContact) and floor.stiffness == 1e4 and floor.friction == 0.5
+    assert isinstance(ball, rodmol.CapsuleContact) and ball.radius == 0.1 and ball.damping == 10.0
+    np.testing.assert_array_equal(head.contact_points, [(0.0, 0.0, 0.0), (0.0, 0.0, 0.01)])
+    np.testing.assert_array_equal(head.contact_radius, (0.02, 0.01))
+    # The law's units for a body are per contact point (the reference and the messages say N/m).
+    assert tables.BODY_CONTACTS["plane_contact"].unit("stiffness") == "N/m"
+    assert tables.LOADS["plane_contact"].unit("stiffness") == "N/m^2"
+    with pytest.raises(ScenarioError) as caught:
+        parse_scenario(BOX_ON_FLOOR.replace('type = "sphere_contact"', 'type = "point_force"'))
+    (problem,) = caught.value.problems
+    assert problem.table == "[[body]] #1 [[contact]] #2" and "plane_contact" in problem.message
