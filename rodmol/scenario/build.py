@@ -92,7 +92,7 @@ def _build_system(data, ctx, name, description):
     solver["scheme"] = scheme
     checked = _check_solver(ctx, solver, t_end, n_elements)
     output = _output(data, ctx)
-    system = system_file.system(data, ctx, n_elements, solver)
+    system = system_file.system(data, ctx, n_elements)
     if ctx.problems or failed(system, checked):
         return None
     return RunSpec(name, description, ctx.source, system, t_end, solver, output)

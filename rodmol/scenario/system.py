@@ -40,19 +40,13 @@ def is_system(data):
     return isinstance(data.get("rod"), list) or any(key in data for key in tables.SYSTEM_TABLES)
 
 
-def system(data, ctx, n_elements, solver):
+def system(data, ctx, n_elements):
     """The :class:`rodmol.System` of the parsed file ``data``, or FAILED once
     its problems are recorded; ``n_elements``: ``[discretization]``'s, the
-    default of every rod; ``solver``: the ``[solver]`` values (those a
-    system does not take yet are reported)."""
+    default of every rod."""
     for key, place in SINGLE_ROD_KEYS.items():
         if key in data:
             ctx.add((key,), f"`{key}` belongs to a single-rod file: in a system file use {place}")
-    free = [entry.get("name") for entry in (data.get("body") if isinstance(data.get("body"), list) else [])
-            if isinstance(entry, dict) and entry.get("motion", "free") == "free"]
-    if solver.get("initial") == "equilibrium" and free:
-        ctx.add(("solver", "initial"), f"the equilibrium start of a system with a free body ({free[0]!r}) is "
-                                       "not supported yet: use `initial = \"straight\"` (the default for systems)")
     settings = ctx.table(data.get("system", {}), ("system",), tables.SYSTEM)
     medium, switches = arm_tables.medium(settings, ctx, "air", at=("system",))
     gravity = arm_tables.values(tables.SYSTEM, ctx, ("system",), settings, keys=("gravity",))
