@@ -113,7 +113,7 @@ def test_every_problem_of_a_system_file_at_once_with_its_line_and_table():
         (34, "[solver]", "unknown"),  # an initial state no system has
     }
     messages = "\n".join(p.message for p in caught.value.problems)
-    for words in ("[system] medium", "used twice", "not supported yet", "did you mean 'arm'"):
+    for words in ("[system] medium", "used twice", "did you mean 'straight'", "did you mean 'arm'"):
         assert words in messages
 
 
