@@ -12,6 +12,12 @@ position. The tree joints' coupling blocks are left out: GMRES's products
 J v are differences of the full right-hand side, so it sees them, only
 converging in more iterations.
 
+A body's joints to the world or to fixed or driven bodies are in its own
+block; a joint between two free bodies couples their blocks as stiffly as
+it holds them: both bodies join the Schur complement below, with the
+coupling blocks N_b1b2 (by differences of the full right-hand side in one
+body's entries, the other's rows).
+
 A penalty joint between a rod node and a free body couples them as stiffly
 as it holds them: left out, GMRES needs hundreds of times the right-hand
 sides or fails. Its blocks are kept, and the free bodies with penalty
@@ -50,8 +56,13 @@ class SystemPreconditioner:
         self._field_of = {p.name: [f for f, n in p.layout.fields.items() for _ in range(n)] for p in self.bodies}
         self._out = np.empty(assembly.size)
         self._scale, self.gamma = scale, np.nan
-        # The Schur complement's bodies (free, with penalty joints) and their offsets in S.
-        self.coupled = [p for p in self.bodies if p.body.free and p.joints]
+        # The Schur complement's bodies (free, with penalty joints or joints to other free bodies)
+        # and their offsets in S; each one's free partners through body joints.
+        self._partners = {p.name: [o for j in p.body_joints for o in j.parts if o is not p and o.body.free]
+                          for p in self.bodies}
+        self.coupled = [p for p in self.bodies if p.body.free and (p.joints or self._partners[p.name])]
+        self._pairs = {(p.name, o.name): np.zeros((FREE_BODY.size, FREE_BODY.size))
+                       for p in self.coupled for o in self._partners[p.name]}  # o's rows, p's columns
         self._offset = dict(zip((p.name for p in self.coupled), FREE_BODY.size * np.arange(len(self.coupled))))
         self._rod_to_body = {id(j): np.zeros((len(JOINT_ROWS), FREE_BODY.size)) for p in self.coupled for j in p.joints}
         self._body_to_rod = {id(j): np.zeros((FREE_BODY.size, len(JOINT_COLUMNS))) for p in self.coupled for j in p.joints}
@@ -76,7 +87,7 @@ class SystemPreconditioner:
                 jac, steps = self._jac[part.name], self._steps[part.name]
                 for j, index in enumerate(range(part.slice.start, part.slice.stop)):
                     field = self._field_of[part.name][j]
-                    if field == "x" and not part.joints:  # no rate reads its position
+                    if field == "x" and not (part.joints or part.body_joints):  # no rate reads its position
                         continue
                     z[index] = y[index] + steps[j]
                     if field in ("x", "Q") and not coupled:  # of the rates kept, only the body's read its pose
@@ -87,6 +98,9 @@ class SystemPreconditioner:
                     for joint in part.joints if coupled else ():
                         rows = joint.node + JOINT_ROWS
                         self._rod_to_body[id(joint)][:, j] = (self._out[rows] - fy[rows]) / steps[j]
+                    for other in self._partners[part.name] if coupled else ():
+                        rows = other.slice
+                        self._pairs[part.name, other.name][:, j] = (self._out[rows] - fy[rows]) / steps[j]
                     z[index] = y[index]
             assembly(t, y, self._out)  # leave the rods as at y
             self.jac_evals += 1
@@ -126,6 +140,9 @@ class SystemPreconditioner:
         for part in self.coupled:
             o = self._offset[part.name]
             schur[o:o + size, o:o + size] = np.eye(size) - gamma * self._jac[part.name]
+        for (name, other), block in self._pairs.items():  # the body joints' coupling of two free bodies
+            o, oo = self._offset[name], self._offset[other]
+            schur[oo:oo + size, o:o + size] -= gamma * block
         for part in self.coupled:
             o = self._offset[part.name]
             by_rod = {}
