@@ -369,7 +369,7 @@ class System:
             body = self.bodies[other[1]]
             position = body.position + body.rotation @ other[2]
             rotation = body.rotation @ (np.eye(3) if other[3] is None else other[3])
-        half = 0.5 * model.ds * model.material.rho  # a stand-in: the discretisation carries the segment
+        half = 0.5 * model.ds * model.rod.material.rho  # a stand-in: the discretisation carries the segment
         self.bodies[name] = RigidBody(half * float(model.rod.area(0.0)), half * model.rod.second_moments(0.0),
                                       position=position, rotation=rotation)
         self.pinned_bases[rod] = name

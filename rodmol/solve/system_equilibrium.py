@@ -8,7 +8,7 @@ orientation, Q = Q_init exp(theta). Equations: each rod's rest equations with
 its base clamped where the body's pose puts the clamp and its penalty joints'
 held points where the bodies (or partner rods) put them, then each free body's
 balance of forces and moments about its origin (body frame): the rods' clamp
-wrenches (:meth:`Assembly.body_wrench`), the penalty joints' reactions and its
+wrenches (:meth:`Assembly.body_wrench`), the penalty joints' and body joints' reactions and its
 weight less buoyancy with the base segments it carries, read from the same
 Newton-Euler rates the dynamics integrate (at v = w = 0 they are M^-1 times the
 wrench, so M times them is the wrench). The loads (gravity, tensions, load
@@ -172,6 +172,7 @@ class FreeRestEquations:
             force, moment = joint.wrench(y, self._body(joint.part), joint.row, joint.value)
             if joint.part.name in reactions:
                 reactions[joint.part.name] += np.concatenate([force, moment])
+        assembly.add_body_joints(self.t, y, reactions)  # the free bodies' velocities in y are zero
         out = np.empty(self.size)
         for name, eq in self.rods.items():  # held=1: a joint's gap is where the bodies are, not a load
             out[self.slices[name]] = eq.residual(z[self.slices[name]], lam, held=1.0)
@@ -204,6 +205,7 @@ def floating(system):
     edges += [(rod, "world") for rod in system.rods if rod not in system.clamps]
     for joint in system.penalty_joints:
         edges.append((joint.rod, joint.partner if joint.partner is not None else joint.body or "world"))
+    edges += [(joint.a, joint.b or "world") for joint in system.body_joints]
     held = {"world"} | {name for name, body in system.bodies.items() if not body.free}
     grown = True
     while grown:
