@@ -1,0 +1,91 @@
+"""The compiled joint between two bodies (rodmol.discretise.body_joints):
+the Hold law between two body points, equal and opposite, and its default
+law; a pinned base needs a scheme that leaves its base segment to it."""
+
+import numpy as np
+import pytest
+
+import rodmol
+from rodmol.discretise.assembly import Assembly
+from rodmol.discretise.body_joints import joint_frequency, pair_wrench, point_masses
+from rodmol.discretise.rotations import from_matrix, from_rotation_vector, matrices
+from rodmol.loads import KERNELS, N_PARAMS, P_DAMPING, P_STIFFNESS, P_TURN_DAMPING, P_TURN_STIFFNESS
+
+
+def _state(rng):
+    """A body state (x, Q, v, w) with a random pose and motion."""
+    quat = from_rotation_vector(rng.standard_normal(3))
+    return np.concatenate([rng.standard_normal(3), quat, rng.standard_normal(3), rng.standard_normal(3)])
+
+
+def _law(k=2e3, c=3.0, k_r=5.0, c_r=0.1):
+    row = np.zeros(N_PARAMS)
+    row[[P_STIFFNESS, P_DAMPING, P_TURN_STIFFNESS, P_TURN_DAMPING]] = k, c, k_r, c_r
+    return row
+
+
+@pytest.mark.parametrize("kind", ["pin", "clamp"])
+def test_the_two_bodies_feel_equal_and_opposite_wrenches_that_keep_momentum_and_angular_momentum(kind):
+    rng = np.random.default_rng(3)
+    a, b = _state(rng), _state(rng)
+    point_a, point_b = rng.standard_normal(3), rng.standard_normal(3)
+    turn_a, turn_b = from_rotation_vector(rng.standard_normal(3)), from_rotation_vector(rng.standard_normal(3))
+    (f_a, m_a), (f_b, m_b) = pair_wrench(KERNELS[kind].code, _law(), np.zeros(3), a, point_a, turn_a, b,
+                                         point_b, turn_b)
+    r_a, r_b = matrices(a[3:7]), matrices(b[3:7])
+    force_a, force_b = r_a @ np.asarray(f_a), r_b @ np.asarray(f_b)
+    np.testing.assert_allclose(force_a + force_b, 0.0, atol=1e-12 * np.linalg.norm(force_a))
+    # Moments about the global origin: each body's about its origin plus its origin's arm.
+    moment_a = r_a @ np.asarray(m_a) + np.cross(a[:3], force_a)
+    moment_b = r_b @ np.asarray(m_b) + np.cross(b[:3], force_b)
+    np.testing.assert_allclose(moment_a + moment_b, 0.0, atol=1e-12 * np.linalg.norm(moment_a))
+    # The force is the law's: stiffness times the gap between the points, plus damping of their
+    # relative velocity (global).
+    u_a, u_b = a[:3] + r_a @ point_a, b[:3] + r_b @ point_b
+    v_a = r_a @ (a[7:10] + np.cross(a[10:], point_a))
+    v_b = r_b @ (b[7:10] + np.cross(b[10:], point_b))
+    np.testing.assert_allclose(force_a, -2e3 * (u_a - u_b) - 3.0 * (v_a - v_b), rtol=1e-12)
+    if kind == "pin":  # a ball joint: no moment about the joint point
+        np.testing.assert_allclose(r_a @ np.asarray(m_a), np.cross(u_a - a[:3], force_a), atol=1e-12)
+
+
+def test_bodies_whose_joint_frames_meet_feel_nothing():
+    rng = np.random.default_rng(5)
+    a = _state(rng)
+    a[7:] = 0.0
+    r_a = matrices(a[3:7])
+    point_a, turn_a = np.array([0.1, -0.2, 0.3]), from_rotation_vector([0.2, 0.1, -0.3])
+    b = np.concatenate([a[:3] + r_a @ point_a, from_matrix(r_a @ matrices(turn_a)), np.zeros(6)])
+    (f_a, m_a), (f_b, m_b) = pair_wrench(KERNELS["clamp"].code, _law(), np.zeros(3), a, point_a, turn_a, b,
+                                         np.zeros(3), np.array([1.0, 0.0, 0.0, 0.0]))
+    np.testing.assert_allclose(np.r_[f_a, m_a, f_b, m_b], 0.0, atol=1e-9)
+
+
+def _arm(n=4):
+    material = rodmol.Material(E=2e5, nu=0.5, mu=100.0, rho=1100.0)
+    return rodmol.Model(rodmol.Rod(0.2, radius=0.01, material=material), n)
+
+
+def test_the_default_law_puts_the_reduced_mass_on_a_rod_nodes_hold_frequency():
+    heavy = rodmol.RigidBody(2.0, (1e-3, 2e-3, 3e-3), centre_of_mass=(0.05, 0.0, 0.0))
+    light = rodmol.RigidBody(0.5, (1e-4, 1e-4, 1e-4), position=(0.1, 0.0, 0.0))
+    system = rodmol.System({"arm": _arm()}, {"heavy": heavy, "light": light},
+                           [rodmol.Joint(("heavy", (0.1, 0.0, 0.0)), ("light", (0.0, 0.0, 0.0)))])
+    (joint,) = Assembly(system).body_joints
+    omega2 = 100.0 * 2e5 / (1100.0 * 0.05**2)  # HOLD_STIFFNESS_FACTOR E / (rho ds^2)
+    assert joint_frequency([_arm()]) ** 2 == pytest.approx(omega2, rel=1e-12)
+    m_heavy, i_heavy = point_masses(heavy.mass_matrix, (0.1, 0.0, 0.0))
+    assert m_heavy == pytest.approx(2.0) and i_heavy == pytest.approx(2e-3 + 2.0 * 0.05**2 * 2 / 3)
+    mass, inertia = 1.0 / (1.0 / 2.0 + 1.0 / 0.5), 1.0 / (1.0 / i_heavy + 1.0 / 1e-4)
+    k, c, k_r, c_r = joint.row[[P_STIFFNESS, P_DAMPING, P_TURN_STIFFNESS, P_TURN_DAMPING]]
+    assert k == pytest.approx(mass * omega2, rel=1e-12) and c == pytest.approx(2.0 * np.sqrt(k * mass))
+    assert k_r == pytest.approx(inertia * omega2, rel=1e-12) and c_r == pytest.approx(2.0 * np.sqrt(k_r * inertia))
+
+
+def test_a_pinned_base_carries_its_rods_base_segment_and_needs_the_centred_scheme():
+    system = rodmol.System({"arm": _arm()}, joints=[rodmol.Joint(("arm", "base"), "world", "pin")])
+    part = Assembly(system).bodies["arm.base"]
+    segment = 1100.0 * np.pi * 0.01**2 * 0.05 / 2  # rho A ds / 2, the base node's half cell
+    np.testing.assert_allclose(np.diag(part.mass_matrix)[:3], segment, rtol=1e-12)
+    with pytest.raises(rodmol.NotSupportedYet, match="centred"):
+        Assembly(system, "upwind")
