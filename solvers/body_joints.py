@@ -50,10 +50,10 @@ def _turn(angle):
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
-def _scaled(build, factor):
-    """The system ``build(stiffness)`` with its body joints at ``factor`` times their default stiffness."""
-    defaults = [j.row[P_STIFFNESS] for j in Assembly(build([None, None])).body_joints]
-    return build([factor * k for k in defaults])
+def _scaled(build, factor, n=None):
+    """The system ``build(stiffness, n)`` with its body joints at ``factor`` times their default stiffness."""
+    defaults = [j.row[P_STIFFNESS] for j in Assembly(build([None, None], n)).body_joints]
+    return build([factor * k for k in defaults], n)
 
 
 def pendulum(stiffness, n=None):
@@ -89,7 +89,7 @@ def beam(stiffness, n, base="pin"):
 
 
 PROBLEMS = {  # name: (build(stiffness, n), reference(n), t_end per mode, N per mode, the drift's length)
-    "pendulum": (pendulum, lambda n: _scaled(pendulum, 1.0), (1.5, 0.75, 0.05), (0, 0, 0), ARM),
+    "pendulum": (pendulum, lambda n: _scaled(pendulum, 1.0, n), (1.5, 0.75, 0.05), (0, 0, 0), ARM),
     "two bodies": (pair, one_body, (1.0, 0.5, 0.05), (0, 0, 0), ARM),
     "simply supported": (beam, lambda n: beam(None, n, "clamp"), (0.3, 0.3, 0.02), (16, 16, 4), 1.0),
 }
@@ -125,11 +125,11 @@ def main(argv=None):
     rows = []
     for name, (build, reference, t_ends, sizes, length) in PROBLEMS.items():
         t_end, n = C.pick(args, *t_ends), C.pick(args, *sizes)
-        rodmol.simulate(_scaled(lambda k: build(k, n), 1.0), t_end / 10)  # compile, warm
+        rodmol.simulate(_scaled(build, 1.0, n), t_end / 10)  # compile, warm
         for solver in ("gmres", "sparse"):
             run_ref, wall_ref = timed(reference(n), t_end, args.reps, linsolver=solver)
             for factor in factors:
-                system = _scaled(lambda k: build(k, n), factor)
+                system = _scaled(build, factor, n)
                 run, wall = timed(system, t_end, args.reps, linsolver=solver)
                 gap = drift(run, system) / length
                 rows.append(dict(

@@ -9,15 +9,14 @@ moment M act on a, -F and -M on b, the force at a's point on both (equal
 and opposite with one line of action: momentum and angular momentum are
 kept). The damping acts on a's velocities relative to b's point.
 
-Default law: the joint's reduced mass m (1/m = 1/m_a + 1/m_b, a body's mass
-at the joint point; a fixed or driven body or the world counts as
-infinite) and reduced rotational inertia I about the point (likewise) on a
-spring of the frequency omega of a rod node on its default Hold, the
-system's fastest (``HOLD_STIFFNESS_FACTOR`` E A / ds on rho A ds:
-omega^2 = HOLD_STIFFNESS_FACTOR E / (rho ds^2)): stiffness m omega^2,
-turning stiffness I omega^2, both dampings critical. The joint's mode is
-then no faster than the rods' held nodes', and its drift is the joint's
-load over m omega^2 (docs/systems.md, "Joints of bodies").
+Default law (:func:`joint_law`): the joint's fastest modes at about the
+frequency omega of a rod node on its default Hold, the system's fastest
+(``HOLD_STIFFNESS_FACTOR`` E A / ds on rho A ds: omega^2 =
+HOLD_STIFFNESS_FACTOR E / (rho ds^2)), so no faster than the rods' held
+nodes, and every mode of the joint at least critically damped; a fixed or
+driven body or the world counts as infinitely heavy. Its drift is the
+joint's load over a stiffness of the order of the reduced mass times
+omega^2 (docs/systems.md, "Joints of bodies").
 """
 
 import numpy as np
@@ -36,32 +35,43 @@ def joint_frequency(models):
     return max(np.sqrt(HOLD_STIFFNESS_FACTOR * m.rod.material.E / m.rod.material.rho) / m.ds for m in models)
 
 
-def point_masses(mass_matrix, point):
-    """(mass [kg], rotational inertia [kg m^2]) of a body at ``point`` [m]
-    (body frame): the means of the diagonals of its 6x6 ``mass_matrix``
-    (about the origin) moved to the point."""
+def mobility(part, point, turn=None):
+    """The 6x6 inverse mass matrix [1/kg, 1/(kg m^2)] of body ``part`` at
+    ``point`` [m] (body frame), for the velocities (v_p, w) of the point in
+    the frame ``turn`` maps the body frame to: zero for a fixed or driven body."""
+    if part is None or not part.body.free:
+        return np.zeros((6, 6))
     shift = np.eye(6)
     px, py, pz = point
     shift[:3, 3:] = [[0.0, -pz, py], [pz, 0.0, -px], [-py, px, 0.0]]  # origin velocity v_p + p x w
-    moved = shift.T @ mass_matrix @ shift
-    return np.trace(moved[:3, :3]) / 3.0, np.trace(moved[3:, 3:]) / 3.0
+    frame = np.kron(np.eye(2), np.eye(3) if turn is None else turn)
+    return frame @ np.linalg.inv(shift.T @ part.mass_matrix @ shift) @ frame.T
 
 
 def joint_law(joint, parts, omega):
     """(stiffness [N/m], damping [N s/m], turning stiffness [N m], turning
     damping [N m s]) of ``joint`` between the body parts ``parts`` (a, b; b
     None for the world): the joint's own values, else the defaults (module
-    docstring); the turning law is the translational one times I / m."""
-    inverse_mass, inverse_inertia = 0.0, 0.0
-    for part, point in zip(parts, (joint.point_a, joint.point_b)):
-        if part is not None and part.body.free:
-            m, i = point_masses(part.mass_matrix, point)
-            inverse_mass, inverse_inertia = inverse_mass + 1.0 / m, inverse_inertia + 1.0 / i
-    mass, inertia = 1.0 / inverse_mass, 1.0 / inverse_inertia
-    k = mass * omega**2 if joint.stiffness is None else joint.stiffness
-    c = 2.0 * np.sqrt(k * mass) if joint.damping is None else joint.damping
-    arm2 = inertia / mass
-    return k, c, k * arm2, c * arm2
+    docstring). G, the sum of the two bodies' mobilities at the joint (a's
+    body frame, the poses at rest), makes the modes of the relative motion
+    those of K^1/2 G K^1/2, K = diag(k, k, k, k_r, k_r, k_r) (a pin: its
+    first block): k = omega^2 over G's largest translational eigenvalue,
+    k_r = omega^2 over its largest rotational one (the fastest modes at about
+    omega), and the damping proportional to K, C = 2 K / omega_min with
+    omega_min^2 the smallest mode's: every mode at least critically damped,
+    which BDF needs at long steps (its order 5 is stable there for modes
+    damped more than 0.62 of critical only, order 4 more than 0.29)."""
+    a, b = parts
+    turn = np.eye(3) if b is None else a.body.rotation.T @ b.body.rotation
+    g = mobility(a, joint.point_a) + mobility(b, joint.point_b, turn)
+    clamp = joint.kind == "clamp"
+    k = omega**2 / np.linalg.eigvalsh(g[:3, :3])[-1] if joint.stiffness is None else joint.stiffness
+    k_r = k * np.linalg.eigvalsh(g[:3, :3])[-1] / np.linalg.eigvalsh(g[3:, 3:])[-1] if clamp else 0.0
+    size = 6 if clamp else 3
+    root = np.sqrt(np.r_[k, k, k, k_r, k_r, k_r][:size])
+    slowest = np.sqrt(np.linalg.eigvalsh(root[:, None] * g[:size, :size] * root[None, :])[0])
+    beta = 2.0 / slowest if joint.damping is None else joint.damping / k
+    return k, beta * k, k_r, beta * k_r
 
 
 @jit

@@ -7,7 +7,7 @@ import pytest
 
 import rodmol
 from rodmol.discretise.assembly import Assembly
-from rodmol.discretise.body_joints import joint_frequency, pair_wrench, point_masses
+from rodmol.discretise.body_joints import joint_frequency, pair_wrench
 from rodmol.discretise.rotations import from_matrix, from_rotation_vector, matrices
 from rodmol.loads import KERNELS, N_PARAMS, P_DAMPING, P_STIFFNESS, P_TURN_DAMPING, P_TURN_STIFFNESS
 
@@ -61,25 +61,48 @@ def test_bodies_whose_joint_frames_meet_feel_nothing():
     np.testing.assert_allclose(np.r_[f_a, m_a, f_b, m_b], 0.0, atol=1e-9)
 
 
+_turn = matrices(from_rotation_vector([0.3, -0.2, 0.5]))
+
+
 def _arm(n=4):
     material = rodmol.Material(E=2e5, nu=0.5, mu=100.0, rho=1100.0)
     return rodmol.Model(rodmol.Rod(0.2, radius=0.01, material=material), n)
 
 
-def test_the_default_law_puts_the_reduced_mass_on_a_rod_nodes_hold_frequency():
+def test_the_default_law_puts_the_fastest_joint_mode_at_a_held_rod_nodes_frequency_and_damps_every_mode():
     heavy = rodmol.RigidBody(2.0, (1e-3, 2e-3, 3e-3), centre_of_mass=(0.05, 0.0, 0.0))
-    light = rodmol.RigidBody(0.5, (1e-4, 1e-4, 1e-4), position=(0.1, 0.0, 0.0))
-    system = rodmol.System({"arm": _arm()}, {"heavy": heavy, "light": light},
-                           [rodmol.Joint(("heavy", (0.1, 0.0, 0.0)), ("light", (0.0, 0.0, 0.0)))])
-    (joint,) = Assembly(system).body_joints
+    light = rodmol.RigidBody(0.5, (1e-4, 1e-4, 2e-4), position=(0.1, 0.0, 0.0), rotation=_turn)
     omega2 = 100.0 * 2e5 / (1100.0 * 0.05**2)  # HOLD_STIFFNESS_FACTOR E / (rho ds^2)
     assert joint_frequency([_arm()]) ** 2 == pytest.approx(omega2, rel=1e-12)
-    m_heavy, i_heavy = point_masses(heavy.mass_matrix, (0.1, 0.0, 0.0))
-    assert m_heavy == pytest.approx(2.0) and i_heavy == pytest.approx(2e-3 + 2.0 * 0.05**2 * 2 / 3)
-    mass, inertia = 1.0 / (1.0 / 2.0 + 1.0 / 0.5), 1.0 / (1.0 / i_heavy + 1.0 / 1e-4)
-    k, c, k_r, c_r = joint.row[[P_STIFFNESS, P_DAMPING, P_TURN_STIFFNESS, P_TURN_DAMPING]]
-    assert k == pytest.approx(mass * omega2, rel=1e-12) and c == pytest.approx(2.0 * np.sqrt(k * mass))
-    assert k_r == pytest.approx(inertia * omega2, rel=1e-12) and c_r == pytest.approx(2.0 * np.sqrt(k_r * inertia))
+    for kind, size in (("clamp", 6), ("pin", 3)):
+        system = rodmol.System({"arm": _arm()}, {"heavy": heavy, "light": light},
+                               [rodmol.Joint(("heavy", (0.1, 0.0, 0.0)), ("light", (0.0, 0.0, 0.0)), kind)])
+        assembly = Assembly(system)
+        (joint,) = assembly.body_joints
+        k, c, k_r, c_r = joint.row[[P_STIFFNESS, P_DAMPING, P_TURN_STIFFNESS, P_TURN_DAMPING]]
+        # Independently: the relative motion's mass matrix at the joint, both bodies in the global frame.
+        mass = np.zeros((6, 6))
+        for part, point in ((assembly.bodies["heavy"], (0.1, 0.0, 0.0)), (assembly.bodies["light"], (0.0, 0.0, 0.0))):
+            r = part.body.rotation
+            arm = r @ np.asarray(point)
+            shift = np.eye(6)
+            shift[:3, 3:] = np.array([[0.0, -arm[2], arm[1]], [arm[2], 0.0, -arm[0]], [-arm[1], arm[0], 0.0]])  # v_o = v_p + arm x w
+            frame = np.kron(np.eye(2), r)
+            about_point = shift.T @ frame @ part.mass_matrix @ frame.T @ shift  # (v, w) of the point, global
+            mass += np.linalg.inv(about_point)
+        mass = np.linalg.inv(mass[:size, :size]) if size == 3 else np.linalg.inv(mass)
+        stiffness = np.diag([k] * 3 + [k_r] * 3)[:size, :size]
+        damping = np.diag([c] * 3 + [c_r] * 3)[:size, :size]
+        # The modes of M x'' + C x' + K x = 0: the fastest at omega (the translation's or the turning's
+        # block alone), every one damped at least critically (real eigenvalues), the slowest critically.
+        system_matrix = np.block([[np.zeros((size, size)), np.eye(size)],
+                                  [-np.linalg.solve(mass, stiffness), -np.linalg.solve(mass, damping)]])
+        rates = np.linalg.eigvals(system_matrix)
+        assert np.max(np.abs(rates.imag)) < 1e-4 * np.max(np.abs(rates))
+        frequencies = np.sqrt(np.linalg.eigvals(np.linalg.solve(mass, stiffness)).real)
+        assert 0.99 < np.max(frequencies) / np.sqrt(omega2) < 2.0
+        assert c / k == pytest.approx(2.0 / np.min(frequencies), rel=1e-6)
+        assert (k_r == 0.0) == (kind == "pin")
 
 
 def test_a_pinned_base_carries_its_rods_base_segment_and_needs_the_centred_scheme():
