@@ -71,10 +71,12 @@ class Joint:
     stiffness, damping : float, optional
         Of a penalty joint (any node but the base): as for
         :class:`rodmol.Hold` [N/m, N s/m], whose law and defaults it takes.
-        Of a joint between bodies (or a pinned base) the default stiffness
-        is the joint's reduced mass times the squared frequency of a rod
-        node on its default Hold (the system's stiffest rod), the damping
-        critical (docs/systems.md, "Joints of bodies").
+        Of a joint between bodies (or a pinned base) the defaults put the
+        joint's fastest mode at the frequency of a rod node on its default
+        Hold (the system's fastest) and damp every mode of the joint at
+        least critically (:func:`rodmol.discretise.body_joints.joint_law`;
+        docs/systems.md, "Joints of bodies"); a given stiffness [N/m] is the
+        translational one, the turning one scaled with it.
     """
 
     a: object

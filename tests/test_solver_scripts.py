@@ -198,6 +198,12 @@ def _loops(out):
     assert all(row["max_drift_over_L"] < 1e-4 for row in sparse), sparse  # the default factor or stiffer
 
 
+def _body_joints(out):
+    table = rows(out / "body_joints.csv")
+    assert table and all(row["success"] for row in table if row["factor"] == 1.0), table
+    assert all(row["max_drift_over_L"] < 1e-3 for row in table if row["factor"] == 1.0), table
+
+
 SCRIPTS = {
     "scaling.py": (["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"], _scaling),
     "temporal.py": (["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv", "temporal_options.csv"],
@@ -223,6 +229,7 @@ SCRIPTS = {
     "rest_strains_speed.py": (["rest_strains_speed.csv", "rest_strains_speed.md"], _rest_strains_speed),
     "holds.py": (["holds.csv", "holds.md"], _holds),
     "loops.py": (["loops.csv", "loops.md"], _loops),
+    "body_joints.py": (["body_joints.csv", "body_joints.md"], _body_joints),
 }
 
 
