@@ -31,6 +31,12 @@ forces (and clamp moments) are equal and opposite, acting at the two nodes
 (the couple of the pair, gap x F, is O(F^2 / k)). :mod:`rodmol.discretise.joints`
 holds the joints' parts.
 
+Coupling (joints of bodies): two bodies, or a body and the world, joined at
+a point of each by the same hold law between the two points, equal and
+opposite on the two bodies (:mod:`rodmol.discretise.body_joints`,
+:meth:`Assembly.add_body_joints`). A pinned rod base is clamped to a free
+body that is its base segment alone (``BodyPart.segment_only``), pinned so.
+
 What a free body carries: the rods' velocity nodes stand for their
 ``node_lengths``, which leave out the length next to the base node (ds/2
 in the centred scheme, none upwind); on a body that piece, the rod's base
