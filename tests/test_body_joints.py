@@ -175,3 +175,17 @@ def test_the_equilibrium_of_a_pinned_clamped_beam_is_its_settled_run():
     assert abs(tip) < 1e-2 * abs(base)  # clamped: 7.6e-3 of the base's at N = 8
     np.testing.assert_allclose(nodes[:, 1], nodes_run[:, 1], atol=1e-4 * np.max(np.abs(nodes[:, 1])))
     assert abs(base_run / base - 1.0) < 1e-4
+
+
+def test_the_fixed_step_and_explicit_backends_swing_the_pendulum_as_cvode():
+    pendulum = rodmol.RigidBody(PEND_M, (PEND_IC,) * 3, centre_of_mass=(0.0, -PEND_D, 0.0), rotation=_turn_z(0.3))
+    system = rodmol.System({"far": _far_rod()}, {"pendulum": pendulum},
+                           [rodmol.Joint(("pendulum", (0.0, 0.0, 0.0)), "world", kind="pin")])
+    # 0.02 s: RK23's steps are bounded by the rods' and the joint's fastest modes (1.6e4 steps for 0.1 s).
+    runs = {backend: rodmol.simulate(system, 0.02, output_dt=0.01, backend=backend, **options)
+            for backend, options in (("cvode", dict(rtol=1e-8)), ("galpha", dict(dt=5e-4)), ("rk23", {}))}
+    assert all(run.success for run in runs.values())
+    angles = {backend: _angle_z(run["pendulum"].rotation) for backend, run in runs.items()}
+    assert angles["cvode"][-1] < 0.3 - 3e-3  # it swings down (by 4e-3 rad)
+    np.testing.assert_allclose(angles["rk23"], angles["cvode"], atol=1e-6)
+    np.testing.assert_allclose(angles["galpha"], angles["cvode"], atol=1e-6)

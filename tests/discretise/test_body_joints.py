@@ -6,9 +6,11 @@ import numpy as np
 import pytest
 
 import rodmol
+from rodmol._differences import central_columns
 from rodmol.discretise.assembly import Assembly
 from rodmol.discretise.body_joints import joint_frequency, pair_wrench
 from rodmol.discretise.rotations import from_matrix, from_rotation_vector, matrices
+from rodmol.discretise.system_preconditioner import SystemPreconditioner
 from rodmol.loads import KERNELS, N_PARAMS, P_DAMPING, P_STIFFNESS, P_TURN_DAMPING, P_TURN_STIFFNESS
 
 
@@ -112,3 +114,65 @@ def test_a_pinned_base_carries_its_rods_base_segment_and_needs_the_centred_schem
     np.testing.assert_allclose(np.diag(part.mass_matrix)[:3], segment, rtol=1e-12)
     with pytest.raises(rodmol.NotSupportedYet, match="centred"):
         Assembly(system, "upwind")
+
+
+def _joined_bodies():
+    """A rod pinned at its base to the world, its tip clamped to a free bar; the bar pinned to a free
+    weight, the weight clamped to a fixed post; a free ball clamped to the world."""
+    rod = _arm().replace(gravity=(0.0, -9.81, 0.0))
+    bar = rodmol.RigidBody(0.02, (1e-5, 2e-5, 3e-5), position=(0.2, 0.0, 0.0), centre_of_mass=(0.0, 0.01, 0.0))
+    weight = rodmol.RigidBody(0.05, (2e-5, 2e-5, 2e-5), position=(0.2, 0.05, 0.0), rotation=_turn)
+    post = rodmol.RigidBody(1.0, (1e-3, 1e-3, 1e-3), motion="fixed", position=(0.2, 0.1, 0.0))
+    ball = rodmol.RigidBody(0.01, (1e-6, 1e-6, 1e-6), position=(0.0, 0.3, 0.0), centre_of_mass=(0.0, -0.01, 0.0))
+    joints = [rodmol.Joint("world", ("arm", "base"), "pin"),
+              rodmol.Joint(("bar", (0.0, 0.0, 0.0)), ("arm", "tip")),
+              rodmol.Joint(("bar", (0.0, 0.05, 0.0)), ("weight", (0.0, 0.0, 0.0)), "pin"),
+              rodmol.Joint(("weight", _turn.T @ (0.0, 0.05, 0.0)), ("post", (0.0, 0.0, 0.0))),
+              rodmol.Joint(("ball", (0.0, 0.0, 0.0)), "world")]
+    return Assembly(rodmol.System({"arm": rod}, {"bar": bar, "weight": weight, "post": post, "ball": ball},
+                                  joints, gravity=(0.0, -9.81, 0.0)))
+
+
+def test_the_pattern_holds_every_nonzero_the_body_joints_make():
+    assembly = _joined_bodies()
+    scale = assembly.atol_scale()
+    y = assembly.initial_state() + 1e-2 * np.random.default_rng(3).standard_normal(assembly.size) * scale
+    f0 = assembly(0.0, y).copy()
+    pattern = assembly.pattern().toarray()
+    touched = np.zeros_like(pattern)
+    for j in range(assembly.size):
+        z = y.copy()
+        z[j] += 1e-6 * scale[j]
+        touched[:, j] = assembly(0.0, z) != f0
+    assert not np.argwhere(touched & ~pattern).size
+    bar, weight, ball = (assembly.bodies[name].slice for name in ("bar", "weight", "ball"))
+    assert touched[weight, bar].any() and touched[bar, weight].any()  # the pin between two free bodies
+    assert touched[ball, ball][7:, :3].any()  # the ball's clamp to the world reads its position
+
+
+def test_the_schur_preconditioner_inverts_the_newton_matrix_with_body_joints_and_a_pinned_base():
+    # Every coupling of the free bodies is kept (the joints between them, the pinned base's body with its
+    # rod's first cell, the bar with its rod joint): the preconditioner is the Newton matrix itself, to
+    # the error of its forward differences; without the bodies' couplings it is far off.
+    assembly = _joined_bodies()
+    scale = assembly.atol_scale()
+    y = assembly.initial_state() + 1e-2 * np.random.default_rng(5).standard_normal(assembly.size) * scale
+    fy = assembly(0.0, y).copy()
+    jac = central_columns(lambda z: assembly(0.0, z).copy(), y, range(assembly.size), 1e-7 * scale)
+    gamma = 1e-4
+    newton = np.eye(assembly.size) - gamma * jac
+    precond = SystemPreconditioner(assembly, scale)
+    precond.setup(0.0, y, fy, False, [0], gamma)
+    assert [p.name for p in precond.coupled] == ["bar", "weight", "arm.base"]
+    v = np.random.default_rng(6).standard_normal(assembly.size) * scale
+    # The fixed post's pose has no correction (its rates read nothing else and are zero at its pose), so
+    # the weight's rows against it, left out of the weight's block, never act.
+    v[assembly.bodies["post"].slice] = 0.0
+    r, z = newton @ v, np.empty_like(v)
+    precond.solve(0.0, y, fy, r, z, gamma, 0.0, 1)
+    error = np.abs((z - v) / scale).max()
+    assert error < 2e-4
+    apart = np.concatenate([precond.rods["arm"].apply(r[assembly.parts["arm"]]),
+                            *[np.linalg.solve(np.eye(p.layout.size) - gamma * precond._jac[p.name], r[p.slice])
+                              for p in assembly.bodies.values()]])
+    assert np.abs((apart - v) / scale).max() > 100 * error
