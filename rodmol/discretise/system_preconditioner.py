@@ -51,7 +51,7 @@ class Coupling:
     the blocks by differences, ``rod_to_body`` (N_rb / -gamma, rows x body)
     and ``body_to_rod`` (N_br / -gamma, body x columns). ``full``: the
     body's rates read the columns through the rod's rates (a clamp: cell
-    0's stress), so their differences take the whole right-hand side."""
+    0's stress), so their differences take the rod's rates first."""
 
     rod: str
     rows: np.ndarray
@@ -150,13 +150,13 @@ class SystemPreconditioner:
         """The body's rows against each coupling's columns (N_br / -gamma), by differences of its rates."""
         assembly = self.assembly
         for c in self._couplings[part.name]:
+            rod = assembly.parts[c.rod]
             for k, index in enumerate(c.columns):
                 step = BODY_STEP * max(self._scale[index], 1e-300)
                 z[index] = y[index] + step
-                if c.full:
-                    assembly(t, z, self._out)
-                else:
-                    assembly.body_rates(part, t, z, self._out)
+                if c.full:  # the rod's rates (its cell 0's stress), its base velocities as at y
+                    assembly.rods[c.rod](t, z[rod], self._out[rod])
+                assembly.body_rates(part, t, z, self._out)
                 c.body_to_rod[:, k] = (self._out[part.slice] - fy[part.slice]) / step
                 z[index] = y[index]
         assembly(t, y, self._out)
