@@ -29,6 +29,7 @@ from ..discretise.joints import RodJointPart
 from ..discretise.rigid import NET_MASS, free_body_rates
 from ..discretise.system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE
 from ..errors import EquilibriumError
+from ..loads import P_STIFFNESS
 from .rest_equations import STATIC_FIELDS, RestEquations, continuation
 from .watch import state_problem
 
@@ -128,10 +129,18 @@ class FreeRestEquations:
         return z
 
     def tolerance(self, tol):
-        """Per-row tolerances: the rods' own (:meth:`RestEquations.tolerance`), ``tol`` for the bodies."""
+        """Per-row tolerances: the rods' own (:meth:`RestEquations.tolerance`); for a
+        body, ``tol`` raised to the round-off floor of the forces its balance sums,
+        as a rod's rows are: its rods' cell 0 stresses (of size E A) and its joints'
+        penalties on positions of size L (k L)."""
         out = np.full(self.size, float(tol))
         for name, eq in self.rods.items():
             out[self.slices[name]] = eq.tolerance(tol)
+        for part in self.assembly.free:
+            forces = [np.max(sd.sampled.kl[0]) for sd in part.systems]
+            forces += [joint.row[P_STIFFNESS] * self.length for joint in part.joints + part.body_joints]
+            floor = 10 * np.finfo(float).eps * max(forces, default=0.0) / self.scale
+            out[self.slices[part.name]] = max(float(tol), floor)
         return out
 
     def _place(self, z):
