@@ -12,11 +12,17 @@ Two methods hold the joints:
   Such joints may close loops (several rods between the ground and one
   platform, a rod held at both ends).
 
-Joints between two bodies (or a body and the world), a pinned base and a
-base joined to a rod raise :class:`rodmol.errors.NotSupportedYet`.
-"""
+* a joint between two bodies, or a body and the world, clamp or pin at a
+  point of each body, is the same penalty law between the two points (one
+  body's joint frame held by the other's), equal and opposite on the two
+  bodies (:class:`BodyJoint`);
+* a rod's base *pinned* to the world or to a body is a small free body of
+  its own, the rod's base segment (the half cell the velocity nodes leave
+  out), its base clamped to it (eliminated) and the body pinned by a body
+  joint (:attr:`System.pinned_bases`).
 
-from dataclasses import dataclass
+A base joined to a rod raises :class:`rodmol.errors.NotSupportedYet`.
+"""
 
 import numpy as np
 
@@ -27,96 +33,9 @@ from .errors import NotSupportedYet, ParameterError
 from .holds import Hold
 from .model import Model
 from .parameters import Medium
+from .system_joints import BodyJoint, Joint, PenaltyJoint
 
-#: Joint kinds: "clamp" holds the position and the orientation, "pin" the position only (a ball joint).
-JOINT_KINDS = ("clamp", "pin")
-#: Named ends of a rod a joint may hold (else an arc length s [m], a velocity node).
-ROD_ENDS = ("base", "tip")
-
-
-@dataclass(frozen=True)
-class Joint:
-    """A joint between two ends.
-
-    Parameters
-    ----------
-    a, b : end
-        Each ``"world"``, ``(body_name, point)`` or ``(body_name, point,
-        rotation)``, a point [m] of a body in its body frame and the rotation
-        (joint frame to body frame), or ``(rod_name, "base")``,
-        ``(rod_name, "tip")`` or ``(rod_name, s)``, s [m] a velocity node
-        of the rod's grid. A clamp of a rod's base to a body point makes the
-        rod's base frame the joint frame (default rotation: identity): the
-        rod leaves the body along the joint frame's x axis. At any other
-        node the rotation, if given, is the section's held orientation in
-        the body frame (default: the section's orientation at rest). Two
-        rods' tips or nodes s may be joined (the relative orientation of
-        their sections at rest is held by a clamp).
-    kind : str
-        ``"clamp"`` (all six relative motions fixed) or ``"pin"`` (the
-        positions only: a ball joint; not at a rod's base).
-    stiffness, damping : float, optional
-        Of a penalty joint (any node but the base): as for
-        :class:`rodmol.Hold` [N/m, N s/m], whose law and defaults it takes.
-    """
-
-    a: object
-    b: object
-    kind: str = "clamp"
-    stiffness: float | None = None
-    damping: float | None = None
-
-    def __post_init__(self):
-        _checks.choice("kind", self.kind, JOINT_KINDS)
-        object.__setattr__(self, "a", _end("a", self.a))
-        object.__setattr__(self, "b", _end("b", self.b))
-        for name, unit in (("stiffness", " N/m"), ("damping", " N s/m")):
-            value = getattr(self, name)
-            if value is not None:
-                check = _checks.positive if name == "stiffness" else _checks.non_negative
-                object.__setattr__(self, name, check(name, value, unit))
-
-
-def _end(name, value):
-    """A checked joint end: "world", ("rod", name, "base" | "tip" | s) or ("body", name, point, rotation or None)."""
-    if isinstance(value, str) and value == "world":
-        return value
-    if isinstance(value, tuple) and len(value) == 2 and isinstance(value[0], str):
-        where = value[1]
-        if isinstance(where, str):
-            if where not in ROD_ENDS:
-                raise ParameterError(f"joint end `{name}`: a rod's end must be one of {list(ROD_ENDS)} or an "
-                                     f"arc length s [m], got {where!r}")
-            return ("rod", value[0], where)
-        if np.ndim(where) == 0 and not isinstance(where, bool):
-            return ("rod", value[0], _checks.positive(f"{name}` arc length `s", where, " m"))
-    if isinstance(value, tuple) and len(value) in (2, 3) and isinstance(value[0], str):
-        point = _checks.vector3(f"{name}` point `", value[1])
-        rotation = _checks.rotation(f"joint end {name} rotation", value[2], tol=1e-9) if len(value) == 3 else None
-        return ("body", value[0], point, rotation)
-    raise ParameterError(f"joint end `{name}` must be 'world', (body_name, point[, rotation]) or "
-                         f"(rod_name, 'base' | 'tip' | s), got {_checks.short(value)}")
-
-
-@dataclass(frozen=True)
-class PenaltyJoint:
-    """A joint held by a penalty (:class:`rodmol.Hold`'s law): rod ``rod``'s
-    hold ``loads[load]`` (its Model's), held by the body ``body`` (None: the
-    world, or a rod) at ``point`` [m], body frame, with the section's
-    orientation ``rotation`` (section to body frame; None: as at rest), or
-    by the node of rod ``partner`` whose hold is its ``loads[partner_load]``
-    (each of the two rods holds the other's node: the pair is equal and opposite)."""
-
-    index: int
-    rod: str
-    load: int
-    body: str | None
-    point: np.ndarray | None
-    rotation: np.ndarray | None
-    kind: str
-    partner: str | None = None
-    partner_load: int | None = None
-
+__all__ = ["BodyJoint", "Joint", "PenaltyJoint", "System"]
 
 class System:
     """Named rods and rigid bodies joined by joints.
@@ -147,6 +66,13 @@ class System:
     penalty_joints : list of PenaltyJoint
         The joints at other nodes; each rod's Model in ``rods`` carries their
         holds (:class:`rodmol.Hold`, named ``"joints[i]"``) after its own loads.
+    body_joints : list of BodyJoint
+        The joints between bodies or a body and the world (with the pins of
+        the pinned bases).
+    pinned_bases : dict of str to str
+        The rods whose base is pinned, each to the name of its base body
+        (``"<rod>.base"``, in ``bodies``: a free body carrying the rod's base
+        segment only; its result is the base's pose).
     """
 
     def __init__(self, rods, bodies=None, joints=(), *, medium=None, gravity=(0.0, -9.81, 0.0)):
@@ -176,6 +102,7 @@ class System:
                      for name, m in rods.items()}
         self.bodies = dict(bodies)
         self.joints = _checks.items("joints", joints, Joint, "a rodmol.Joint")
+        self.body_joints, self.pinned_bases = [], {}
         self.clamps, self.penalty_joints = self._joints()
 
     def _joints(self):
@@ -196,22 +123,21 @@ class System:
             if len(rod_ends) == 2:
                 penalties += self._rod_to_rod(i, joint, rod_ends, holds)
                 continue
-            if len(rod_ends) != 1:
-                raise NotSupportedYet(f"`joints[{i}]` joins {_describe(ends[0])} and {_describe(ends[1])}: "
-                                      "only a rod to a body, to the world or to a rod is supported yet (not "
-                                      "body to body or body to world)")
+            if not rod_ends:
+                self.body_joints.append(self._body_joint(i, joint, *ends))
+                continue
             _, rod, where = rod_ends[0]
             other = ends[1] if ends[0] is rod_ends[0] else ends[0]
             if where == "base":
-                if joint.kind != "clamp":
-                    raise NotSupportedYet(f"`joints[{i}]` pins the base of rod {rod!r}: a rod's base can only "
-                                          "be clamped yet (pin any other node)")
-                if joint.stiffness is not None or joint.damping is not None:
-                    raise ParameterError(f"`joints[{i}]` clamps the base of rod {rod!r}: the clamp is eliminated "
-                                         "(exact), it takes no `stiffness` or `damping`")
                 if rod in clamps:
                     raise ParameterError(f"`joints[{i}]`: the base of rod {rod!r} is already jointed; hold a "
                                          "rod's other nodes by joints at its tip or at an arc length s")
+                if joint.kind == "pin":
+                    clamps[rod] = self._pinned_base(i, joint, rod, other)
+                    continue
+                if joint.stiffness is not None or joint.damping is not None:
+                    raise ParameterError(f"`joints[{i}]` clamps the base of rod {rod!r}: the clamp is eliminated "
+                                         "(exact), it takes no `stiffness` or `damping`")
                 clamps[rod] = self._clamp(i, rod, other)
                 continue
             model = self.rods[rod]
@@ -265,6 +191,70 @@ class System:
             raise ParameterError(f"rod {rod!r} is clamped to body {other[1]!r}, so its Model's `base` "
                                  f"must be the default (the body gives its pose and motion), got {base!r}")
         return (other[1], other[2], np.eye(3) if other[3] is None else other[3])
+
+    def _body_joint(self, i, joint, a, b):
+        """The :class:`BodyJoint` of ``joints[i]`` between the ends ``a``, ``b`` (bodies or the world)."""
+        if a == "world" and b == "world":
+            raise ParameterError(f"`joints[{i}]` joins the world to itself")
+        if a == "world":
+            a, b = b, a
+        name_a, point_a, turn_a = a[1], a[2], np.eye(3) if a[3] is None else a[3]
+        body_a = self.bodies[name_a]
+        at_rest = body_a.position + body_a.rotation @ point_a
+        frame = body_a.rotation @ turn_a
+        if b == "world":
+            free = body_a.free
+            name_b, point_b, turn_b = None, at_rest, frame
+        else:
+            name_b, point_b = b[1], b[2]
+            if name_b == name_a:
+                raise ParameterError(f"`joints[{i}]` joins body {name_a!r} to itself")
+            body_b = self.bodies[name_b]
+            free = body_a.free or body_b.free
+            turn_b = body_b.rotation.T @ frame if b[3] is None else b[3]
+            gap = float(np.linalg.norm(body_b.position + body_b.rotation @ point_b - at_rest))
+            if gap > 1e-9 * max(1.0, float(np.linalg.norm(at_rest))):
+                raise ParameterError(f"`joints[{i}]` joins body {name_a!r} at {tuple(point_a)} to body {name_b!r} "
+                                     f"at {tuple(point_b)}, but at rest the two points are {gap:.3g} m apart: "
+                                     "place the bodies (their `position`, `rotation`) so that they meet")
+            turn_gap = float(np.linalg.norm(body_b.rotation @ turn_b - frame))
+            if joint.kind == "clamp" and turn_gap > 1e-9:
+                raise ParameterError(f"`joints[{i}]` clamps bodies {name_a!r} and {name_b!r} with joint frames "
+                                     f"that differ at rest (by {turn_gap:.3g}): give one rotation or matching ones")
+        if not free:
+            raise ParameterError(f"`joints[{i}]` joins {_describe(('body', name_a))} and "
+                                 f"{_describe(b if b == 'world' else ('body', name_b))}, neither of which is "
+                                 "free: such a joint does nothing (make a body free, or drop the joint)")
+        return BodyJoint(i, name_a, point_a, turn_a, name_b, point_b, turn_b, joint.kind,
+                         joint.stiffness, joint.damping)
+
+    def _pinned_base(self, i, joint, rod, other):
+        """Pin rod ``rod``'s base to ``other`` (``joints[i]``): its base body
+        (a free :class:`RigidBody` standing for the rod's base segment, its
+        mass properties replaced by the segment's when discretised), the base
+        clamped to it; returns the clamp."""
+        name = f"{rod}.base"
+        if name in self.bodies or name in self.rods:
+            raise ParameterError(f"`joints[{i}]` pins the base of rod {rod!r}, whose base body is named {name!r}, "
+                                 "but that name is taken: rename the rod or the body")
+        model = self.rods[rod]
+        if other == "world":
+            base = model.base
+            if not base.fixed:
+                raise ParameterError(f"`joints[{i}]` pins rod {rod!r} to the world, but its Model's `base` "
+                                     "moves: drop the joint or the motion")
+            position, rotation = np.array(base.position, dtype=float), np.array(base.rotation, dtype=float)
+        else:
+            self._clamp(i, rod, other)  # the same checks of the Model's base as for a clamp
+            body = self.bodies[other[1]]
+            position = body.position + body.rotation @ other[2]
+            rotation = body.rotation @ (np.eye(3) if other[3] is None else other[3])
+        half = 0.5 * model.ds * model.rod.material.rho  # a stand-in: the discretisation carries the segment
+        self.bodies[name] = RigidBody(half * float(model.rod.area(0.0)), half * model.rod.second_moments(0.0),
+                                      position=position, rotation=rotation)
+        self.pinned_bases[rod] = name
+        self.body_joints.append(self._body_joint(i, joint, ("body", name, np.zeros(3), None), other))
+        return (name, np.zeros(3), np.eye(3))
 
     def rods_on(self, body):
         """Names of the rods whose base is clamped to ``body``, in ``rods`` order."""

@@ -88,8 +88,15 @@ def test_system_graph_checks():
         rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint(("hed", (0, 0, 0)), ("arm", "base"))])
     with pytest.raises(rodmol.ParameterError, match="already jointed"):
         rodmol.System({"arm": _arm()}, {"head": head}, [on_head, rodmol.Joint("world", ("arm", "base"))])
-    with pytest.raises(rodmol.NotSupportedYet, match="pins the base"):
-        rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint(("head", (0, 0, 0)), ("arm", "base"), "pin")])
+    # A pinned base is clamped to a body of its own (named after the rod), pinned where the joint says.
+    pinned = rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint(("head", (0.1, 0, 0)), ("arm", "base"),
+                                                                          "pin")])
+    assert pinned.pinned_bases == {"arm": "arm.base"} and pinned.rods_on("arm.base") == ["arm"]
+    (pin,) = pinned.body_joints
+    assert (pin.a, pin.b, pin.kind, tuple(pin.point_b)) == ("arm.base", "head", "pin", (0.1, 0.0, 0.0))
+    np.testing.assert_array_equal(pinned.bodies["arm.base"].position, (0.1, 0.0, 0.0))
+    with pytest.raises(rodmol.ParameterError, match="'arm.base'.*taken"):
+        rodmol.System({"arm": _arm()}, {"arm.base": head}, [rodmol.Joint("world", ("arm", "base"), "pin")])
     with pytest.raises(rodmol.NotSupportedYet, match="joins a rod's base to a rod"):
         rodmol.System({"arm": _arm(), "arm2": _arm()}, joints=[rodmol.Joint(("arm", "tip"), ("arm2", "base"))])
     with pytest.raises(rodmol.ParameterError, match="to itself"):
@@ -109,8 +116,19 @@ def test_system_graph_checks():
     assert [(h.s, h.kind, h.name) for h in held.rods["arm"].loads] == [(0.2, "pin", "joints[0]"),
                                                                       (0.1, "clamp", "joints[1]")]
     assert [(j.rod, j.load, j.body) for j in held.penalty_joints] == [("arm", 0, None), ("arm", 1, "head")]
-    with pytest.raises(rodmol.NotSupportedYet, match="body 'head'"):
-        rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint("world", ("head", (0, 0, 0)))])
+    # Bodies join each other and the world at points that meet at rest, one of them free.
+    fixed = rodmol.RigidBody(1.0, (1e-3, 1e-3, 1e-3), motion="fixed", position=(0.0, 0.3, 0.0))
+    joined = rodmol.System({"arm": _arm()}, {"head": head, "wall": fixed},
+                           [rodmol.Joint("world", ("head", (0, 0, 0))),
+                            rodmol.Joint(("head", (0.0, 0.1, 0.0)), ("wall", (0.0, -0.2, 0.0)), "pin")])
+    assert [(j.a, j.b, j.kind) for j in joined.body_joints] == [("head", None, "clamp"), ("head", "wall", "pin")]
+    with pytest.raises(rodmol.ParameterError, match="0.1 m apart"):
+        rodmol.System({"arm": _arm()}, {"head": head, "wall": fixed},
+                      [rodmol.Joint(("head", (0.0, 0.1, 0.0)), ("wall", (0.0, -0.1, 0.0)))])
+    with pytest.raises(rodmol.ParameterError, match="neither of which is free"):
+        rodmol.System({"arm": _arm()}, {"wall": fixed}, [rodmol.Joint(("wall", (0, 0, 0)), "world")])
+    with pytest.raises(rodmol.ParameterError, match="to itself"):
+        rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint(("head", (0, 0, 0)), ("head", (0, 0, 0)))])
     with pytest.raises(rodmol.ParameterError, match="used twice"):
         rodmol.System({"head": _arm()}, {"head": head})
     moving = _arm().replace(base=rodmol.BaseMotion(velocity=lambda t: (0, 0, 0)))

@@ -206,6 +206,12 @@ def _body_contact(out):
     assert untouched["head_gap_at_rest_mm"] == example["head_gap_at_rest_mm"]
 
 
+def _body_joints(out):
+    table = rows(out / "body_joints.csv")
+    assert table and all(row["success"] for row in table if row["factor"] == 1.0), table
+    assert all(row["max_drift_over_L"] < 1e-3 for row in table if row["factor"] == 1.0), table
+
+
 SCRIPTS = {
     "scaling.py": (["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"], _scaling),
     "temporal.py": (["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv", "temporal_options.csv"],
@@ -232,6 +238,7 @@ SCRIPTS = {
     "holds.py": (["holds.csv", "holds.md"], _holds),
     "loops.py": (["loops.csv", "loops.md"], _loops),
     "body_contact.py": (["body_contact.csv", "body_contact.md"], _body_contact),
+    "body_joints.py": (["body_joints.csv", "body_joints.md"], _body_joints),
 }
 
 

@@ -31,6 +31,12 @@ forces (and clamp moments) are equal and opposite, acting at the two nodes
 (the couple of the pair, gap x F, is O(F^2 / k)). :mod:`rodmol.discretise.joints`
 holds the joints' parts.
 
+Coupling (joints of bodies): two bodies, or a body and the world, joined at
+a point of each by the same hold law between the two points, equal and
+opposite on the two bodies (:mod:`rodmol.discretise.body_joints`,
+:meth:`Assembly.add_body_joints`). A pinned rod base is clamped to a free
+body that is its base segment alone (``BodyPart.segment_only``), pinned so.
+
 What a free body carries: the rods' velocity nodes stand for their
 ``node_lengths``, which leave out the length next to the base node (ds/2
 in the centred scheme, none upwind); on a body that piece, the rod's base
@@ -54,90 +60,14 @@ the segments' at their clamps) and quadratic drag.
 import numpy as np
 from scipy import sparse
 
-from ..bodies import mass_matrix_about_origin
-from .body_contact import BodyContacts
+from .body_joints import BodyJointPart, joint_frequency
+from .body_part import BodyPart, clamp_velocities, cross
 from .joints import JointPart, RecordedJoints, RodJointPart, block_entries
-from .layout import BlockLayout
 from .physics import quaternion_rate
-from .rigid import BODY_FIELDS, NET_MASS, NET_MOMENT, POSE_FIELDS, clamp_wrench, free_body_rates, pack_body
+from .rigid import clamp_wrench, free_body_rates
 from .rotations import from_matrix, matrices
-from .sampling import section_masses
 from .stencil import WORK_TOTAL
 from .system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE, SemiDiscrete, field_scales
-
-
-def _cross(a, b):
-    """a x b over the last axis (numpy's cross costs 20 us on one pair, most of a body's rates)."""
-    a, b = np.asarray(a), np.asarray(b)
-    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1], a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
-
-
-def clamp_velocities(points, turns, v, w):
-    """(n, 6) base velocities (v0, w0) = (Rj^T (v + w x p), Rj^T w) of rods
-    clamped at ``points`` (n, 3) [m] with ``turns`` (n, 3, 3) (base to body
-    frame) to a body moving with (v, w) (body frame): local frames of the bases."""
-    return np.concatenate([np.einsum("rji,rj->ri", turns, v + _cross(w, points)),
-                           np.einsum("rji,j->ri", turns, np.broadcast_to(w, 3))], axis=1)
-
-
-class BodyPart:
-    """One rigid body's place in the state, its constant data and its rods'
-    clamps stacked for the coupling (points (n, 3) [m] and rotations (n, 3, 3),
-    base to body frame). ``mass_matrix`` (6, 6), ``rigid_mass`` (the same
-    without the body's added mass) and ``params`` (:func:`pack_body`'s row)
-    include the rods' base segments it carries (:meth:`carry`)."""
-
-    def __init__(self, name, body, start, fluid_density):
-        self.name, self.body = name, body
-        self.params = pack_body(body, fluid_density)
-        self.layout = BlockLayout(1, dict(BODY_FIELDS if body.free else POSE_FIELDS))
-        self.slice = slice(start, start + self.layout.size)
-        self.fields = {f: slice(start + s.start, start + s.stop) for f, s in self.layout.slices().items()}
-        self.mass_matrix = body.mass_matrix.copy()  # with the rods' base segments (clamp)
-        self.inverse_mass = np.linalg.inv(self.mass_matrix)
-        self.rigid_mass = body.mass_matrix - body.added_mass  # gyroscopic terms and momentum: no body added mass
-        self.rods, self.systems = [], []
-        self.works = []  # each rod kernel's scratch: cell 0's total stress after a call (stencil.rhs)
-        self.points, self.turns = np.zeros((0, 3)), np.zeros((0, 3, 3))
-        self.shares = np.zeros(0)  # the base node's share of cell 0 [m] (Scheme.base_share ds)
-        self.strains = np.zeros((0, 6), dtype=np.int64)  # state indices of (q, k) of each rod's cell 0
-        self.joints = []  # its penalty joints (JointPart)
-        self.contacts = BodyContacts(body) if body.contacts else None
-
-    def clamp(self, name, sd, start, point, turn):
-        """Hold the base of rod ``name`` (its system ``sd``, its state from ``start``)."""
-        self.shares = np.append(self.shares, sd.scheme.base_share * sd.model.ds)
-        self.carry(sd, point, turn)
-        self.rods.append(name)
-        self.systems.append(sd)
-        self.works.append(sd.kernel_arguments()[-1])
-        self.points = np.vstack([self.points, point])
-        self.turns = np.concatenate([self.turns, np.asarray(turn, dtype=float)[None]])
-        self.flat_turns = np.ascontiguousarray(self.turns.reshape(-1, 9))  # row-major, for the kernel
-        sl, first = sd.layout.slices(), start + sd.layout.header
-        index = np.r_[first + sl["q"].start:first + sl["q"].stop, first + sl["k"].start:first + sl["k"].stop]
-        self.strains = np.vstack([self.strains, index])
-
-    def carry(self, sd, point, turn):
-        """Add to the body the base segment of the rod of system ``sd``
-        clamped at ``point`` [m] with ``turn`` (base to body frame): the
-        length of rod its velocity nodes leave out (the base node's,
-        ``Scheme.node_lengths``: ds/2 centred, none upwind) with the base
-        section's masses, lumped at the clamp as the nodes' are at theirs."""
-        length = max(sd.model.rod.length - float(np.sum(sd.node_lengths)), 0.0)
-        mass, _, inertia, net_mass = (length * a[0] for a in section_masses(sd.model, [0.0]))
-        turn = np.asarray(turn, dtype=float)
-        segment = mass_matrix_about_origin(turn @ np.diag(mass) @ turn.T, turn @ np.diag(inertia) @ turn.T, point)
-        self.mass_matrix += segment
-        self.inverse_mass = np.linalg.inv(self.mass_matrix)
-        self.rigid_mass += segment  # its added mass too, as the rods' nodes count theirs
-        self.params[NET_MASS] += net_mass
-        self.params[NET_MOMENT:NET_MOMENT + 3] += net_mass * np.asarray(point, dtype=float)
-
-    def base_velocities(self, v, w):
-        """(n, 6) base velocities of the rods for the body velocities (v, w) (:func:`clamp_velocities`)."""
-        return clamp_velocities(self.points, self.turns, v, w)
 
 
 class Assembly:
@@ -170,8 +100,9 @@ class Assembly:
             self.parts[name] = slice(start, start + sd.size)
             start += sd.size
         self.scheme = next(iter(self.rods.values())).scheme
+        pinned = set(system.pinned_bases.values())
         for name, body in system.bodies.items():
-            part = BodyPart(name, body, start, system.medium.rho)
+            part = BodyPart(name, body, start, system.medium.rho, segment_only=name in pinned)
             for rod in system.rods_on(name):
                 _, point, rotation = system.clamps[rod]
                 part.clamp(rod, self.rods[rod], self.parts[rod].start, point, rotation)
@@ -189,6 +120,12 @@ class Assembly:
             elif joint.partner is not None:
                 self.rod_joints.append(RodJointPart(joint, *rod, self.rods[joint.partner],
                                                     self.parts[joint.partner].start))
+        omega = joint_frequency(system.rods.values())
+        self.body_joints = [BodyJointPart(j, self.bodies[j.a], None if j.b is None else self.bodies[j.b], omega)
+                            for j in system.body_joints]
+        for joint in self.body_joints:
+            for part in joint.parts:
+                part.body_joints.append(joint)
         self.free = [p for p in self.bodies.values() if p.body.free]
         self.lightly_damped = any(sd.lightly_damped for sd in self.rods.values())
         self._gravity = np.ascontiguousarray(system.gravity, dtype=float)
@@ -276,11 +213,12 @@ class Assembly:
         for part in self.free:  # the rods' base velocities first
             for sd, row in zip(part.systems, part.base_velocities(y[part.fields["v"]], y[part.fields["w"]])):
                 sd.base_velocities[:] = row
-        reactions = {part.name: np.zeros(6) for part in self.free if part.joints}
+        reactions = {part.name: np.zeros(6) for part in self.free if part.joints or part.body_joints}
         for joint in self.joints:  # and the held points of the penalty joints, with their bodies' reactions
             f, m = joint.wrench(y, self.body_state(joint.part, t, y), joint.row, joint.value)
             if joint.part.name in reactions:
                 reactions[joint.part.name] += (*f, *m)
+        self.add_body_joints(t, y, reactions)
         for joint in self.rod_joints:
             joint.wrench(y, joint.row, joint.value)
         for name, sd in self.rods.items():
@@ -297,12 +235,13 @@ class Assembly:
         already at y (else here, on scratch rows)."""
         if part.body.free:
             force, torque = self.body_wrench(part, y) if part.rods else ((0.0,) * 3, (0.0,) * 3)
-            if part.joints:
+            if part.joints or part.body_joints:
                 if reactions is None:
                     reactions, body = np.zeros(6), np.ascontiguousarray(y[part.slice])
                     for joint in part.joints:  # the rods' own rows stay as the last call set them
                         f, m = joint.wrench(y, body, joint.row.copy(), joint.value.copy())
                         reactions += (*f, *m)
+                    reactions = self.add_body_joints(t, y, {part.name: reactions}, part.body_joints)[part.name]
                 force = tuple(np.add(force, reactions[:3]))
                 torque = tuple(np.add(torque, reactions[3:]))
             if part.contacts is not None:
@@ -315,6 +254,16 @@ class Assembly:
         v, w = self.body_velocities(part, t, y)
         out[part.fields["x"]] = matrices(quat) @ v
         out[part.fields["Q"]] = quaternion_rate(tuple(quat), tuple(w), QUATERNION_RESTORING_RATE)
+
+    def add_body_joints(self, t, y, reactions, joints=None):
+        """Add to ``reactions`` ({free body name: (6,)}) the force and moment
+        of each body joint (default: all of them) at (t, y) on its bodies named there."""
+        for joint in self.body_joints if joints is None else joints:
+            states = [self.body_state(part, t, y) for part in joint.parts]
+            for part, wrench in zip(joint.parts, joint.wrench(*states)):
+                if part.name in reactions:
+                    reactions[part.name] += (*wrench[0], *wrench[1])
+        return reactions
 
     def body_wrench(self, part, y):
         """Force and moment about the origin [N, N m] of the rods clamped to
@@ -350,6 +299,12 @@ class Assembly:
                 pat[np.ix_(velocity, node)] = True
         for joint in self.rod_joints:  # each side: its node's velocity rows against the partner node
             pat[np.ix_(joint.node + block_entries("v", "w"), joint.partner_fields)] = True
+        for joint in self.body_joints:  # each free body's velocity rows against the other's block
+            for part in joint.parts:
+                for other in joint.parts:
+                    if part.body.free:
+                        velocity = np.r_[part.fields["v"], part.fields["w"]]
+                        pat[np.ix_(velocity, np.arange(other.slice.start, other.slice.stop))] = True
         return pat.tocsc()
 
     def atol_scale(self):
@@ -381,13 +336,13 @@ class Assembly:
             p = np.einsum("nij,nj->ni", rot, sd.sampled.mass * lay.field(y_rod, "v") * lengths)
             h = np.einsum("nij,nj->ni", rot, sd.sampled.inertia * lay.field(y_rod, "w") * lengths)
             linear += p.sum(axis=0)
-            angular += (_cross(lay.field(y_rod, "u"), p) + h).sum(axis=0)
+            angular += (cross(lay.field(y_rod, "u"), p) + h).sum(axis=0)
         for part in self.free:
             r = matrices(y[part.fields["Q"]])
             v, w = y[part.fields["v"]], y[part.fields["w"]]
             momentum = part.rigid_mass @ np.concatenate([v, w])
             linear += r @ momentum[:3]
-            angular += _cross(y[part.fields["x"]], r @ momentum[:3]) + r @ momentum[3:]
+            angular += cross(y[part.fields["x"]], r @ momentum[:3]) + r @ momentum[3:]
         return linear, angular
 
 

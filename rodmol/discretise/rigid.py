@@ -132,6 +132,20 @@ def joint_wrench(kind, row, value, y, node, body, point, turn):
     returns the reaction on the body: the force and moment [N, N m] about
     its origin, body frame, equal and opposite to the node's, the force
     acting where the node is (so momentum and angular momentum are kept)."""
+    held_by(row, value, body, point, turn)
+    u = _row3(y, node + U)
+    quat = (y[node + QUAT], y[node + QUAT + 1], y[node + QUAT + 2], y[node + QUAT + 3])
+    r = rotation(quat)
+    f, m = hold(kind, row, (value[0], value[1], value[2]), u, quat, r, _row3(y, node + V), _row3(y, node + W))
+    return reaction(body, u, to_global(r, f), to_global(r, m))
+
+
+@jit
+def held_by(row, value, body, point, turn):
+    """Write into a hold's parameter ``row`` and ``value`` the frame of a
+    body in the state ``body`` (x, Q, v, w) at ``point`` [m] with axes
+    ``turn`` (quaternion), body frame: its displacement from the row's
+    rest position, its orientation, velocity and angular velocity, global."""
     x_b = _row3(body, BX)
     q_b = (body[BQ], body[BQ + 1], body[BQ + 2], body[BQ + 3])
     v_b, w_b = _row3(body, BV), _row3(body, BW)
@@ -147,10 +161,13 @@ def joint_wrench(kind, row, value, y, node, body, point, turn):
     for i in range(3):
         row[P_HELD_VELOCITY + i] = velocity[i]
         row[P_HELD_SPIN + i] = spin[i]
-    u = _row3(y, node + U)
-    quat = (y[node + QUAT], y[node + QUAT + 1], y[node + QUAT + 2], y[node + QUAT + 3])
-    r = rotation(quat)
-    f, m = hold(kind, row, (value[0], value[1], value[2]), u, quat, r, _row3(y, node + V), _row3(y, node + W))
-    force = scale(-1.0, to_local(r_b, to_global(r, f)))
-    moment = scale(-1.0, to_local(r_b, to_global(r, m)))
-    return force, add(moment, cross(to_local(r_b, sub(u, x_b)), force))
+
+
+@jit
+def reaction(body, u, force, moment):
+    """The force and moment [N, N m] about the origin of a body in the state
+    ``body``, body frame, opposite to ``force`` and ``moment`` (global) on
+    what it holds, the force acting at ``u`` [m] (global)."""
+    r_b = rotation((body[BQ], body[BQ + 1], body[BQ + 2], body[BQ + 3]))
+    f = scale(-1.0, to_local(r_b, force))
+    return f, add(scale(-1.0, to_local(r_b, moment)), cross(to_local(r_b, sub(u, _row3(body, BX))), f))

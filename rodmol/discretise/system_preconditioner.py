@@ -12,6 +12,12 @@ position. The tree joints' coupling blocks are left out: GMRES's products
 J v are differences of the full right-hand side, so it sees them, only
 converging in more iterations.
 
+A body's joints to the world or to fixed or driven bodies are in its own
+block; a joint between two free bodies couples their blocks as stiffly as
+it holds them: both bodies join the Schur complement below, with the
+coupling blocks N_b1b2 (by differences of the full right-hand side in one
+body's entries, the other's rows).
+
 A penalty joint between a rod node and a free body couples them as stiffly
 as it holds them: left out, GMRES needs hundreds of times the right-hand
 sides or fails. Its blocks are kept, and the free bodies with penalty
@@ -24,6 +30,8 @@ body column and joined rod; a solve is z_r' = N_rr^-1 r_r, z_b = S^-1
 (r_b - N_br z_r'), z_r = z_r' - N_rr^-1 N_rb z_b.
 """
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from .joints import block_entries
@@ -34,6 +42,37 @@ JOINT_ROWS, JOINT_COLUMNS = block_entries("v", "w"), block_entries("u", "Q", "v"
 
 #: Relative step of the body blocks' differences, times each entry's scale.
 BODY_STEP = 1e-7
+
+
+@dataclass(eq=False)
+class Coupling:
+    """A coupling of a Schur body with rod ``rod``: the rod's ``rows`` its
+    entries move and the ``columns`` its rates read (state indices), and
+    the blocks by differences, ``rod_to_body`` (N_rb / -gamma, rows x body)
+    and ``body_to_rod`` (N_br / -gamma, body x columns). ``full``: the
+    body's rates read the columns through the rod's rates (a clamp: cell
+    0's stress), so their differences take the rod's rates first."""
+
+    rod: str
+    rows: np.ndarray
+    columns: np.ndarray
+    full: bool
+
+    def __post_init__(self):
+        self.rod_to_body = np.zeros((len(self.rows), FREE_BODY.size))
+        self.body_to_rod = np.zeros((FREE_BODY.size, len(self.columns)))
+
+
+def couplings(assembly, part):
+    """The :class:`Coupling` of a Schur body ``part``: its penalty joints'
+    nodes and, for a pinned base (``segment_only``), its rods' clamps (the
+    header and first element: they outweigh the segment's own mass)."""
+    found = [Coupling(j.joint.rod, j.node + JOINT_ROWS, j.node + JOINT_COLUMNS, False) for j in part.joints]
+    for name, sd in zip(part.rods, part.systems) if part.segment_only else ():
+        start = assembly.parts[name].start
+        first = np.arange(start, start + sd.layout.header + sd.layout.block)
+        found.append(Coupling(name, first, first, True))
+    return found
 
 
 class SystemPreconditioner:
@@ -50,11 +89,16 @@ class SystemPreconditioner:
         self._field_of = {p.name: [f for f, n in p.layout.fields.items() for _ in range(n)] for p in self.bodies}
         self._out = np.empty(assembly.size)
         self._scale, self.gamma = scale, np.nan
-        # The Schur complement's bodies (free, with penalty joints) and their offsets in S.
-        self.coupled = [p for p in self.bodies if p.body.free and p.joints]
+        # The Schur complement's bodies (free, with penalty joints, joints to other free bodies or a
+        # pinned base's), their offsets in S, their couplings with rods and with their free partners.
+        self._partners = {p.name: [o for j in p.body_joints for o in j.parts if o is not p and o.body.free]
+                          for p in self.bodies}
+        self.coupled = [p for p in self.bodies
+                        if p.body.free and (p.joints or self._partners[p.name] or (p.segment_only and p.rods))]
+        self._couplings = {p.name: couplings(assembly, p) for p in self.coupled}
+        self._pairs = {(p.name, o.name): np.zeros((FREE_BODY.size, FREE_BODY.size))
+                       for p in self.coupled for o in self._partners[p.name]}  # o's rows, p's columns
         self._offset = dict(zip((p.name for p in self.coupled), FREE_BODY.size * np.arange(len(self.coupled))))
-        self._rod_to_body = {id(j): np.zeros((len(JOINT_ROWS), FREE_BODY.size)) for p in self.coupled for j in p.joints}
-        self._body_to_rod = {id(j): np.zeros((FREE_BODY.size, len(JOINT_COLUMNS))) for p in self.coupled for j in p.joints}
         self._schur = np.eye(FREE_BODY.size * len(self.coupled))
         self.jac_evals = self.setups = self.solves = 0
 
@@ -72,11 +116,11 @@ class SystemPreconditioner:
                 assembly(t, y, self._out)  # the rods' stress at y (their Jacobians and other bodies moved it)
                 coupled = part in self.coupled
                 if coupled:
-                    self._joint_columns(part, t, y, fy, z)
+                    self._coupling_columns(part, t, y, fy, z)
                 jac, steps = self._jac[part.name], self._steps[part.name]
                 for j, index in enumerate(range(part.slice.start, part.slice.stop)):
                     field = self._field_of[part.name][j]
-                    if field == "x" and not part.joints and part.contacts is None:  # no rate reads it
+                    if field == "x" and not (part.joints or part.body_joints) and part.contacts is None:
                         continue
                     z[index] = y[index] + steps[j]
                     if field in ("x", "Q") and not coupled:  # of the rates kept, only the body's read its pose
@@ -84,9 +128,11 @@ class SystemPreconditioner:
                     else:  # its velocities move the rods' bases, its pose the joints' held points
                         assembly(t, z, self._out)
                     jac[:, j] = (self._out[part.slice] - fy[part.slice]) / steps[j]
-                    for joint in part.joints if coupled else ():
-                        rows = joint.node + JOINT_ROWS
-                        self._rod_to_body[id(joint)][:, j] = (self._out[rows] - fy[rows]) / steps[j]
+                    for c in self._couplings[part.name] if coupled else ():
+                        c.rod_to_body[:, j] = (self._out[c.rows] - fy[c.rows]) / steps[j]
+                    for other in self._partners[part.name] if coupled else ():
+                        rows = other.slice
+                        self._pairs[part.name, other.name][:, j] = (self._out[rows] - fy[rows]) / steps[j]
                     z[index] = y[index]
             assembly(t, y, self._out)  # leave the rods as at y
             self.jac_evals += 1
@@ -100,25 +146,35 @@ class SystemPreconditioner:
             self._factor_schur(gamma)
         self.setups += 1
 
-    def _joint_columns(self, part, t, y, fy, z):
-        """The body's rows against each of its joint nodes' columns (N_br / -gamma), by differences of its rates."""
+    def _coupling_columns(self, part, t, y, fy, z):
+        """The body's rows against each coupling's columns (N_br / -gamma), by differences of its rates."""
         assembly = self.assembly
-        for joint in part.joints:
-            block = self._body_to_rod[id(joint)]
-            for c, index in enumerate(joint.node + JOINT_COLUMNS):
+        for c in self._couplings[part.name]:
+            rod = assembly.parts[c.rod]
+            for k, index in enumerate(c.columns):
                 step = BODY_STEP * max(self._scale[index], 1e-300)
                 z[index] = y[index] + step
+                if c.full:  # the rod's rates (its cell 0's stress), its base velocities as at y
+                    assembly.rods[c.rod](t, z[rod], self._out[rod])
                 assembly.body_rates(part, t, z, self._out)
-                block[:, c] = (self._out[part.slice] - fy[part.slice]) / step
+                c.body_to_rod[:, k] = (self._out[part.slice] - fy[part.slice]) / step
                 z[index] = y[index]
+        assembly(t, y, self._out)
 
     def _rod_solve(self, name, rows_values):
-        """N_rr^-1 of a right-hand side nonzero at joint rows only: [(joint, values (6,))] of rod ``name``."""
+        """N_rr^-1 of a right-hand side nonzero at coupling rows only: [(coupling, values)] of rod ``name``."""
         rhs = np.zeros(self.assembly.rods[name].size)
         start = self.assembly.parts[name].start
-        for joint, values in rows_values:
-            rhs[joint.node - start + JOINT_ROWS] += values
+        for c, values in rows_values:
+            rhs[c.rows - start] += values
         return self.rods[name].apply(rhs)
+
+    def _by_rod(self, part):
+        """``part``'s couplings grouped by rod."""
+        by_rod = {}
+        for c in self._couplings[part.name]:
+            by_rod.setdefault(c.rod, []).append(c)
+        return by_rod
 
     def _factor_schur(self, gamma):
         """S = N_bb - N_br N_rr^-1 N_rb over the coupled bodies, inverted."""
@@ -126,21 +182,19 @@ class SystemPreconditioner:
         for part in self.coupled:
             o = self._offset[part.name]
             schur[o:o + size, o:o + size] = np.eye(size) - gamma * self._jac[part.name]
+        for (name, other), block in self._pairs.items():  # the body joints' coupling of two free bodies
+            o, oo = self._offset[name], self._offset[other]
+            schur[oo:oo + size, o:o + size] -= gamma * block
         for part in self.coupled:
             o = self._offset[part.name]
-            by_rod = {}
-            for joint in part.joints:
-                by_rod.setdefault(joint.joint.rod, []).append(joint)
-            for rod, joints in by_rod.items():
+            for rod, found in self._by_rod(part).items():
                 start = self.assembly.parts[rod].start
                 for k in range(size):
-                    x = self._rod_solve(rod, [(j, -gamma * self._rod_to_body[id(j)][:, k]) for j in joints])
-                    for other in self.coupled:  # every body joined to this rod reads x at its joint nodes
-                        for joint in other.joints:
-                            if joint.joint.rod == rod:
-                                oo = self._offset[other.name]
-                                n_br = -gamma * self._body_to_rod[id(joint)]
-                                schur[oo:oo + size, o + k] -= n_br @ x[joint.node - start + JOINT_COLUMNS]
+                    x = self._rod_solve(rod, [(c, -gamma * c.rod_to_body[:, k]) for c in found])
+                    for other in self.coupled:  # every body coupled to this rod reads x at its columns
+                        oo = self._offset[other.name]
+                        for c in self._by_rod(other).get(rod, ()):
+                            schur[oo:oo + size, o + k] -= -gamma * c.body_to_rod @ x[c.columns - start]
         self._schur = np.linalg.inv(schur)
 
     def solve(self, t, y, fy, r, z, gamma, delta, lr):
@@ -159,15 +213,15 @@ class SystemPreconditioner:
         rhs = np.concatenate([r[part.slice] for part in self.coupled])
         for part in self.coupled:
             o = self._offset[part.name]
-            for joint in part.joints:
-                rhs[o:o + FREE_BODY.size] -= -g * self._body_to_rod[id(joint)] @ z[joint.node + JOINT_COLUMNS]
+            for c in self._couplings[part.name]:
+                rhs[o:o + FREE_BODY.size] -= -g * c.body_to_rod @ z[c.columns]
         z_b = self._schur @ rhs
         by_rod = {}
         for part in self.coupled:
             o = self._offset[part.name]
             z[part.slice] = z_b[o:o + FREE_BODY.size]
-            for joint in part.joints:
-                by_rod.setdefault(joint.joint.rod, []).append((joint, -g * self._rod_to_body[id(joint)] @ z_b[o:o + FREE_BODY.size]))
+            for c in self._couplings[part.name]:
+                by_rod.setdefault(c.rod, []).append((c, -g * c.rod_to_body @ z_b[o:o + FREE_BODY.size]))
         for rod, rows_values in by_rod.items():
             z[parts[rod]] -= self._rod_solve(rod, rows_values)
         self.solves += 1

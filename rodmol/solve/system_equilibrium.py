@@ -8,11 +8,11 @@ orientation, Q = Q_init exp(theta). Equations: each rod's rest equations with
 its base clamped where the body's pose puts the clamp and its penalty joints'
 held points where the bodies (or partner rods) put them, then each free body's
 balance of forces and moments about its origin (body frame): the rods' clamp
-wrenches (:meth:`Assembly.body_wrench`), the penalty joints' reactions, its
-contacts (:mod:`rodmol.discretise.body_contact`) and its weight less buoyancy
-with the base segments it carries, read from the same Newton-Euler rates the
-dynamics integrate (at v = w = 0 they are M^-1 times the wrench, so M times
-them is the wrench). The loads (gravity, tensions, load
+wrenches (:meth:`Assembly.body_wrench`), the penalty joints' and body joints'
+reactions, its contacts (:mod:`rodmol.discretise.body_contact`) and its weight
+less buoyancy with the base segments it carries, read from the same
+Newton-Euler rates the dynamics integrate (at v = w = 0 they are M^-1 times
+the wrench, so M times them is the wrench). The loads (gravity, tensions, load
 values) are ramped by the continuation of :func:`continuation`; the joints'
 held points follow the bodies at every step.
 
@@ -30,6 +30,7 @@ from ..discretise.joints import RodJointPart
 from ..discretise.rigid import NET_MASS, free_body_rates
 from ..discretise.system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE
 from ..errors import EquilibriumError
+from ..loads import P_STIFFNESS
 from .rest_equations import STATIC_FIELDS, RestEquations, continuation
 from .watch import state_problem
 
@@ -129,10 +130,18 @@ class FreeRestEquations:
         return z
 
     def tolerance(self, tol):
-        """Per-row tolerances: the rods' own (:meth:`RestEquations.tolerance`), ``tol`` for the bodies."""
+        """Per-row tolerances: the rods' own (:meth:`RestEquations.tolerance`); for a
+        body, ``tol`` raised to the round-off floor of the forces its balance sums,
+        as a rod's rows are: its rods' cell 0 stresses (of size E A) and its joints'
+        penalties on positions of size L (k L)."""
         out = np.full(self.size, float(tol))
         for name, eq in self.rods.items():
             out[self.slices[name]] = eq.tolerance(tol)
+        for part in self.assembly.free:
+            forces = [np.max(sd.sampled.kl[0]) for sd in part.systems]
+            forces += [joint.row[P_STIFFNESS] * self.length for joint in part.joints + part.body_joints]
+            floor = 10 * np.finfo(float).eps * max(forces, default=0.0) / self.scale
+            out[self.slices[part.name]] = max(float(tol), floor)
         return out
 
     def _place(self, z):
@@ -173,6 +182,7 @@ class FreeRestEquations:
             force, moment = joint.wrench(y, self._body(joint.part), joint.row, joint.value)
             if joint.part.name in reactions:
                 reactions[joint.part.name] += np.concatenate([force, moment])
+        assembly.add_body_joints(self.t, y, reactions)  # the free bodies' velocities in y are zero
         out = np.empty(self.size)
         for name, eq in self.rods.items():  # held=1: a joint's gap is where the bodies are, not a load
             out[self.slices[name]] = eq.residual(z[self.slices[name]], lam, held=1.0)
@@ -209,6 +219,7 @@ def floating(system):
     edges += [(rod, "world") for rod in system.rods if rod not in system.clamps]
     for joint in system.penalty_joints:
         edges.append((joint.rod, joint.partner if joint.partner is not None else joint.body or "world"))
+    edges += [(joint.a, joint.b or "world") for joint in system.body_joints]
     held = {"world"} | {name for name, body in system.bodies.items() if not body.free}
     grown = True
     while grown:

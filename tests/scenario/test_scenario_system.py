@@ -276,3 +276,26 @@ def test_a_bodys_contacts_are_its_body_contact_tables():
         parse_scenario(BOX_ON_FLOOR.replace('type = "sphere_contact"', 'type = "point_force"'))
     (problem,) = caught.value.problems
     assert problem.table == "[[body]] #1 [[contact]] #2" and "plane_contact" in problem.message
+
+
+def test_joints_of_bodies_and_a_pinned_base_are_read_from_a_file():
+    text = TWO_ARMS.read_text() + """
+[[body]]
+name = "tail"
+mass = 0.1
+inertia = [1e-5, 1e-5, 1e-5]
+position = [0.0, -0.05, 0.0]
+
+[[joint]]
+a = ["head", [0.0, -0.05, 0.0]]
+b = ["tail", [0.0, 0.0, 0.0]]
+kind = "pin"
+
+[[joint]]
+a = ["tail", [0.0, 0.0, 0.0]]
+b = "world"
+"""
+    system = parse_scenario(text).model
+    assert [(j.a, j.b, j.kind) for j in system.body_joints] == [("head", "tail", "pin"), ("tail", None, "clamp")]
+    pinned = parse_scenario(text.replace('b = ["right", "base"]', 'b = ["right", "base"]\nkind = "pin"')).model
+    assert pinned.pinned_bases == {"right": "right.base"} and pinned.clamps["right"][0] == "right.base"
