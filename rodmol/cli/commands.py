@@ -28,7 +28,7 @@ from pathlib import Path
 from .._files import output_directory
 from .._progress import Progress
 from .._version import __version__
-from ..errors import NotSupportedYet, ParameterError
+from ..errors import ParameterError
 from ..output import h5result
 from ..output.formats import FORMATS, get_format
 from ..output.lock import OutputLock
@@ -111,10 +111,7 @@ def _run(args):
 
 def _run_system(args, spec, out):
     """``rodmol run`` of a system file: the run, its files streamed while it goes (``--resume``
-    continues a killed one)."""
-    if args.resume_anyway:
-        raise NotSupportedYet("`--resume-anyway` is not supported yet for systems: use `--resume` (with the "
-                              "run's own settings)")
+    continues a killed one with its recorded settings, ``--resume-anyway`` with the file's)."""
     if (args.format or spec.output.format) != "xdmf":
         raise ParameterError("a system's run is written as `--format xdmf` only")
     say = (lambda *a, **k: None) if args.quiet else print
@@ -125,7 +122,8 @@ def _run_system(args, spec, out):
     started = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # the summary gives the message
-        result = spec.simulate(progress=progress, out=out, overwrite=args.overwrite, resume=bool(args.resume))
+        result = spec.simulate(progress=progress, out=out, overwrite=args.overwrite,
+                               resume="force" if args.resume_anyway else bool(args.resume))
     if progress:
         progress.close()
     state = "finished" if result.success else f"failed: {result.message}"

@@ -33,8 +33,19 @@ from . import h5result, run_files, stream
 from .parts import view_step
 from .run_record import damaged
 from .stream import CHUNK_FRAMES, RunWriter
-from .system_files import (INDEX, _keys, _plain, chunk_batch, read_info, read_series, read_system, surface_of,
-                           write_bodies_view, write_index, write_views)
+from .system_files import (
+    INDEX,
+    _keys,
+    _plain,
+    chunk_batch,
+    read_info,
+    read_series,
+    read_system,
+    surface_of,
+    write_bodies_view,
+    write_index,
+    write_views,
+)
 
 
 class SystemRunWriter:
