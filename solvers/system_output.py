@@ -17,8 +17,10 @@ a warm-up (numba's compilation).
 
 Reported per version: the wall time of ``frames`` for the first chunks and
 the last, their ratio (flat: a chunk costs the same however long the run),
-the whole run's writing time, the size of ``system.h5`` at the end and the
-peak resident memory.
+the same for the system's own files alone (``system_*``: from the moment
+the rods' chunks are on disk to the end of ``frames``), the whole run's
+writing time, the size of ``system.h5`` at the end and the peak resident
+memory.
 
     python solvers/system_output.py [--quick | --smoke] [--out DIR] [--commit REV] [--chunk N]
 """
@@ -63,19 +65,22 @@ CHILD = textwrap.dedent("""
     t_out = 0.01 * np.arange(n_chunks * chunk + 1)
     writer = SystemRunWriter(out, chunk_frames=chunk, overwrite=True)
     writer.begin(assembly, t_out)
-    seconds, k = [], 0
+    rods_done, flush = [], writer.flush  # frames() flushes the rods' writers, then writes the system's files
+    writer.flush = lambda: (flush(), rods_done.append(time.perf_counter()))
+    seconds, system, k = [], [], 0
     while k < len(t_out) - 1:
         stop = min((k // chunk + 1) * chunk, len(t_out) - 1)
         frames = np.arange(k if k == 0 else k + 1, stop + 1)
         started = time.perf_counter()
         writer.frames(t_out[frames], np.tile(y0, (len(frames), 1)))
         seconds.append(time.perf_counter() - started)
+        system.append(time.perf_counter() - rods_done[-1])
         k = stop
     started = time.perf_counter()
     writer.end(True, "done", {})
     ending = time.perf_counter() - started
     peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # kB -> MB (Linux)
-    print(json.dumps(dict(seconds=seconds, end_s=ending, peak_rss_mb=peak, state_size=int(assembly.size),
+    print(json.dumps(dict(seconds=seconds, system_s=system, end_s=ending, peak_rss_mb=peak, state_size=int(assembly.size),
                           index_mb=__import__("os").path.getsize(out + "/system.h5") / 1e6)))
 """)
 
@@ -114,14 +119,18 @@ def main(argv=None):
         sha = export(commit, os.path.join(tmp, "old"))
         for label, tree in (("old", os.path.join(tmp, "old")), ("new", ROOT)):
             r = measure(tree, os.path.join(tmp, f"out_{label}"), n_chunks, chunk)
-            s = C.np.asarray(r["seconds"])
+            s, own = C.np.asarray(r["seconds"]), C.np.asarray(r["system_s"])
             first, last = float(C.np.median(s[1:1 + window])), float(C.np.median(s[-window:]))
+            own_first, own_last = float(C.np.median(own[1:1 + window])), float(C.np.median(own[-window:]))
             rows.append(dict(version=label, state_size=r["state_size"], chunks=len(s), frames=n_chunks * chunk + 1,
                              first_chunks_ms=1e3 * first, last_chunks_ms=1e3 * last, last_over_first=last / first,
-                             writing_s=float(s.sum() + r["end_s"]), index_mb=r["index_mb"],
-                             peak_rss_mb=r["peak_rss_mb"]))
+                             system_first_ms=1e3 * own_first, system_last_ms=1e3 * own_last,
+                             system_last_over_first=own_last / own_first,
+                             writing_s=float(s.sum() + r["end_s"]), system_writing_s=float(own.sum()),
+                             index_mb=r["index_mb"], peak_rss_mb=r["peak_rss_mb"]))
             print(f"{label}: a chunk {1e3 * first:.1f} ms at first, {1e3 * last:.1f} ms at the end "
-                  f"({last / first:.2f}x); writing {rows[-1]['writing_s']:.2f} s; system.h5 {r['index_mb']:.2f} MB; "
+                  f"({last / first:.2f}x; the system's own files {1e3 * own_first:.1f} and {1e3 * own_last:.1f} ms); "
+                  f"writing {rows[-1]['writing_s']:.2f} s; system.h5 {r['index_mb']:.2f} MB; "
                   f"peak {r['peak_rss_mb']:.0f} MB", flush=True)
     header = C.header_lines(args, SCRIPT) + [
         f"old: {sha[:10]} (git archive); new: the working tree",

@@ -198,6 +198,12 @@ def _loops(out):
     assert all(row["max_drift_over_L"] < 1e-4 for row in sparse), sparse  # the default factor or stiffer
 
 
+def _system_output(out):
+    old, new = rows(out / "system_output.csv")
+    assert old["version"] == "old" and new["version"] == "new" and old["frames"] == new["frames"]
+    assert new["index_mb"] < 0.1 * old["index_mb"]  # an index of chunk files, not every frame so far
+
+
 SCRIPTS = {
     "scaling.py": (["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"], _scaling),
     "temporal.py": (["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv", "temporal_options.csv"],
@@ -223,6 +229,7 @@ SCRIPTS = {
     "rest_strains_speed.py": (["rest_strains_speed.csv", "rest_strains_speed.md"], _rest_strains_speed),
     "holds.py": (["holds.csv", "holds.md"], _holds),
     "loops.py": (["loops.csv", "loops.md"], _loops),
+    "system_output.py": (["system_output.csv", "system_output.md"], _system_output),
 }
 
 
@@ -232,6 +239,9 @@ def test_script_smoke_run(script, tmp_path):
     if script == "core_speed.py" and subprocess.run(
             ["git", "-C", ROOT, "cat-file", "-e", "9fce6d7^{commit}"], capture_output=True).returncode != 0:
         pytest.skip("needs a git checkout holding commit 9fce6d7")
+    if script == "system_output.py" and subprocess.run(
+            ["git", "-C", ROOT, "cat-file", "-e", "06aa966^{commit}"], capture_output=True).returncode != 0:
+        pytest.skip("needs a git checkout holding commit 06aa966")
     if script == "rest_strains_speed.py" and subprocess.run(
             ["git", "-C", ROOT, "merge-base", "HEAD", "main"], capture_output=True).returncode != 0:
         pytest.skip("needs a git checkout with a main branch (the base it measures against)")

@@ -95,6 +95,13 @@ class SystemRunWriter:
         keys = _keys(assembly.rods, "rod")
         if self._resumed is not None:
             self.check(assembly)
+        self._plan(SystemResult(assembly, np.empty(0), np.empty((0, assembly.size)), True, "", {}),
+                   len(self.t_out))
+        if self._resumed is not None:
+            # First list only the chunks kept: the rods roll back to them next, and a new chunk may
+            # replace a dropped one of the same name.
+            write_bodies_view(self.directory, self._parts[1], list(self.chunks))
+            self._write_index(True, "running", {}, complete=False)
             for name, key in keys.items():
                 writer = RunWriter(self.directory / key, resume=True)
                 writer.roll_back(self.restart[0])
@@ -105,11 +112,6 @@ class SystemRunWriter:
         for name, writer in self.rods.items():
             writer.prepare(assembly.rods[name])
             writer.begin(assembly.rods[name], self.t_out)
-        self._plan(SystemResult(assembly, np.empty(0), np.empty((0, assembly.size)), True, "", {}),
-                   len(self.t_out))
-        if self._resumed is not None:  # list only the chunks kept before a new chunk replaces a dropped one
-            write_bodies_view(self.directory, self._parts[1], list(self.chunks))
-            self._write_index(True, "running", {}, complete=False)
 
     def frames(self, t, y):
         """Store the assembled states ``y`` (n, size) at output times ``t`` (n,) as one chunk."""
