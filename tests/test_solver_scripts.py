@@ -201,7 +201,8 @@ def _loops(out):
 def _system_output(out):
     old, new = rows(out / "system_output.csv")
     assert old["version"] == "old" and new["version"] == "new" and old["frames"] == new["frames"]
-    assert new["index_mb"] < 0.1 * old["index_mb"]  # an index of chunk files, not every frame so far
+    assert old["index_last_kb"] > 2 * old["index_first_kb"]  # every frame so far, rewritten at each chunk
+    assert new["index_last_kb"] < 0.1 * old["index_last_kb"]  # an index of chunk files
 
 
 SCRIPTS = {

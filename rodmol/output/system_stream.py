@@ -251,6 +251,8 @@ class SystemRunWriter:
             _, state = h5result.frame_state(self.directory, chunk, row)
         self.chunks, self.t = kept, t[:frames].tolist()
         self.restart, self._resumed = (point, state), info["rods"]
+        for file in run_files.temporaries(self.directory):  # what a writer killed mid-file left
+            file.unlink(missing_ok=True)
 
 
 def _layout(assembly):
