@@ -19,6 +19,7 @@ The Newton systems are solved (``linsolver``) by
 * ``"dense"``: small systems and cross-checks.
 """
 
+import math
 import time
 
 import numpy as np
@@ -38,6 +39,9 @@ KRYLOV_DIM = 5
 #: (scikit-sundae's right-hand side cannot report a recoverable failure) would otherwise retry
 #: ever shorter steps without end; a sound run meets none, or a few in wild Newton iterates.
 NONFINITE_RATES = 200
+#: Right-hand sides between two output frames before their rates are checked: a sound run
+#: takes a few to a few hundred, and is not slowed by the check (2 % of the octopus's).
+WATCHED_AFTER = 1000
 
 
 class _OutOfTime(Exception):
@@ -75,7 +79,8 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
                               "preconditioner leaves their coupling out, and the runs go wrong): use 'sparse'")
     if max_order == "auto":
         max_order = 2 if assembly.lightly_damped else 5
-    evals = [0, 0]  # right-hand sides, and those with non-finite rates since the last output frame
+    # Right-hand sides; those with non-finite rates since the last output frame; the first count then.
+    evals = [0, 0, 0]
     origin = [None]  # the first of those from a finite state: where the rates turned non-finite
 
     def rhs(t, y, yp):
@@ -83,7 +88,7 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
         if max_wall_time is not None and time.perf_counter() - start > max_wall_time:
             raise _OutOfTime
         assembly(t, y, yp)
-        if not np.isfinite(yp.sum()):  # a NaN or inf anywhere makes the sum one
+        if evals[0] - evals[2] > WATCHED_AFTER and not math.isfinite(yp.sum()) and not np.all(np.isfinite(yp)):
             evals[1] += 1
             if origin[0] is None and np.isfinite(y.sum()):  # where they turned so from a finite state
                 origin[0] = _nonfinite(assembly, t, yp)
@@ -129,7 +134,7 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
             message = f"CVODE stopped after t = {reached:.6g} s: {broken}"
             break
         frames.append(np.array(r.y))
-        evals[1], origin[0] = 0, None
+        evals[1:], origin[0] = [0, evals[0]], None
         jac_evals = int(r.njev)
         if progress is not None:
             try:
@@ -161,7 +166,8 @@ def _nonfinite(assembly, t, rates):
             field = next(f for f, entries in fields.items() if entries.start <= part.start + bad[0] < entries.stop)
             where.append(f"body {name!r} ({field})")
     return (f"the rates of {', '.join(where)} were non-finite at t = {t:.6g} s (from a finite state; "
-            f"{NONFINITE_RATES} non-finite right-hand sides since the last output frame): no step can be taken "
+            f"{NONFINITE_RATES} non-finite right-hand sides among the {WATCHED_AFTER + NONFINITE_RATES} or more "
+            "since the last output frame): no step can be taken "
             "(the model gives no finite motion there: a load, an input or a body's property out of range?)")
 
 
