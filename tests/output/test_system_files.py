@@ -117,3 +117,18 @@ def test_every_part_gets_its_own_file_name_and_none_is_the_runs_own():
         keys = _keys(names, "rod")
         assert len(set(keys.values())) == len(names) and not set(keys.values()) & set(SYSTEM), keys
         assert all(keys[n] == n for n in names if n.isidentifier() and n not in SYSTEM)
+
+
+def test_a_result_read_back_is_written_again_as_it_was(written, tmp_path):
+    """write_series of a SystemResult without its System (read from files): the same frames, the
+    bodies drawn from their stored surfaces, the views showing every 3rd frame and the last."""
+    result, out = written
+    rodmol.write_series(rodmol.load_result(out), tmp_path, every=3)
+    again = rodmol.load_result(tmp_path)
+    assert again.success and np.array_equal(again.states, result.states)
+    for field in ("position", "quaternion", "velocity", "angular_velocity"):
+        assert np.array_equal(getattr(again["head"], field), getattr(result["head"], field)), field
+    assert np.array_equal(again["head"].surface[1], body_surface(result.assembly.bodies["head"].body)[1])
+    grids = (tmp_path / "frames" / "chunk_000000.xmf").read_text().count('<Grid Name="head" GridType="Uniform">')
+    assert grids == 2  # frames 0 and 3 of 4
+    assert np.array_equal(again["right"].positions, rodmol.load_result(out)["right"].positions)
