@@ -160,11 +160,17 @@ def test_a_forced_resume_goes_on_with_the_changed_system(two_arms, whole, tmp_pa
 
 
 def test_the_command_line_resumes_a_system_anyway(tmp_path, killed_system, capsys):
+    import h5py
+
     from rodmol.cli.commands import main
 
     scenario = Path(__file__).parents[2] / "examples" / "two_arms.toml"
+    assert main(["run", str(scenario), "--out", str(tmp_path), "--chunk-frames", "4", "--t-end", "0.3",
+                 "--quiet"]) == 0
+    with h5py.File(tmp_path / "system.h5") as index:  # the option's chunks: frames 0-4, 5-6
+        assert list(index["chunk_frames"][()]) == [5, 2]
     spec = rodmol.load_scenario(scenario)
-    killed_system(spec.simulate, tmp_path, 1, chunk_frames=4)  # 11 frames: frames 0-4 kept
+    killed_system(spec.simulate, tmp_path, 1, chunk_frames=4, overwrite=True)  # 11 frames: frames 0-4 kept
     assert main(["run", str(scenario), "--out", str(tmp_path), "--resume", "--scheme", "upwind", "--quiet"]) == 2
     assert "scheme: the run 'centred', this call 'upwind'" in capsys.readouterr().err
     assert main(["run", str(scenario), "--out", str(tmp_path), "--resume-anyway", "--scheme", "upwind",
