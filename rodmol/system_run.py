@@ -106,7 +106,8 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
     atol = rtol * assembly.atol_scale() if atol is None else _sized("atol", atol, assembly.size)
     if np.any(atol <= 0):
         raise ParameterError("`atol` must be > 0")
-    settings = _settings.record_system(assembly, backend=backend, rtol=rtol, atol=asked_atol,
+    settings = _settings.record_system(assembly, backend=backend, rtol=rtol,
+                                       atol=None if asked_atol is None else atol,
                                        backend_options=backend_options,
                                        initial=recorded.get("initial") if resume else
                                        "straight" if initial is None else initial)
