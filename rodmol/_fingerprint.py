@@ -33,6 +33,19 @@ def model_fingerprint(model):
     return fingerprint((type(model), model.rod, model.options()))
 
 
+def system_fingerprints(system):
+    """The fingerprints of a :class:`rodmol.System`'s parts, by name (``"rod 'NAME'"``,
+    ``"body 'NAME'"``, ``"joints"``, ``"medium"``, ``"gravity"``): each rod's
+    :func:`model_fingerprint` (its grid compared apart; its Model carries the system's
+    gravity, medium and penalty joints' holds), each body's and the system-wide ones, so that a
+    resumed run can say which part changed."""
+    parts = {f"rod {name!r}": model_fingerprint(model) for name, model in system.rods.items()}
+    parts.update({f"body {name!r}": fingerprint(body) for name, body in system.bodies.items()})
+    parts.update(joints=fingerprint(tuple(system.joints)), medium=fingerprint(system.medium),
+                 gravity=fingerprint(system.gravity))
+    return parts
+
+
 def _name(obj):
     return f"{getattr(obj, '__module__', '?')}.{getattr(obj, '__qualname__', type(obj).__qualname__)}"
 

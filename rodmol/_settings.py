@@ -7,17 +7,21 @@ another value, unless it forces the resume (``resume="force"``, the command
 line's ``--resume-anyway``). The grid and the output times cannot be
 forced: the frames kept fix them (the grid is :func:`check_grid`'s, checked
 once, before anything is sized by it). Each takes what the run's system owns.
+A :class:`rodmol.System`'s run records the same settings
+(:func:`record_system`), its model as the fingerprints of its parts, so that a
+refusal names the parts that changed.
 """
 
 import json
 
 import numpy as np
 
-from ._fingerprint import fingerprint, model_fingerprint
+from ._fingerprint import fingerprint, model_fingerprint, system_fingerprints
 from .errors import ParameterError
 
 #: The recorded settings, in the order messages name them, with how a message names each.
 NAMES = {"n_elements": "number of elements N (the grid)", "model": "model (fingerprint of its parameters)",
+         "system": "system (fingerprints of its parts)",
          "scheme": "scheme", "backend": "backend", "rtol": "rtol", "atol": "atol",
          "backend_options": "backend options", "initial": "initial state"}
 
@@ -27,8 +31,19 @@ def record(system, *, backend, rtol, atol, backend_options, initial):
     as JSON values: ``atol`` None for :func:`rodmol.simulate.default_atol` or the per-entry
     array, ``initial`` a name or the state vector (recorded as its fingerprint)."""
     return dict(n_elements=int(system.layout.n_blocks), model=model_fingerprint(system.model),
-                scheme=str(system.scheme.name),
-                backend=str(backend), rtol=float(rtol),
+                **_solver(system.scheme, backend, rtol, atol, backend_options, initial))
+
+
+def record_system(assembly, *, backend, rtol, atol, backend_options, initial):
+    """The settings of a run of a :class:`rodmol.System` (its ``Assembly``): as :func:`record`'s,
+    with the fingerprints of the system's parts (:func:`rodmol._fingerprint.system_fingerprints`)
+    for the model's; the rods' grids fix the state's layout, which the run's index compares."""
+    return dict(system=system_fingerprints(assembly.system),
+                **_solver(assembly.scheme, backend, rtol, atol, backend_options, initial))
+
+
+def _solver(scheme, backend, rtol, atol, backend_options, initial):
+    return dict(scheme=str(scheme.name), backend=str(backend), rtol=float(rtol),
                 atol=None if atol is None else np.asarray(atol, dtype=float).tolist(),
                 backend_options=json.loads(json.dumps(dict(backend_options), default=repr)),
                 initial=initial if isinstance(initial, str) else
@@ -67,13 +82,27 @@ def check(recorded, current, force, where):
     than ``recorded``, unless ``force``; returns the differences, described (for the record
     of a forced resume). The grid, which cannot be forced, is :func:`check_grid`'s."""
     found = differences(recorded, current)
-    said = [f"{NAMES[key]}: the run {_show(key, run)}, this call {_show(key, now)}" for key, run, now in found]
+    said = [_said(key, run, now) for key, run, now in found]
     if found and not force:
         raise ParameterError(
             f"cannot resume the run in {where} with other settings than it was made with:\n  "
             + "\n  ".join(said) + "\nleave them out of the call (or the scenario) to continue with the run's, "
             "or force it: simulate(..., resume='force'), on the command line `--resume-anyway`")
     return said
+
+
+def _said(key, run, now):
+    """How a refusal names the setting ``key`` that differs: the run's value and this call's
+    (for a system, the parts whose fingerprints differ)."""
+    if key == "system":
+        changed = [part for part in {**run, **now} if run.get(part) != now.get(part)]
+        gone = [part for part in changed if part not in now]
+        new = [part for part in changed if part not in run]
+        kept = [part for part in changed if part in run and part in now]
+        text = "; ".join(f"{what} {', '.join(parts)}" for what, parts in
+                         (("changed:", kept), ("not in this call's system:", gone), ("new:", new)) if parts)
+        return f"{NAMES[key]}: {text}"
+    return f"{NAMES[key]}: the run {_show(key, run)}, this call {_show(key, now)}"
 
 
 def _show(key, value):

@@ -8,15 +8,18 @@ chunked run (:func:`rodmol.solve.chunked.run_chunked`) into the sink
 (:class:`rodmol.output.system_stream.SystemRunWriter`), and ``resume=True``
 continues a killed run from its last restart point.
 
-``resume="force"`` is refused for systems (their model is not fingerprinted
-yet). ``progress`` is reported at the output times only.
+A resumed run takes the settings it recorded (:mod:`rodmol._settings`,
+:func:`~rodmol._settings.record_system`: the fingerprints of the system's
+parts, the scheme, tolerances and backend options) wherever the call gives
+none, and refuses other values, or a changed system, naming each, unless
+``resume="force"``. ``progress`` is reported at the output times only.
 """
 
 import warnings
 
 import numpy as np
 
-from . import _checks, run_sinks
+from . import _checks, _settings, run_sinks
 from .discretise.assembly import Assembly
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
 from .errors import ParameterError
@@ -45,15 +48,18 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
     arguments as for :func:`rodmol.simulate`. With ``out``, the frames are
     streamed chunk by chunk (:mod:`rodmol.output.system_stream`) and
     ``resume=True`` continues a killed or interrupted run there from its last
-    restart point, with its recorded settings where the call gives none.
-    Returns a :class:`rodmol.system_result.SystemResult`."""
-    if resume is not True and resume is not False:
-        raise ParameterError(f"`resume` must be False or True for a system, got {_checks.short(resume)}")
+    restart point, with its recorded settings where the call gives none;
+    other settings or a changed system (any rod's model, body, joint, the
+    medium or gravity) are refused naming each, unless ``resume="force"``
+    (not another grid or other output times). Returns a
+    :class:`rodmol.system_result.SystemResult`."""
+    if not (resume is True or resume is False or (isinstance(resume, str) and resume == "force")):
+        raise ParameterError(f"`resume` must be False, True or 'force', got {_checks.short(resume)}")
     if out is None and (overwrite is not False or resume):
         raise ParameterError("`overwrite` and `resume=True` need `out`, the run's directory")
     if resume and overwrite:
         raise ParameterError("give either `resume` or `overwrite=True`, not both")
-    sink, first = None, 0
+    sink, first, recorded = None, 0, {}
     if resume:  # the run's directory first: its settings fill in what the call leaves out
         sink = _sink(out, True, False)
         recorded = sink.settings or {}
@@ -62,9 +68,11 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
         rtol = recorded.get("rtol") if rtol is None else rtol
         atol = recorded.get("atol") if atol is None else atol
         backend = recorded.get("backend") if backend is None else backend
-        backend_options = backend_options or recorded.get("backend_options") or {}
+        if not backend_options and backend == recorded.get("backend"):  # (another backend: its own)
+            backend_options = recorded.get("backend_options") or {}
         first, initial = sink.restart[0], sink.restart[1]
         t0 = float(sink.t_out[first])
+    asked_atol = atol  # None: the default, rtol times the parts' scales (recorded as None)
     backend = "cvode" if backend is None else backend
     run = cvode_system if backend == "cvode" else get_backend(backend)
     checked = options.backend_options(backend, run, backend_options)
@@ -98,14 +106,17 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
     atol = rtol * assembly.atol_scale() if atol is None else _sized("atol", atol, assembly.size)
     if np.any(atol <= 0):
         raise ParameterError("`atol` must be > 0")
+    settings = _settings.record_system(assembly, backend=backend, rtol=rtol,
+                                       atol=None if asked_atol is None else atol,
+                                       backend_options=backend_options,
+                                       initial=recorded.get("initial") if resume else
+                                       "straight" if initial is None else initial)
+    forced = _settings.check(recorded, settings, resume == "force", repr(str(getattr(sink, "directory", sink)))) \
+        if recorded else []
     if out is not None and sink is None:  # after every check: with `overwrite`, this clears the earlier run
         sink = _sink(out, False, bool(overwrite))
     if sink is not None:
-        getattr(sink, "record_settings", lambda settings: None)(
-            dict(scheme=scheme.name, rtol=rtol, atol=atol.tolist(), backend=backend,
-                 backend_options=dict(backend_options),
-                 initial=recorded.get("initial") if resume else
-                 "straight" if initial is None else initial if isinstance(initial, str) else "state"))
+        getattr(sink, "record_settings", lambda settings, forced: None)(settings, forced)
     owned = progress is True
     if owned:
         from ._progress import Progress

@@ -212,6 +212,13 @@ def _body_joints(out):
     assert all(row["max_drift_over_L"] < 1e-3 for row in table if row["factor"] == 1.0), table
 
 
+def _system_output(out):
+    old, new = rows(out / "system_output.csv")
+    assert old["version"] == "old" and new["version"] == "new" and old["frames"] == new["frames"]
+    assert old["index_last_kb"] > 2 * old["index_first_kb"]  # every frame so far, rewritten at each chunk
+    assert new["index_last_kb"] < 0.1 * old["index_last_kb"]  # an index of chunk files
+
+
 SCRIPTS = {
     "scaling.py": (["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"], _scaling),
     "temporal.py": (["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv", "temporal_options.csv"],
@@ -239,6 +246,7 @@ SCRIPTS = {
     "loops.py": (["loops.csv", "loops.md"], _loops),
     "body_contact.py": (["body_contact.csv", "body_contact.md"], _body_contact),
     "body_joints.py": (["body_joints.csv", "body_joints.md"], _body_joints),
+    "system_output.py": (["system_output.csv", "system_output.md"], _system_output),
 }
 
 
@@ -248,6 +256,9 @@ def test_script_smoke_run(script, tmp_path):
     if script == "core_speed.py" and subprocess.run(
             ["git", "-C", ROOT, "cat-file", "-e", "9fce6d7^{commit}"], capture_output=True).returncode != 0:
         pytest.skip("needs a git checkout holding commit 9fce6d7")
+    if script == "system_output.py" and subprocess.run(
+            ["git", "-C", ROOT, "cat-file", "-e", "06aa966^{commit}"], capture_output=True).returncode != 0:
+        pytest.skip("needs a git checkout holding commit 06aa966")
     if script == "rest_strains_speed.py" and subprocess.run(
             ["git", "-C", ROOT, "merge-base", "HEAD", "main"], capture_output=True).returncode != 0:
         pytest.skip("needs a git checkout with a main branch (the base it measures against)")

@@ -191,7 +191,7 @@ def test_progress_sees_every_output_and_the_wall_time_budget_stops_the_run():
 
 @pytest.mark.parametrize("kwargs, match", [
     (dict(resume=True), "need `out`"),
-    (dict(resume="force"), "`resume` must be False or True"),
+    (dict(resume="force"), "need `out`"),
     (dict(backend="rk45"), "unknown `backend` 'rk45'"),
     (dict(linsolver="band"), "linsolver"),
     (dict(krylov_dim=3), "unknown option"),

@@ -28,11 +28,12 @@ from pathlib import Path
 from .._files import output_directory
 from .._progress import Progress
 from .._version import __version__
-from ..errors import NotSupportedYet, ParameterError
+from ..errors import ParameterError
 from ..output import h5result
 from ..output.formats import FORMATS, get_format
 from ..output.lock import OutputLock
 from ..output.run_files import cannot_write
+from ..output.system_stream import SystemRunWriter
 from ..systems import System
 from .options import EXAMPLES, add_run_options, load_spec
 
@@ -111,21 +112,24 @@ def _run(args):
 
 def _run_system(args, spec, out):
     """``rodmol run`` of a system file: the run, its files streamed while it goes (``--resume``
-    continues a killed one)."""
-    if args.resume_anyway:
-        raise NotSupportedYet("`--resume-anyway` is not supported yet for systems: use `--resume` (with the "
-                              "run's own settings)")
+    continues a killed one with its recorded settings, ``--resume-anyway`` with the file's)."""
     if (args.format or spec.output.format) != "xdmf":
         raise ParameterError("a system's run is written as `--format xdmf` only")
     say = (lambda *a, **k: None) if args.quiet else print
     system = spec.model
     say(f"rodmol: {spec.name}: {len(system.rods)} rods, {len(system.bodies)} bodies, t_end = {spec.t_end:g} s, "
         f"{spec.solver['scheme']} scheme -> {out}")
+    resume, sink = "force" if args.resume_anyway else bool(args.resume), out
+    if resume and args.overwrite:
+        raise ParameterError("give either `--resume` or `--overwrite`, not both")
+    if not resume:  # the file's chunks and views (a resumed run keeps its own)
+        chunk_frames = spec.output.chunk_frames if args.chunk_frames is None else args.chunk_frames
+        sink = SystemRunWriter(out, chunk_frames=chunk_frames, every=spec.output.every, overwrite=args.overwrite)
     progress = None if args.quiet else Progress(stream=sys.stdout)
     started = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # the summary gives the message
-        result = spec.simulate(progress=progress, out=out, overwrite=args.overwrite, resume=bool(args.resume))
+        result = spec.simulate(progress=progress, out=sink, resume=resume)
     if progress:
         progress.close()
     state = "finished" if result.success else f"failed: {result.message}"

@@ -28,7 +28,7 @@ from . import (
     run_files,
     stream,
     system_files,
-    system_stream,  # noqa: F401  (registers the sink of a System's out=DIR)
+    system_stream,  # (also registers the sink of a System's out=DIR)
     writers,
 )
 
@@ -88,7 +88,7 @@ def get_format(name, what="format"):
 
 def write_series(result, directory, every=None, format=DEFAULT):
     """Write a finished :class:`rodmol.Result` (or a system's ``SystemResult``:
-    :func:`rodmol.output.system_files.write_system`) for ParaView into ``directory``.
+    :func:`rodmol.output.system_stream.write_system`) for ParaView into ``directory``.
 
     ``format="xdmf"`` (default): ``result.h5`` and the XDMF views
     (:class:`rodmol.output.stream.RunWriter`), returns the path of ``rod.xdmf``;
@@ -102,7 +102,7 @@ def write_series(result, directory, every=None, format=DEFAULT):
     if isinstance(result, SystemResult):  # each rod's files as a single rod's, the bodies', the index
         if entry.name != "xdmf":
             raise ParameterError(f"a system's result is written as 'xdmf' only, got `format` {format!r}")
-        return system_files.write_system(result, directory, every)
+        return system_stream.write_system(result, directory, every)
     return entry.write(result, output_directory(directory, "directory"), every)
 
 

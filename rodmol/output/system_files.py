@@ -1,39 +1,48 @@
-"""The files of a system's run (several rods and rigid bodies), written once it ended.
+"""The files of a system's run (several rods and rigid bodies).
 
 A system's run directory (``simulate(system, ..., out=DIR)``,
 :func:`rodmol.write_series` of a :class:`~rodmol.system_result.SystemResult`) holds
 
-* ``system.h5``: the output times ``t``, the assembled ``states``, each
-  body's frames (group ``bodies/KEY``: ``position`` [m] and ``quaternion``
+* ``system.h5``: the index, small, replaced atomically after every chunk:
+  the planned output times ``t_out``, the times reached ``t``, the chunk
+  files in order (``chunks``, ``chunk_frames``), each body's drawn surface
+  (group ``bodies/KEY``: ``surface_points`` [m], body frame, and
+  ``surface_triangles``) and, as JSON in the attribute ``info``,
+  ``success``, ``message``, ``stats``, ``complete``, the parts' names with
+  their keys and their slices of the state (``parts``), and for a run of
+  ``simulate`` its ``settings`` (:func:`rodmol._settings.record_system`);
+* ``frames/chunk_NNNNNN.h5``: the frames of one chunk: ``t``, the assembled
+  ``states`` and each body's ``bodies/KEY/position`` [m] and ``quaternion``
   (body to global), ``velocity`` [m/s] and ``angular_velocity`` [rad/s],
-  body frame) and, as JSON in the attribute ``info``, ``success``,
-  ``message``, ``stats`` and the parts' names with their keys; in the group
-  ``view``, each body's drawn surface (``KEY_triangles``) and its points at
-  the shown frames (``KEY_points``, global);
+  body frame; in the group ``view``, each body's triangles and its points at
+  the shown frames (``KEY_points``, global, single precision); and
+  ``frames/chunk_NNNNNN.xmf``, the bodies' grids of its shown frames. Each is
+  written under a temporary name and renamed when complete, and never
+  changed after (:mod:`rodmol.output.h5result`'s chunk files);
 * ``bodies.xdmf``: the bodies for ParaView, one temporal collection each,
-  drawn as their mesh (:meth:`rodmol.RigidBody.from_mesh`) or, without one, as
-  the ellipsoid of uniform density with their mass and inertia, at their pose;
+  including every chunk's grids, drawn as their mesh
+  (:meth:`rodmol.RigidBody.from_mesh`) or, without one, as the ellipsoid of
+  uniform density with their mass and inertia, at their pose;
 * a folder per rod, named after it: that rod's run directory exactly as a
   single rod's (``result.h5``, ``rod.xdmf``, ``cables.xdmf``, ``markers.xdmf``;
   :mod:`rodmol.output.stream`).
 
-``simulate(system, ..., out=DIR)`` streams it while the run goes
-(:mod:`rodmol.output.system_stream`); :func:`write_system` writes a finished
-result at once.
+So writing a chunk costs the same at any length of the run. ``simulate(system,
+..., out=DIR)`` streams it while the run goes, and :func:`rodmol.write_series`
+writes a finished result at once (:mod:`rodmol.output.system_stream`).
+:func:`read_system` also reads the single ``system.h5`` of an older rodmol
+(every frame in the index).
 """
 
-import html
 import json
 import re
 from pathlib import Path
 
 import numpy as np
 
-from .._files import output_directory
 from ..errors import ParameterError
 from ..system_result import BodyResult, SystemResult
-from . import h5result, stream, xdmf
-from .parts import view_step
+from . import h5result, xdmf
 from .run_files import SYSTEM
 
 INDEX, BODIES_VIEW = SYSTEM
@@ -84,56 +93,67 @@ def surface_of(result, name):
     return result[name].surface
 
 
-def write_system(result, directory, every=None):
-    """Write a finished :class:`SystemResult` into ``directory`` (see the module),
-    replacing an earlier run there; returns the path of ``system.h5``.
-    ``every``: show every n-th frame in the views (and the last)."""
-    directory = output_directory(directory, "directory")
-    rods = _keys(result.rods, "rod")
-    for name, key in rods.items():
-        stream.write_xdmf(result[name], directory / key, every)
-    return write_index(directory, result, view_step(len(result.t), every))
+def chunk_batch(result, frames, shown, surfaces, keys):
+    """The datasets of a chunk file (:func:`rodmol.output.h5result.write_chunk`) holding the frames
+    ``frames`` (a slice) of the SystemResult ``result``: ``t``, ``states``, each body's fields and,
+    for the views, its triangles and its points at the chunk's frames ``shown`` (indices into the
+    chunk), placed by its pose; ``surfaces`` and ``keys``: each body's drawn surface and file key."""
+    batch = {"t": result.t[frames], "states": result.states[frames]}
+    for name, key in keys.items():
+        body = result[name]
+        for field in BODY_FIELDS:
+            batch[f"bodies/{key}/{field}"] = getattr(body, field)[frames]
+        points, triangles = surfaces[name]
+        position, rotation = body.position[frames][shown], body.rotation[frames][shown]
+        batch[f"{h5result.VIEW_GROUP}/{key}_triangles"] = triangles
+        batch[f"{h5result.VIEW_GROUP}/{key}_points"] = position[:, None, :] + np.einsum("nij,pj->npi", rotation,
+                                                                                         points)
+    return batch
 
 
-def write_index(directory, result, step, **extra):
-    """Write ``system.h5`` and ``bodies.xdmf`` of the SystemResult ``result`` (with its
-    assembly) into ``directory``, the views showing every ``step``-th frame and the last;
-    ``extra`` goes into the index's ``info`` (a streamed run's plan and settings).
-    Returns the path of ``system.h5``."""
-    rods, bodies = _keys(result.rods, "rod"), _keys(result.bodies, "body")
-    t = result.t
-    shown = sorted(set(range(0, len(t), step)) | {len(t) - 1})
-    surfaces = {name: surface_of(result, name) for name in result.bodies}
-    info = dict(format=FORMAT, success=bool(result.success), message=str(result.message),
-                stats=_plain(result.stats), rods=rods, bodies=bodies, shown=shown, **extra)
+def write_views(directory, chunk, t, surfaces, keys, chunks):
+    """Write the bodies' grids of the chunk file ``chunk`` at its shown times ``t`` (its ``.xmf``
+    fragment), then ``bodies.xdmf`` including the fragments of every chunk in ``chunks``."""
+    grids = {key: xdmf.body_grids(chunk, t, key, len(surfaces[name][0]), len(surfaces[name][1]))
+             for name, key in keys.items()}
+    xdmf.write_fragment(directory / _fragment(chunk), xdmf.fragment(grids))
+    write_bodies_view(directory, keys, chunks)
+
+
+def write_bodies_view(directory, keys, chunks):
+    """Write ``bodies.xdmf``: each body's temporal collection, including its grids from the
+    fragment of every chunk file in ``chunks``."""
+    xdmf.write_collections(directory / BODIES_VIEW, keys, [_fragment(c) for c in chunks])
+
+
+def _fragment(chunk):
+    return chunk[:-3] + ".xmf"
+
+
+def write_index(directory, t_out, t, chunks, info, surfaces, keys):
+    """Replace ``system.h5`` (see the module): planned and reached times [s], the chunk files
+    (name -> frames), ``info`` (JSON) and the bodies' drawn ``surfaces`` under their ``keys``."""
+    import h5py
 
     def fill(handle):
         handle.attrs["format"] = FORMAT
-        handle.attrs["info"] = json.dumps(info)
-        handle.create_dataset("t", data=t)
-        handle.create_dataset("states", data=result.states)
-        for name, key in bodies.items():
-            body = result[name]
-            for field in BODY_FIELDS:
-                handle.create_dataset(f"bodies/{key}/{field}", data=getattr(body, field))
-            if name in surfaces:
-                points, triangles = surfaces[name]
-                handle.create_dataset(f"bodies/{key}/{SURFACE[0]}", data=points)
-                handle.create_dataset(f"bodies/{key}/{SURFACE[1]}", data=triangles)
-                placed = body.position[shown, None, :] + np.einsum("nij,pj->npi", body.rotation[shown], points)
-                handle.create_dataset(f"{h5result.VIEW_GROUP}/{key}_triangles", data=triangles)
-                handle.create_dataset(f"{h5result.VIEW_GROUP}/{key}_points", data=placed, dtype=h5result.VIEW)
+        handle.attrs["info"] = json.dumps(dict(info, format=FORMAT))
+        handle.create_dataset("t_out", data=np.asarray(t_out, dtype=float))
+        handle.create_dataset("t", data=np.asarray(t, dtype=float))
+        handle.create_dataset("chunks", data=[c.encode() for c in chunks], dtype=h5py.string_dtype())
+        handle.create_dataset("chunk_frames", data=np.asarray(list(chunks.values()), dtype=np.int64))
+        for name, key in keys.items():
+            for field, value in zip(SURFACE, surfaces[name]):
+                handle.create_dataset(f"bodies/{key}/{field}", data=value)
 
-    h5result.atomic_h5(directory / INDEX, fill)
-    grids = {html.escape(name, quote=True): xdmf.body_grids(INDEX, t[shown], key, len(surfaces[name][0]),
-                                                           len(surfaces[name][1]))
-             for name, key in bodies.items()}
-    xdmf.write_fragment(directory / BODIES_VIEW, xdmf.fragment(grids))
-    return directory / INDEX
+    h5result.atomic_h5(Path(directory) / INDEX, fill)
+    return Path(directory) / INDEX
 
 
 def read_info(directory):
-    """(info, t, states) of the index ``system.h5`` in ``directory`` (a damaged file: a ParameterError)."""
+    """The index ``system.h5`` in ``directory``: dict of ``info``, ``t``, ``t_out`` (None if it
+    has none), ``chunks`` (name -> frames; None for an older rodmol's index, which holds every
+    frame) and the bodies' ``surfaces`` (key -> (points, triangles)); a damaged file: a ParameterError."""
     import h5py
 
     path = Path(directory) / INDEX
@@ -142,31 +162,42 @@ def read_info(directory):
             info = json.loads(handle.attrs["info"])
             if info.get("format") != FORMAT:
                 raise ParameterError(f"{str(path)!r} is not the index of a system's run")
-            return info, handle["t"][()], handle["states"][()]
+            index = dict(info=info, t=handle["t"][()], t_out=handle["t_out"][()] if "t_out" in handle else None,
+                         chunks=None)
+            if "chunks" in handle:
+                names = [c.decode() if isinstance(c, bytes) else str(c) for c in handle["chunks"][()]]
+                index["chunks"] = dict(zip(names, handle["chunk_frames"][()].tolist()))
+            index["surfaces"] = {key: tuple(handle[f"bodies/{key}/{f}"][()] for f in SURFACE)
+                                 for key in info["bodies"].values() if f"bodies/{key}/{SURFACE[0]}" in handle}
+            if index["chunks"] is None:  # an older rodmol's index: the frames are in it
+                index["frames"] = dict(states=handle["states"][()], **{
+                    f"bodies/{key}/{f}": handle[f"bodies/{key}/{f}"][()]
+                    for key in info["bodies"].values() for f in BODY_FIELDS})
     except (OSError, KeyError, ValueError) as exc:
         raise h5result.damaged(path, exc) from exc
+    return index
+
+
+def read_series(directory, index, name):
+    """The dataset ``name`` of every frame listed in the ``index`` (:func:`read_info`), in time order."""
+    if index["chunks"] is None:
+        return index["frames"][name]
+    if not index["chunks"]:
+        return np.zeros((0,))
+    return h5result.read_series(directory, list(index["chunks"]), name)
 
 
 def read_system(directory):
-    """The :class:`SystemResult` of a system's run directory (its rods read on first access)."""
-    import h5py
-
+    """The :class:`SystemResult` of a system's run directory (its rods and bodies read on first access)."""
     directory = Path(directory)
-    path = directory / INDEX
-    try:
-        with h5py.File(path, "r") as handle:
-            info = json.loads(handle.attrs["info"])
-            if info.get("format") != FORMAT:
-                raise ParameterError(f"{str(path)!r} is not the index of a system's run")
-            t, states = handle["t"][()], handle["states"][()]
-            fields = {key: {f: handle[f"bodies/{key}/{f}"][()] for f in BODY_FIELDS + SURFACE
-                            if f"bodies/{key}/{f}" in handle}
-                      for key in info["bodies"].values()}
-    except (OSError, KeyError, ValueError) as exc:
-        raise h5result.damaged(path, exc) from exc
+    index = read_info(directory)
+    info, t = index["info"], index["t"]
+    states = read_series(directory, index, "states")
     rods = {name: (lambda key=key: h5result.read_result(directory / key / h5result.INDEX))
             for name, key in info["rods"].items()}
-    bodies = {name: (lambda key=key: _body(t, fields[key])) for name, key in info["bodies"].items()}
+    bodies = {name: (lambda key=key: _body(t, {f: read_series(directory, index, f"bodies/{key}/{f}")
+                                               for f in BODY_FIELDS}, index["surfaces"].get(key)))
+              for name, key in info["bodies"].items()}
     message = info["message"]
     if not info.get("complete", True):
         message = (f"the run was stopped before it finished (killed?): {len(t)} frames up to t = "
@@ -175,10 +206,9 @@ def read_system(directory):
                         saved=(rods, bodies))
 
 
-def _body(t, fields):
+def _body(t, fields, surface):
     body = BodyResult(t, *(fields[f] for f in BODY_FIELDS))
-    if SURFACE[0] in fields:
-        body.surface = (fields[SURFACE[0]], fields[SURFACE[1]])
+    body.surface = surface
     return body
 
 
@@ -190,10 +220,11 @@ def is_system(path):
 
 def _keys(names, kind):
     """{name: key}: a file name for each part: its own name if that is a plain one
-    and not the run's own files' (``system.h5``, ``bodies.xdmf``), else ``kind_i``
+    and not the run's own files' (``system.h5``, ``bodies.xdmf``, ``frames``), else ``kind_i``
     (i its index), made unique against every other key."""
-    plain = [n for n in names if re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.-]*", n) and n not in SYSTEM]
-    keys, taken = {}, set(plain) | set(SYSTEM)
+    reserved = (*SYSTEM, h5result.FRAMES)
+    plain = [n for n in names if re.fullmatch(r"[A-Za-z0-9_][A-Za-z0-9_.-]*", n) and n not in reserved]
+    keys, taken = {}, set(plain) | set(reserved)
     for i, name in enumerate(names):
         if name in plain and name not in keys.values():
             keys[name] = name

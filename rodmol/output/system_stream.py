@@ -7,18 +7,20 @@ rod's run) and, for each chunk,
 * hands each rod's frames to that rod's :class:`rodmol.output.stream.RunWriter`
   (``DIR/NAME/``, a single rod's run directory, streamed as one), waits until
   they are on disk,
-* then rewrites ``system.h5`` and ``bodies.xdmf`` (:func:`rodmol.output.system_files.write_index`)
-  with every frame so far, the planned output times, ``chunk_frames`` and the run's settings.
+* then writes the chunk's own file (``frames/chunk_NNNNNN.h5``: the assembled
+  states and the bodies' frames), its bodies' grids and ``bodies.xdmf``, and
+  last replaces the small index ``system.h5`` listing it
+  (:mod:`rodmol.output.system_files`).
 
-``system.h5`` is written last, so it never lists a frame a rod's files lack:
-it is what a resumed run (``resume=True``) restarts from, at its last restart
-point (a frame index that is a multiple of ``chunk_frames``), rolling every
-rod's directory back to that frame. A run killed at any moment leaves a
-directory that :func:`rodmol.load_result` reads up to the last chunk its
-``system.h5`` lists (a rod's own files may hold one chunk more).
-
-Unlike a rod's chunks, ``system.h5`` holds every frame so far (the assembled
-states and the bodies' frames): it is rewritten, atomically, at each chunk.
+Each file appears complete under its real name or not at all, and
+``system.h5`` is written last, so it never lists a frame a rod's files or
+its chunk files lack: it is what a resumed run (``resume=True``) restarts
+from, at its last restart point (a frame index that is a multiple of
+``chunk_frames``), rolling every rod's directory back to that frame. A run
+killed at any moment leaves a directory that :func:`rodmol.load_result`
+reads up to the last chunk its ``system.h5`` lists (a rod's own files may
+hold one chunk more). Writing a chunk costs the same at any length of the
+run, and the writer keeps no frames of the chunks before (only their times).
 """
 
 import numpy as np
@@ -27,10 +29,23 @@ from .. import run_sinks
 from .._files import output_directory
 from ..errors import ParameterError
 from ..system_result import SystemResult
-from . import run_files
+from . import h5result, run_files, stream
 from .parts import view_step
+from .run_record import damaged
 from .stream import CHUNK_FRAMES, RunWriter
-from .system_files import INDEX, _keys, read_info, read_system, write_index
+from .system_files import (
+    INDEX,
+    _keys,
+    _plain,
+    chunk_batch,
+    read_info,
+    read_series,
+    read_system,
+    surface_of,
+    write_bodies_view,
+    write_index,
+    write_views,
+)
 
 
 class SystemRunWriter:
@@ -43,8 +58,8 @@ class SystemRunWriter:
         Output frames per chunk; the solver restarts at every chunk boundary
         (the restart points of ``resume``).
     every : int, optional
-        The views show every ``every``-th output frame (and the last);
-        default as for a single rod (:func:`rodmol.output.parts.view_step`).
+        The views show every ``every``-th output frame (and the last of each
+        chunk); default as for a single rod (:func:`rodmol.output.parts.view_step`).
     resume : bool
         Continue the unfinished run in ``directory`` from its last restart
         point (:attr:`restart`), with its own ``chunk_frames`` and ``every``.
@@ -58,9 +73,10 @@ class SystemRunWriter:
             raise ParameterError(f"`every` and `chunk_frames` must be >= 1, got {every!r}, {chunk_frames!r}")
         self.directory = output_directory(directory, "out")
         self.chunk_frames, self.every = int(chunk_frames), None if every is None else int(every)
-        self.assembly, self.rods, self.t_out, self.settings = None, {}, None, None
-        self.t, self.states = [], []  # the frames listed in system.h5, chunk by chunk
-        self.restart, self._resumed = None, None
+        self.assembly, self.rods, self.t_out, self.settings, self.forced = None, {}, None, None, []
+        self.t, self.chunks = [], {}  # the times listed in system.h5, and its chunk files (name -> frames)
+        self.restart, self._resumed, self._layout = None, None, None
+        self._parts = None  # (rod keys, body keys, body surfaces, the parts' slices) of the run
         if resume:
             self._reopen()
         else:
@@ -79,6 +95,13 @@ class SystemRunWriter:
         keys = _keys(assembly.rods, "rod")
         if self._resumed is not None:
             self.check(assembly)
+        self._plan(SystemResult(assembly, np.empty(0), np.empty((0, assembly.size)), True, "", {}),
+                   len(self.t_out))
+        if self._resumed is not None:
+            # First list only the chunks kept: the rods roll back to them next, and a new chunk may
+            # replace a dropped one of the same name.
+            write_bodies_view(self.directory, self._parts[1], list(self.chunks))
+            self._write_index(True, "running", {}, complete=False)
             for name, key in keys.items():
                 writer = RunWriter(self.directory / key, resume=True)
                 writer.roll_back(self.restart[0])
@@ -96,9 +119,7 @@ class SystemRunWriter:
         for name, writer in self.rods.items():
             writer.store(chunk[name])
         self.flush()  # the rods' frames on disk before system.h5 lists them
-        self.t.append(chunk.t)
-        self.states.append(chunk.states)
-        self._write_index(True, "running", {}, complete=False)
+        self.store(chunk)
 
     def flush(self):
         """Wait until every rod's chunks stored so far are on disk (an ``OSError`` if one failed)."""
@@ -106,45 +127,94 @@ class SystemRunWriter:
             writer.flush()
 
     def end(self, success, message, stats):
-        """Finish every rod's files and the index; returns the run's SystemResult (in memory)."""
+        """Finish every rod's files and the index; returns the run's SystemResult (its states
+        read back from the chunk files)."""
         for writer in self.rods.values():
             writer.end(success, message, stats)
-        return self._write_index(success, message, stats, complete=True)
+        if not self.t:  # stopped before its first frame was stored: nothing to list
+            return SystemResult(self.assembly, np.empty(0), np.empty((0, self.assembly.size)), success, message,
+                                dict(stats))
+        self._write_index(success, message, stats, complete=True)
+        return SystemResult(self.assembly, np.array(self.t), read_series(self.directory, dict(chunks=self.chunks),
+                                                                         "states"), success, message, dict(stats))
 
     def check(self, assembly):
-        """Resuming: refuse an assembly that is not the one of the run in the directory."""
-        keys, size = _keys(assembly.rods, "rod"), self.states[0].shape[1]
-        if self._resumed != keys or size != assembly.size:
+        """Resuming: refuse an assembly that is not the one of the run in the directory (other
+        rods, or another layout of the state: another grid, a body free or not)."""
+        keys, size = _keys(assembly.rods, "rod"), assembly.size
+        if self._resumed != keys or self._layout is not None and self._layout != _layout(assembly):
             raise ParameterError(f"cannot resume the run in {str(self.directory)!r}: it is a run of the rods "
-                                 f"{list(self._resumed)} with {size} states, this system has the rods "
-                                 f"{list(keys)} with {assembly.size}")
+                                 f"{list(self._resumed)} with the state's parts {self._layout}, this system has "
+                                 f"the rods {list(keys)} with {_layout(assembly)} ({size} states): the states kept "
+                                 "are the run's, so its rods' grids and bodies cannot change (start a new run)")
 
-    def record_settings(self, settings):
-        """The run's settings (JSON values), recorded in the index for a resumed run."""
+    def record_settings(self, settings, forced=()):
+        """The run's settings (JSON values, :func:`rodmol._settings.record_system`), recorded in the
+        index for a resumed run; ``forced``: what a forced resume changed."""
         self.settings = dict(settings)
+        if forced:
+            start = float(self.t_out[self.restart[0]]) if self.restart is not None else 0.0
+            self.forced = [*self.forced, dict(t_start=start, changed=list(forced))]
 
     def result(self):
         """The SystemResult read from the directory."""
         return read_system(self.directory)
 
+    # ----------------------------------------------------------------- other uses
+
+    def store(self, result, frames=slice(None)):
+        """Write the frames ``frames`` (a slice) of the SystemResult ``result`` (the next frames of
+        the run) as one chunk file, its views and the index listing it (its rods' files are
+        written by the caller)."""
+        if self._parts is None:
+            self._plan(result, len(result.t) if self.t_out is None else len(self.t_out))
+        _, bodies, surfaces, _ = self._parts
+        t, start = result.t[frames], len(self.t)
+        shown = [k for k in range(len(t)) if (start + k) % self.every == 0 or k == len(t) - 1]
+        name = h5result.chunk_name(len(self.chunks))
+        h5result.write_chunk(self.directory, name, [chunk_batch(result, frames, shown, surfaces, bodies)])
+        write_views(self.directory, name, t[shown], surfaces, bodies, [*self.chunks, name])
+        self.t.extend(np.asarray(t, dtype=float).tolist())
+        self.chunks[name] = len(t)
+        self._write_index(True, "running", {}, complete=False)
+
+    def write_result(self, result):
+        """Write a finished SystemResult (each rod's files as a single rod's, then the system's
+        chunks); returns the path of ``system.h5``."""
+        self.t_out = np.asarray(result.t, dtype=float)
+        self._plan(result, len(result.t))
+        for name, key in self._parts[0].items():
+            stream.write_xdmf(result[name], self.directory / key, self.every)
+        for k0 in range(0, len(result.t), self.chunk_frames):
+            self.store(result, slice(k0, k0 + self.chunk_frames))
+        self._write_index(result.success, result.message, result.stats, complete=True)
+        return self.directory / INDEX
+
     # ----------------------------------------------------------------- internals
 
+    def _plan(self, result, n_frames):
+        """The run's parts (file keys, the bodies' surfaces, the state's layout) and the views' step."""
+        if self._parts is None:
+            bodies = _keys(result.bodies, "body")
+            self._parts = (_keys(result.rods, "rod"), bodies, {name: surface_of(result, name) for name in bodies},
+                           None if result.assembly is None else _layout(result.assembly))
+        self.every = view_step(n_frames, self.every)
+
     def _write_index(self, success, message, stats, complete):
-        if not self.t:  # stopped before its first frame was stored: nothing to list
-            return SystemResult(self.assembly, np.empty(0), np.empty((0, self.assembly.size)), success, message,
-                                dict(stats))
-        result = SystemResult(self.assembly, np.concatenate(self.t), np.concatenate(self.states), success,
-                              message, dict(stats))
-        write_index(self.directory, result, view_step(len(self.t_out), self.every), complete=complete,
-                    t_out=self.t_out.tolist(), chunk_frames=self.chunk_frames, every=self.every,
-                    settings=self.settings)
-        return result
+        rods, bodies, surfaces, layout = self._parts
+        info = dict(success=bool(success), message=str(message), stats=_plain(stats), rods=rods, bodies=bodies,
+                    complete=complete, chunk_frames=self.chunk_frames, every=self.every, settings=self.settings)
+        if layout is not None:
+            info["parts"] = layout
+        if self.forced:
+            info["forced"] = self.forced
+        write_index(self.directory, self.t_out, self.t, dict(self.chunks), info, surfaces, bodies)
 
     def _refuse_replacing(self, overwrite):
         if overwrite or not (self.directory / INDEX).is_file():
             run_files.refuse_replacing(self.directory, overwrite, "resume=True", "overwrite=True")
             return
-        info = read_info(self.directory)[0]
+        info = read_info(self.directory)["info"]
         if info.get("complete", True) and info["success"]:
             raise ParameterError(f"the output directory {str(self.directory)!r} holds a finished system run: "
                                  "it is kept unless you pass overwrite=True (`--overwrite`) to replace it")
@@ -152,22 +222,49 @@ class SystemRunWriter:
                              "continue it with resume=True (`--resume`), or replace it with overwrite=True")
 
     def _reopen(self):
-        """Read the run to resume: its plan, settings and frames up to its last restart point."""
-        if not (self.directory / INDEX).is_file():
+        """Read the run to resume: its plan, settings and chunks up to its last restart point
+        (the chunks after it, cut short by Ctrl-C or a failure, are dropped and redone)."""
+        path = self.directory / INDEX
+        if not path.is_file():
             raise ParameterError(f"nothing to resume in {str(self.directory)!r}: no {INDEX}")
-        info, t, states = read_info(self.directory)
+        index = read_info(self.directory)
+        info, t = index["info"], index["t"]
         if info.get("complete", True) and info["success"]:
             raise ParameterError(f"nothing to resume in {str(self.directory)!r}: the run there finished "
                                  f"({info['message']})")
-        if "t_out" not in info or not len(t):
+        if index["t_out"] is None or index["chunks"] is None or not len(t):
             raise ParameterError(f"nothing to resume in {str(self.directory)!r}: no frames of a streamed "
-                                 "run were kept")
-        self.t_out, self.chunk_frames = np.asarray(info["t_out"], dtype=float), int(info["chunk_frames"])
+                                 "run were kept (or an older rodmol wrote them: start the run again)")
+        self.t_out, self.chunk_frames = index["t_out"], int(info["chunk_frames"])
         self.every, self.settings = info.get("every"), info.get("settings") or {}
+        self.forced, self._layout = list(info.get("forced") or []), info.get("parts")
         last = len(t) - 1
         point = last - last % self.chunk_frames
-        self.t, self.states = [t[:point + 1]], [states[:point + 1]]
-        self.restart, self._resumed = (point, states[point]), info["rods"]
+        kept, frames = {}, 0
+        for name, n in index["chunks"].items():
+            if frames + n - 1 > point:
+                break
+            kept[name], frames = n, frames + n
+        # The first chunk cut short: its first frame, the run's initial state, is the restart point.
+        chunk, row = (list(kept)[-1], -1) if kept else (list(index["chunks"])[0], 0)
+        with damaged(self.directory / chunk):
+            _, state = h5result.frame_state(self.directory, chunk, row)
+        self.chunks, self.t = kept, t[:frames].tolist()
+        self.restart, self._resumed = (point, state), info["rods"]
+        for file in run_files.temporaries(self.directory):  # what a writer killed mid-file left
+            file.unlink(missing_ok=True)
+
+
+def _layout(assembly):
+    """The state's layout of an assembly: each part's name and [start, stop) in the state, in order."""
+    return [[name, part.start, part.stop] for name, part in assembly.parts.items()]
+
+
+def write_system(result, directory, every=None):
+    """Write a finished :class:`SystemResult` into ``directory`` (see :mod:`rodmol.output.system_files`),
+    replacing an earlier run there; returns the path of ``system.h5``.
+    ``every``: show every n-th frame in the views (and the last)."""
+    return SystemRunWriter(directory, every=every, overwrite=True).write_result(result)
 
 
 run_sinks.register_system_writer(SystemRunWriter)  # simulate(system, out=DIR) streams into one

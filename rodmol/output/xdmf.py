@@ -19,6 +19,7 @@ two-point segments with ``tension [N]`` (point and cell data), ``s [m]`` and
 *Extract Surface* before *Tube*.
 """
 
+import html
 from pathlib import Path
 
 import numpy as np
@@ -142,13 +143,22 @@ def write_fragment(path, text):
 
 def write_view(path, name, fragments):
     """Write the view ``name`` including its grids from each fragment (relative paths), atomically."""
-    lines = [HEADER.format(ns=XI),
-             f'<Grid Name="{name}" GridType="Collection" CollectionType="Temporal">\n']
-    for fragment in fragments:
-        lines.append(f'<xi:include href="{Path(fragment).as_posix()}" '
-                     f"xpointer=\"xpointer(//Xdmf/Domain/Grid[@Name='{name}']/Grid)\"/>\n")
-    lines.append("</Grid>\n" + FOOTER)
-    data = "".join(lines).encode()
+    write_collections(path, {name: name}, fragments)
+
+
+def write_collections(path, collections, fragments):
+    """Write a view file of several temporal collections, atomically: ``collections`` maps
+    each collection's name (XML-escaped here) to the name of the collection in each
+    fragment (relative paths) whose grids it includes (a plain name: it goes into an XPath)."""
+    lines = [HEADER.format(ns=XI)]
+    for name, included in collections.items():
+        lines.append(f'<Grid Name="{html.escape(name, quote=True)}" GridType="Collection" '
+                     'CollectionType="Temporal">\n')
+        for fragment in fragments:
+            lines.append(f'<xi:include href="{Path(fragment).as_posix()}" '
+                         f"xpointer=\"xpointer(//Xdmf/Domain/Grid[@Name='{included}']/Grid)\"/>\n")
+        lines.append("</Grid>\n")
+    data = "".join(lines + [FOOTER]).encode()
     write_atomically(path, lambda handle: handle.write(data))
 
 

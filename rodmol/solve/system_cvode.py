@@ -19,6 +19,7 @@ The Newton systems are solved (``linsolver``) by
 * ``"dense"``: small systems and cross-checks.
 """
 
+import math
 import time
 
 import numpy as np
@@ -34,8 +35,21 @@ SYSTEM_LINEAR_SOLVERS = ("sparse", "gmres", "dense")
 KRYLOV_DIM = 5
 
 
+#: Non-finite right-hand sides between two output frames after which the run stops: CVODE
+#: (scikit-sundae's right-hand side cannot report a recoverable failure) would otherwise retry
+#: ever shorter steps without end; a sound run meets none, or a few in wild Newton iterates.
+NONFINITE_RATES = 200
+#: Right-hand sides between two output frames before their rates are checked: a sound run
+#: takes a few to a few hundred, and is not slowed by the check (2 % of the octopus's).
+WATCHED_AFTER = 1000
+
+
 class _OutOfTime(Exception):
     """Raised inside the right-hand side when the wall-time budget is used up."""
+
+
+class _NonFinite(Exception):
+    """Raised inside the right-hand side when its rates were non-finite too often (its message says where)."""
 
 
 def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, linsolver=None,
@@ -65,13 +79,21 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
                               "preconditioner leaves their coupling out, and the runs go wrong): use 'sparse'")
     if max_order == "auto":
         max_order = 2 if assembly.lightly_damped else 5
-    evals = [0]
+    # Right-hand sides; those with non-finite rates since the last output frame; the first count then.
+    evals = [0, 0, 0]
+    origin = [None]  # the first of those from a finite state: where the rates turned non-finite
 
     def rhs(t, y, yp):
         evals[0] += 1
         if max_wall_time is not None and time.perf_counter() - start > max_wall_time:
             raise _OutOfTime
         assembly(t, y, yp)
+        if evals[0] - evals[2] > WATCHED_AFTER and not math.isfinite(yp.sum()) and not np.all(np.isfinite(yp)):
+            evals[1] += 1
+            if origin[0] is None and np.isfinite(y.sum()):  # where they turned so from a finite state
+                origin[0] = _nonfinite(assembly, t, yp)
+            if evals[1] >= NONFINITE_RATES:
+                raise _NonFinite(origin[0] or _nonfinite(assembly, t, yp))
 
     options = dict(method="BDF", rtol=rtol, atol=atol, linsolver=linsolver, max_num_steps=1_000_000,
                    max_step=max_step, max_order=int(max_order))
@@ -98,6 +120,9 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
         except _OutOfTime:
             message = f"CVODE stopped after t = {reached:.6g} s: the wall-time budget max_wall_time = {max_wall_time:g} s is used up"
             break
+        except _NonFinite as exc:
+            message = f"CVODE stopped after t = {reached:.6g} s: {exc}"
+            break
         except Exception as exc:  # noqa: BLE001 (a user function's: reported with the frames before)
             message, error = f"CVODE stopped after t = {reached:.6g} s: {cause(exc)}", exc
             break
@@ -109,6 +134,7 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
             message = f"CVODE stopped after t = {reached:.6g} s: {broken}"
             break
         frames.append(np.array(r.y))
+        evals[1:], origin[0] = [0, evals[0]], None
         jac_evals = int(r.njev)
         if progress is not None:
             try:
@@ -124,6 +150,25 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
     if precond is not None:
         stats.update(jac_evals=precond.jac_evals, prec_setups=precond.setups, prec_solves=precond.solves)
     return t, y, success, message, stats, error
+
+
+def _nonfinite(assembly, t, rates):
+    """Where the ``rates`` at ``t`` [s] are non-finite: each part (a rod or a body) and its first such entry."""
+    where = []
+    for name, part in assembly.parts.items():
+        bad = np.flatnonzero(~np.isfinite(rates[part]))
+        if not len(bad):
+            continue
+        if name in assembly.rods:
+            where.append(f"rod {name!r} ({assembly.rods[name].layout.entry_name(int(bad[0]))})")
+        else:
+            fields = assembly.bodies[name].fields
+            field = next(f for f, entries in fields.items() if entries.start <= part.start + bad[0] < entries.stop)
+            where.append(f"body {name!r} ({field})")
+    return (f"the rates of {', '.join(where)} were non-finite at t = {t:.6g} s (from a finite state; "
+            f"{NONFINITE_RATES} non-finite right-hand sides among the {WATCHED_AFTER + NONFINITE_RATES} or more "
+            "since the last output frame): no step can be taken "
+            "(the model gives no finite motion there: a load, an input or a body's property out of range?)")
 
 
 def _broken(assembly, t, y):

@@ -168,13 +168,14 @@ BODIES_SCRIPT = textwrap.dedent("""
 
 def test_paraview_opens_a_systems_bodies_view_at_the_bodies_poses(tmp_path):
     from rodmol.output.system_files import body_surface
+    from rodmol.output.system_stream import SystemRunWriter
 
     arm = rodmol.Model(rodmol.Rod(0.2, 0.008, rodmol.Material(E=1e5, nu=0.5, mu=300.0, rho=1100.0)), 6)
     head = rodmol.RigidBody(0.3, (2e-4, 3e-4, 4e-4), volume=2e-4)
     system = rodmol.System({"arm": arm}, {"head": head}, [rodmol.Joint(("head", (0.04, 0.0, 0.0)), ("arm", "base"))],
                            medium="water", gravity=(0.0, 0.0, -9.81))
     out = tmp_path / "run"
-    result = rodmol.simulate(system, 0.2, output_dt=0.05, out=out)
+    result = rodmol.simulate(system, 0.2, output_dt=0.05, out=SystemRunWriter(out, chunk_frames=2))  # 3 chunks
     script = tmp_path / "open.py"
     script.write_text(BODIES_SCRIPT)
     run = xserver.run([XVFB, *xserver.XVFB_ARGS, PVPYTHON, str(script), str(out.resolve())], timeout=180)

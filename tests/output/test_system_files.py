@@ -7,6 +7,7 @@ import rodmol
 from rodmol.bodies import mesh_properties
 from rodmol.errors import ParameterError
 from rodmol.output.system_files import body_surface
+from rodmol.output.system_stream import SystemRunWriter
 
 
 @pytest.fixture(scope="module")
@@ -30,19 +31,42 @@ def test_the_directory_reads_back_as_the_run(written):
         back.momentum()
 
 
-def test_the_bodies_view_draws_the_body_at_its_pose(written):
+def test_the_bodies_view_draws_the_body_at_its_pose(tmp_path, two_arms):
+    import re
+
     import h5py
 
-    result, out = written
-    view = (out / "bodies.xdmf").read_text()
-    assert view.count('<Grid Name="head" GridType="Uniform">') == len(result.t)
+    result = rodmol.simulate(two_arms(), 0.06, output_dt=0.01, out=SystemRunWriter(tmp_path, chunk_frames=2))
+    view = (tmp_path / "bodies.xdmf").read_text()
+    fragments = re.findall(r'href="([^"]+)"', view)
+    assert fragments == [f"frames/chunk_{k:06d}.xmf" for k in range(3)]  # frames 0-2, 3-4, 5-6
+    grids = sum((tmp_path / f).read_text().count('<Grid Name="head" GridType="Uniform">') for f in fragments)
+    assert grids == len(result.t)
     points, triangles = body_surface(result.assembly.bodies["head"].body)
-    with h5py.File(out / "system.h5") as handle:
-        placed = handle["view/head_points"][()]
-        assert np.array_equal(handle["view/head_triangles"][()], triangles)
+    placed = []
+    for fragment in fragments:
+        with h5py.File(tmp_path / fragment.replace(".xmf", ".h5")) as handle:
+            placed.append(handle["view/head_points"][()])
+            assert np.array_equal(handle["view/head_triangles"][()], triangles)
     head = result["head"]
     expected = head.position[:, None, :] + np.einsum("nij,pj->npi", head.rotation, points)
-    assert np.allclose(placed, expected, atol=1e-7)  # single precision
+    assert np.allclose(np.concatenate(placed), expected, atol=1e-7)  # single precision
+
+
+def test_system_h5_is_an_index_of_chunk_files_written_once(tmp_path, two_arms):
+    """system.h5 is an index (times and chunk names), not the frames: each chunk's states and
+    bodies go to a chunk file written once; the run's SystemResult and load_result agree."""
+    import h5py
+
+    result = rodmol.simulate(two_arms(), 0.06, output_dt=0.01, out=SystemRunWriter(tmp_path, chunk_frames=2))
+    with h5py.File(tmp_path / "system.h5") as index:
+        assert "states" not in index and list(index["chunk_frames"][()]) == [3, 2, 2]
+        assert np.array_equal(index["t"][()], result.t)
+    sizes = [(tmp_path / "frames" / f"chunk_{k:06d}.h5").stat().st_size for k in (1, 2)]
+    assert sizes[0] == sizes[1]  # the second and third chunks: as many frames, as many bytes
+    back = rodmol.load_result(tmp_path)
+    assert np.array_equal(back.states, result.states)
+    assert np.array_equal(back["head"].quaternion, result["head"].quaternion)
 
 
 def test_a_body_without_mesh_is_drawn_as_the_ellipsoid_of_its_mass_and_inertia():
@@ -93,3 +117,18 @@ def test_every_part_gets_its_own_file_name_and_none_is_the_runs_own():
         keys = _keys(names, "rod")
         assert len(set(keys.values())) == len(names) and not set(keys.values()) & set(SYSTEM), keys
         assert all(keys[n] == n for n in names if n.isidentifier() and n not in SYSTEM)
+
+
+def test_a_result_read_back_is_written_again_as_it_was(written, tmp_path):
+    """write_series of a SystemResult without its System (read from files): the same frames, the
+    bodies drawn from their stored surfaces, the views showing every 3rd frame and the last."""
+    result, out = written
+    rodmol.write_series(rodmol.load_result(out), tmp_path, every=3)
+    again = rodmol.load_result(tmp_path)
+    assert again.success and np.array_equal(again.states, result.states)
+    for field in ("position", "quaternion", "velocity", "angular_velocity"):
+        assert np.array_equal(getattr(again["head"], field), getattr(result["head"], field)), field
+    assert np.array_equal(again["head"].surface[1], body_surface(result.assembly.bodies["head"].body)[1])
+    grids = (tmp_path / "frames" / "chunk_000000.xmf").read_text().count('<Grid Name="head" GridType="Uniform">')
+    assert grids == 2  # frames 0 and 3 of 4
+    assert np.array_equal(again["right"].positions, rodmol.load_result(out)["right"].positions)

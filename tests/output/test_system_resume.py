@@ -1,14 +1,19 @@
 """A system's streamed run: frames chunk by chunk into system.h5 and each rod's
 run directory; a run killed (or interrupted) part way reads back up to its
 last listed chunk and, resumed, ends bitwise where the uninterrupted run does,
-with the settings recorded in system.h5."""
+with the settings recorded in system.h5; another system or other settings are
+refused naming each, unless forced."""
 
+import dataclasses
+import json
 from functools import partial
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import rodmol
+from rodmol._fingerprint import system_fingerprints
 from rodmol.discretise.assembly import Assembly
 from rodmol.errors import ParameterError
 from rodmol.output.system_stream import SystemRunWriter
@@ -54,8 +59,11 @@ def test_a_killed_run_resumes_to_the_uninterrupted_one(two_arms, whole, tmp_path
     assert len(kept["right"].t) == (9 if rods_ahead else 5)  # a rod's files may hold one chunk more
     with pytest.raises(ParameterError, match="resume=True"):
         run(two_arms(), out=tmp_path)
+    left = [tmp_path / ".system.h5.x1.part", tmp_path / "frames" / ".chunk_000001.h5.x2.part"]
+    for file in left:  # what a kill in the middle of writing a file leaves beside it
+        file.write_bytes(b"\x89HDF half")
     resumed = rodmol.simulate(two_arms(), T_END, out=tmp_path, resume=True)  # rtol, linsolver: recorded
-    assert resumed.success
+    assert resumed.success and not any(file.exists() for file in left)
     assert_same(resumed, whole)
     assert_same(rodmol.load_result(tmp_path), whole)
     assert resumed.stats["rhs_evals"] < whole.stats["rhs_evals"]  # frames 4-10 only
@@ -93,3 +101,79 @@ def test_resume_refuses_what_it_cannot_continue(two_arms, tmp_path, killed_syste
         rodmol.simulate(rodmol.System(rods={"right": two_arms().rods["right"]}), T_END, out=tmp_path, resume=True)
     with pytest.raises(ParameterError, match="`resume` or `overwrite=True`"):
         rodmol.simulate(two_arms(), T_END, out=tmp_path, resume=True, overwrite=True)
+
+
+def changed(system, **bodies):
+    """``system`` (two_arms') with the head's arguments changed by ``bodies``."""
+    head = dataclasses.replace(system.bodies["head"], **bodies)
+    return rodmol.System(rods=system.rods, bodies={"head": head}, joints=system.joints, medium=system.medium,
+                         gravity=system.gravity)
+
+
+def test_resuming_a_changed_system_or_other_settings_is_refused_naming_each(two_arms, tmp_path, killed_system):
+    killed_system(partial(run, two_arms()), tmp_path, 1, chunk_frames=CHUNK)
+    index = (tmp_path / "system.h5").read_bytes()
+    heavier = changed(two_arms(), mass=0.35)
+    sideways = rodmol.System(rods={n: m.replace(gravity=(0.0, 0.0, 0.0)) for n, m in two_arms().rods.items()},
+                             bodies=two_arms().bodies, joints=two_arms().joints, medium="water",
+                             gravity=(0.0, -1.0, -9.81))
+    pulled = two_arms()
+    cable = dataclasses.replace(pulled.rods["right"].cables[0], tension=lambda t: 0.4 * min(t / 0.1, 1.0))
+    pulled.rods["right"] = pulled.rods["right"].replace(cables=[cable])
+    for system, options, named in [
+        (heavier, {}, "system (fingerprints of its parts): changed: body 'head'"),
+        (sideways, {}, "gravity"),
+        (pulled, {}, "changed: rod 'right'\n"),  # that rod only
+        (two_arms(), dict(rtol=1e-5), "rtol: the run 2e-05, this call 1e-05"),
+        (two_arms(), dict(linsolver="gmres"), "backend options: the run linsolver='sparse', this call "
+                                              "linsolver='gmres'"),
+    ]:
+        with pytest.raises(ParameterError) as refused:
+            rodmol.simulate(system, T_END, out=tmp_path, resume=True, **options)
+        assert named in str(refused.value) + "\n" and "resume='force'" in str(refused.value)
+    assert (tmp_path / "system.h5").read_bytes() == index  # refused before anything was touched
+    finer = rodmol.System(rods={n: m.replace(n_elements=7) for n, m in two_arms().rods.items()},
+                          bodies=two_arms().bodies, joints=two_arms().joints, medium="water",
+                          gravity=two_arms().gravity)
+    with pytest.raises(ParameterError, match="grids"):  # the states kept fix the layout: not even forced
+        rodmol.simulate(finer, T_END, out=tmp_path, resume="force")
+
+
+def test_a_forced_resume_goes_on_with_the_changed_system(two_arms, whole, tmp_path, killed_system):
+    import h5py
+
+    killed_system(partial(run, two_arms()), tmp_path, 1, chunk_frames=CHUNK)
+    heavier = changed(two_arms(), mass=0.35)
+    resumed = rodmol.simulate(heavier, T_END, out=tmp_path, resume="force")
+    assert resumed.success and np.array_equal(resumed.t, whole.t)
+    assert np.array_equal(resumed.states[:5], whole.states[:5])  # the frames kept
+    again = rodmol.simulate(heavier, T_END, out=SystemRunWriter(tmp_path / "again", chunk_frames=CHUNK),
+                            initial=whole.states[4], t0=whole.t[4], output_times=whole.t[4:], rtol=RTOL,
+                            linsolver="sparse")
+    assert np.array_equal(resumed.states[5:], again.states[1:])  # then the heavier head's run from frame 4
+    assert not np.array_equal(resumed.states[-1], whole.states[-1])
+    with h5py.File(tmp_path / "system.h5") as handle:
+        info = json.loads(handle.attrs["info"])
+    assert info["settings"]["system"] == system_fingerprints(heavier)  # a further resume compares with it
+    (forced,) = info["forced"]
+    assert forced["t_start"] == pytest.approx(0.04) and "body 'head'" in forced["changed"][0]
+
+
+def test_the_command_line_resumes_a_system_anyway(tmp_path, killed_system, capsys):
+    import h5py
+
+    from rodmol.cli.commands import main
+
+    scenario = Path(__file__).parents[2] / "examples" / "two_arms.toml"
+    assert main(["run", str(scenario), "--out", str(tmp_path), "--chunk-frames", "4", "--t-end", "0.3",
+                 "--quiet"]) == 0
+    with h5py.File(tmp_path / "system.h5") as index:  # the option's chunks: frames 0-4, 5-6
+        assert list(index["chunk_frames"][()]) == [5, 2]
+    spec = rodmol.load_scenario(scenario)
+    killed_system(spec.simulate, tmp_path, 1, chunk_frames=4, overwrite=True)  # 11 frames: frames 0-4 kept
+    assert main(["run", str(scenario), "--out", str(tmp_path), "--resume", "--scheme", "upwind", "--quiet"]) == 2
+    assert "scheme: the run 'centred', this call 'upwind'" in capsys.readouterr().err
+    assert main(["run", str(scenario), "--out", str(tmp_path), "--resume-anyway", "--scheme", "upwind",
+                 "--quiet"]) == 0
+    result = rodmol.load_result(tmp_path)
+    assert result.success and len(result.t) == 11
