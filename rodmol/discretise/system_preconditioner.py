@@ -8,20 +8,27 @@ inverted directly, J_bb by differences in the body's own entries: of the
 full right-hand side in its velocities (they move the rods' bases), of its
 own rates in its rotation and, if it has penalty joints (whose held points
 it moves), its position; no rate of a body without them reads its
-position. The tree joints' coupling blocks are left out: GMRES's products
-J v are differences of the full right-hand side, so it sees them, only
-converging in more iterations.
+position.
 
-A penalty joint between a rod node and a free body couples them as stiffly
-as it holds them: left out, GMRES needs hundreds of times the right-hand
-sides or fails. Its blocks are kept, and the free bodies with penalty
-joints are eliminated by their Schur complement: with N = I - gamma J split
-into the rods (r) and those bodies (b), N_rb holding each joint node's
-velocity rows against its body's entries and N_br the body's rows against
-the node's u, Q, v, w (both by differences), S = N_bb - N_br N_rr^-1 N_rb
-(dense, one block of ``rigid.FREE_BODY.size`` rows per body) is formed at each setup from one rod solve per
-body column and joined rod; a solve is z_r' = N_rr^-1 r_r, z_b = S^-1
-(r_b - N_br z_r'), z_r = z_r' - N_rr^-1 N_rb z_b.
+A free body is coupled to its rods both ways, and the coupling blocks are
+kept: the free bodies that carry rods or have penalty joints are eliminated
+by their Schur complement. Each coupling is a link between a body and a
+rod: a rod clamped to the body (a tree joint) links the rod's header and
+first element (its rows read the body's velocities, the body's rows read
+their stress; :meth:`Assembly.pattern`), a penalty joint links its node's
+velocity rows (they read the body's pose and velocities) and its u, Q, v, w
+(the body's rows read the joint's reaction). A penalty joint couples as
+stiffly as it holds: left out, GMRES needed hundreds of times the
+right-hand sides or failed. A clamp's coupling left out (as it was until
+the octopus was measured) cost GMRES a second iteration per Newton
+iteration (solvers/octopus_stats.py). With N = I - gamma J split into the rods (r) and
+those bodies (b), N_rb holding the links' rod rows against the body's
+entries and N_br the body's rows against the links' rod entries (both by
+differences), S = N_bb - N_br N_rr^-1 N_rb (dense, one block of
+``rigid.FREE_BODY.size`` rows per body) is formed at each setup from one
+rod solve per body column that moves the rod and joined rod; a solve is
+z_r' = N_rr^-1 r_r, z_b = S^-1 (r_b - N_br z_r'), z_r = z_r' - N_rr^-1
+N_rb z_b.
 """
 
 import numpy as np
@@ -34,6 +41,35 @@ JOINT_ROWS, JOINT_COLUMNS = block_entries("v", "w"), block_entries("u", "Q", "v"
 
 #: Relative step of the body blocks' differences, times each entry's scale.
 BODY_STEP = 1e-7
+
+
+class Link:
+    """One coupling of a free body with a rod in the Schur complement: the
+    rod's ``rows`` that read the body and its entries (``columns``) that
+    the body's rows read, state indices; ``to_body`` (rows x body entries)
+    and ``from_rod`` (body entries x columns) are their Jacobian blocks,
+    J_rb and J_br (N = -gamma J off the diagonal). ``clamp``: the rod's base
+    is clamped to the body (the body's rows read the columns through the
+    rod's stress, so a column's difference re-evaluates the rod), else a
+    penalty joint (through the joint's reaction)."""
+
+    def __init__(self, rod, rows, columns, clamp):
+        self.rod, self.rows, self.columns, self.clamp = rod, rows, columns, clamp
+        self.to_body = np.zeros((len(rows), FREE_BODY.size))
+        self.from_rod = np.zeros((FREE_BODY.size, len(columns)))
+
+
+def links(assembly, part):
+    """The :class:`Link` s of free body ``part``: its clamped rods' header and
+    first element, its penalty joints' nodes."""
+    out = []
+    for name, sd in zip(part.rods, part.systems):
+        start = assembly.parts[name].start
+        first = np.arange(start, start + sd.layout.header + sd.layout.block)
+        out.append(Link(name, first, first, True))
+    for joint in part.joints:
+        out.append(Link(joint.joint.rod, joint.node + JOINT_ROWS, joint.node + JOINT_COLUMNS, False))
+    return out
 
 
 class SystemPreconditioner:
@@ -50,11 +86,10 @@ class SystemPreconditioner:
         self._field_of = {p.name: [f for f, n in p.layout.fields.items() for _ in range(n)] for p in self.bodies}
         self._out = np.empty(assembly.size)
         self._scale, self.gamma = scale, np.nan
-        # The Schur complement's bodies (free, with penalty joints) and their offsets in S.
-        self.coupled = [p for p in self.bodies if p.body.free and p.joints]
+        # The Schur complement's bodies (free, with rods or penalty joints), their links and offsets in S.
+        self.coupled = [p for p in self.bodies if p.body.free and (p.rods or p.joints)]
+        self.links = {p.name: links(assembly, p) for p in self.coupled}
         self._offset = dict(zip((p.name for p in self.coupled), FREE_BODY.size * np.arange(len(self.coupled))))
-        self._rod_to_body = {id(j): np.zeros((len(JOINT_ROWS), FREE_BODY.size)) for p in self.coupled for j in p.joints}
-        self._body_to_rod = {id(j): np.zeros((FREE_BODY.size, len(JOINT_COLUMNS))) for p in self.coupled for j in p.joints}
         self._schur = np.eye(FREE_BODY.size * len(self.coupled))
         self.jac_evals = self.setups = self.solves = 0
 
@@ -70,23 +105,25 @@ class SystemPreconditioner:
             z = np.array(y)
             for part in self.bodies:
                 assembly(t, y, self._out)  # the rods' stress at y (their Jacobians and other bodies moved it)
-                coupled = part in self.coupled
-                if coupled:
-                    self._joint_columns(part, t, y, fy, z)
+                part_links = self.links.get(part.name, ())
+                for link in part_links:
+                    self._rod_columns(part, link, t, y, fy, z)
                 jac, steps = self._jac[part.name], self._steps[part.name]
                 for j, index in enumerate(range(part.slice.start, part.slice.stop)):
                     field = self._field_of[part.name][j]
                     if field == "x" and not part.joints:  # no rate reads its position
                         continue
                     z[index] = y[index] + steps[j]
-                    if field in ("x", "Q") and not coupled:  # of the rates kept, only the body's read its pose
-                        assembly.body_rates(part, t, z, self._out)
-                    else:  # its velocities move the rods' bases, its pose the joints' held points
+                    # Its velocities move the rods' bases, its pose the joints' held points; of the rest
+                    # only the body's own rates read its pose.
+                    full = field in ("v", "w") or bool(part.joints)
+                    if full:
                         assembly(t, z, self._out)
+                    else:
+                        assembly.body_rates(part, t, z, self._out)
                     jac[:, j] = (self._out[part.slice] - fy[part.slice]) / steps[j]
-                    for joint in part.joints if coupled else ():
-                        rows = joint.node + JOINT_ROWS
-                        self._rod_to_body[id(joint)][:, j] = (self._out[rows] - fy[rows]) / steps[j]
+                    for link in part_links:
+                        link.to_body[:, j] = (self._out[link.rows] - fy[link.rows]) / steps[j] if full else 0.0
                     z[index] = y[index]
             assembly(t, y, self._out)  # leave the rods as at y
             self.jac_evals += 1
@@ -100,24 +137,28 @@ class SystemPreconditioner:
             self._factor_schur(gamma)
         self.setups += 1
 
-    def _joint_columns(self, part, t, y, fy, z):
-        """The body's rows against each of its joint nodes' columns (N_br / -gamma), by differences of its rates."""
+    def _rod_columns(self, part, link, t, y, fy, z):
+        """The body's rows against the link's rod entries (J_br), by differences of its rates; a
+        clamp's through its rod's rates (its stress), left as at y."""
         assembly = self.assembly
-        for joint in part.joints:
-            block = self._body_to_rod[id(joint)]
-            for c, index in enumerate(joint.node + JOINT_COLUMNS):
-                step = BODY_STEP * max(self._scale[index], 1e-300)
-                z[index] = y[index] + step
-                assembly.body_rates(part, t, z, self._out)
-                block[:, c] = (self._out[part.slice] - fy[part.slice]) / step
-                z[index] = y[index]
+        rod, sl = assembly.rods[link.rod], assembly.parts[link.rod]
+        for c, index in enumerate(link.columns):
+            step = BODY_STEP * max(self._scale[index], 1e-300)
+            z[index] = y[index] + step
+            if link.clamp:
+                rod(t, z[sl], self._out[sl])
+            assembly.body_rates(part, t, z, self._out)
+            link.from_rod[:, c] = (self._out[part.slice] - fy[part.slice]) / step
+            z[index] = y[index]
+        if link.clamp:
+            rod(t, y[sl], self._out[sl])
 
     def _rod_solve(self, name, rows_values):
-        """N_rr^-1 of a right-hand side nonzero at joint rows only: [(joint, values (6,))] of rod ``name``."""
+        """N_rr^-1 of a right-hand side nonzero at link rows only: [(link, values)] of rod ``name``."""
         rhs = np.zeros(self.assembly.rods[name].size)
         start = self.assembly.parts[name].start
-        for joint, values in rows_values:
-            rhs[joint.node - start + JOINT_ROWS] += values
+        for link, values in rows_values:
+            rhs[link.rows - start] += values
         return self.rods[name].apply(rhs)
 
     def _factor_schur(self, gamma):
@@ -129,18 +170,19 @@ class SystemPreconditioner:
         for part in self.coupled:
             o = self._offset[part.name]
             by_rod = {}
-            for joint in part.joints:
-                by_rod.setdefault(joint.joint.rod, []).append(joint)
-            for rod, joints in by_rod.items():
+            for link in self.links[part.name]:
+                by_rod.setdefault(link.rod, []).append(link)
+            for rod, rod_links in by_rod.items():
                 start = self.assembly.parts[rod].start
                 for k in range(size):
-                    x = self._rod_solve(rod, [(j, -gamma * self._rod_to_body[id(j)][:, k]) for j in joints])
-                    for other in self.coupled:  # every body joined to this rod reads x at its joint nodes
-                        for joint in other.joints:
-                            if joint.joint.rod == rod:
-                                oo = self._offset[other.name]
-                                n_br = -gamma * self._body_to_rod[id(joint)]
-                                schur[oo:oo + size, o + k] -= n_br @ x[joint.node - start + JOINT_COLUMNS]
+                    if not any(link.to_body[:, k].any() for link in rod_links):
+                        continue  # this body entry moves none of the rod's rows (a clamp's pose)
+                    x = self._rod_solve(rod, [(link, -gamma * link.to_body[:, k]) for link in rod_links])
+                    for other in self.coupled:  # every body linked to this rod reads x at its columns
+                        oo = self._offset[other.name]
+                        for link in self.links[other.name]:
+                            if link.rod == rod:
+                                schur[oo:oo + size, o + k] += gamma * link.from_rod @ x[link.columns - start]
         self._schur = np.linalg.inv(schur)
 
     def solve(self, t, y, fy, r, z, gamma, delta, lr):
@@ -159,15 +201,15 @@ class SystemPreconditioner:
         rhs = np.concatenate([r[part.slice] for part in self.coupled])
         for part in self.coupled:
             o = self._offset[part.name]
-            for joint in part.joints:
-                rhs[o:o + FREE_BODY.size] -= -g * self._body_to_rod[id(joint)] @ z[joint.node + JOINT_COLUMNS]
+            for link in self.links[part.name]:
+                rhs[o:o + FREE_BODY.size] += g * link.from_rod @ z[link.columns]
         z_b = self._schur @ rhs
         by_rod = {}
         for part in self.coupled:
             o = self._offset[part.name]
             z[part.slice] = z_b[o:o + FREE_BODY.size]
-            for joint in part.joints:
-                by_rod.setdefault(joint.joint.rod, []).append((joint, -g * self._rod_to_body[id(joint)] @ z_b[o:o + FREE_BODY.size]))
+            for link in self.links[part.name]:
+                by_rod.setdefault(link.rod, []).append((link, -g * link.to_body @ z_b[o:o + FREE_BODY.size]))
         for rod, rows_values in by_rod.items():
             z[parts[rod]] -= self._rod_solve(rod, rows_values)
         self.solves += 1
