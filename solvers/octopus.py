@@ -47,7 +47,7 @@ def arm(n, cable, tension):
     return rodmol.paper_arm(n, tensions={cable: tension}, markers=())
 
 
-def head():
+def head(motion="free"):
     water = rodmol.MEDIA["water"].rho
     volume = 4.0 / 3.0 * np.pi * HEAD_RADIUS**3
     mass = 1.1 * water * volume
@@ -55,20 +55,22 @@ def head():
     added = 0.5 * water * volume  # a sphere's added mass
     drag = 0.5 * water * 0.47 * np.pi * HEAD_RADIUS**2  # C_d = 0.47
     return rodmol.RigidBody(mass, (inertia,) * 3, volume=volume, added_mass=(added,) * 3 + (0.0,) * 3,
-                            drag=(drag,) * 3 + (1e-4,) * 3)
+                            drag=(drag,) * 3 + (1e-4,) * 3, motion=motion)
 
 
-def octopus(n, pattern):
+def octopus(n, pattern, arms=ARMS, motion="free", tilt=30.0):
+    """``arms`` arms spread evenly round the head (``motion``: free, or fixed for a study), their
+    phases spread over a period, leaving it ``tilt`` degrees below the horizontal."""
     rods, joints = {}, []
-    tilt = np.radians(30.0)
-    for i in range(ARMS):
-        angle = 2.0 * np.pi * i / ARMS
+    tilt = np.radians(tilt)
+    for i in range(arms):
+        angle = 2.0 * np.pi * i / arms
         out = np.array([np.cos(angle) * np.cos(tilt), np.sin(angle) * np.cos(tilt), -np.sin(tilt)])
         side = np.array([-np.sin(angle), np.cos(angle), 0.0])
         frame = np.column_stack([out, side, np.cross(out, side)])  # the arm's base frame in the head's
-        rods[f"arm{i + 1}"] = arm(n, 1 if i % 2 == 0 else 3, pattern(2.0 * np.pi * i / ARMS))
+        rods[f"arm{i + 1}"] = arm(n, 1 if i % 2 == 0 else 3, pattern(2.0 * np.pi * i / arms))
         joints.append(rodmol.Joint(("head", HEAD_RADIUS * out, frame), (f"arm{i + 1}", "base")))
-    return rodmol.System(rods, {"head": head()}, joints, medium="water", gravity=(0.0, 0.0, -9.81))
+    return rodmol.System(rods, {"head": head(motion)}, joints, medium="water", gravity=(0.0, 0.0, -9.81))
 
 
 def timed(cases, t_end, reps):

@@ -14,8 +14,9 @@ A free body is coupled to its rods both ways, and the coupling blocks are
 kept: the free bodies that carry rods or have penalty joints are eliminated
 by their Schur complement. Each coupling is a link between a body and a
 rod: a rod clamped to the body (a tree joint) links the rod's header and
-first element (its rows read the body's velocities, the body's rows read
-their stress; :meth:`Assembly.pattern`), a penalty joint links its node's
+first element (their rows read the body's velocities: :meth:`Assembly.pattern`)
+and that element's strains and velocities (the body's rows read cell 0's
+stress from them: :data:`CLAMP_COLUMNS`), a penalty joint links its node's
 velocity rows (they read the body's pose and velocities) and its u, Q, v, w
 (the body's rows read the joint's reaction). A penalty joint couples as
 stiffly as it holds: left out, GMRES needed hundreds of times the
@@ -38,6 +39,9 @@ from .rigid import FREE_BODY
 
 #: A joint node's rows (its velocities) and columns (what the joint reads), within its element block.
 JOINT_ROWS, JOINT_COLUMNS = block_entries("v", "w"), block_entries("u", "Q", "v", "w")
+#: What a body reads of a rod clamped to it, within the rod's first element block: the stress of
+#: cell 0, from its strains and (the viscous law) their rates.
+CLAMP_COLUMNS = block_entries("q", "k", "v", "w")
 
 #: Relative step of the body blocks' differences, times each entry's scale.
 BODY_STEP = 1e-7
@@ -66,7 +70,7 @@ def links(assembly, part):
     for name, sd in zip(part.rods, part.systems):
         start = assembly.parts[name].start
         first = np.arange(start, start + sd.layout.header + sd.layout.block)
-        out.append(Link(name, first, first, True))
+        out.append(Link(name, first, start + sd.layout.header + CLAMP_COLUMNS, True))
     for joint in part.joints:
         out.append(Link(joint.joint.rod, joint.node + JOINT_ROWS, joint.node + JOINT_COLUMNS, False))
     return out
@@ -90,7 +94,14 @@ class SystemPreconditioner:
         self.coupled = [p for p in self.bodies if p.body.free and (p.rods or p.joints)]
         self.links = {p.name: links(assembly, p) for p in self.coupled}
         self._offset = dict(zip((p.name for p in self.coupled), FREE_BODY.size * np.arange(len(self.coupled))))
-        self._schur = np.eye(FREE_BODY.size * len(self.coupled))
+        size = FREE_BODY.size * len(self.coupled)
+        self._schur = np.eye(size)
+        # Per linked rod, N_rr^-1 N_rb (its columns: S's); all links' rod entries and N_br over them.
+        linked = dict.fromkeys(link.rod for p in self.coupled for link in self.links[p.name])
+        self._solved = {rod: np.zeros((assembly.rods[rod].size, size)) for rod in linked}
+        self._reads = np.concatenate([link.columns for p in self.coupled for link in self.links[p.name]]
+                                     or [np.zeros(0, dtype=int)])
+        self._n_br = np.zeros((size, len(self._reads)))
         self.jac_evals = self.setups = self.solves = 0
 
     def setup(self, t, y, fy, jok, jnew, gamma):
@@ -162,27 +173,33 @@ class SystemPreconditioner:
         return self.rods[name].apply(rhs)
 
     def _factor_schur(self, gamma):
-        """S = N_bb - N_br N_rr^-1 N_rb over the coupled bodies, inverted."""
+        """S = N_bb - N_br N_rr^-1 N_rb over the coupled bodies, inverted; N_rr^-1 N_rb and N_br kept."""
         schur, size = np.zeros_like(self._schur), FREE_BODY.size
+        column = 0
         for part in self.coupled:
             o = self._offset[part.name]
             schur[o:o + size, o:o + size] = np.eye(size) - gamma * self._jac[part.name]
+            for link in self.links[part.name]:
+                self._n_br[:, column:column + len(link.columns)] = 0.0
+                self._n_br[o:o + size, column:column + len(link.columns)] = -gamma * link.from_rod
+                column += len(link.columns)
+        for solved in self._solved.values():
+            solved[:] = 0.0
         for part in self.coupled:
             o = self._offset[part.name]
             by_rod = {}
             for link in self.links[part.name]:
                 by_rod.setdefault(link.rod, []).append(link)
             for rod, rod_links in by_rod.items():
-                start = self.assembly.parts[rod].start
                 for k in range(size):
-                    if not any(link.to_body[:, k].any() for link in rod_links):
-                        continue  # this body entry moves none of the rod's rows (a clamp's pose)
-                    x = self._rod_solve(rod, [(link, -gamma * link.to_body[:, k]) for link in rod_links])
-                    for other in self.coupled:  # every body linked to this rod reads x at its columns
-                        oo = self._offset[other.name]
-                        for link in self.links[other.name]:
-                            if link.rod == rod:
-                                schur[oo:oo + size, o + k] += gamma * link.from_rod @ x[link.columns - start]
+                    if any(link.to_body[:, k].any() for link in rod_links):  # not a clamp's pose column
+                        self._solved[rod][:, o + k] = self._rod_solve(
+                            rod, [(link, -gamma * link.to_body[:, k]) for link in rod_links])
+        reads = self._reads  # every body linked to a rod reads N_rr^-1 N_rb at its links' columns
+        for rod, solved in self._solved.items():
+            sl = self.assembly.parts[rod]
+            inside = (reads >= sl.start) & (reads < sl.stop)
+            schur -= self._n_br[:, inside] @ solved[reads[inside] - sl.start]
         self._schur = np.linalg.inv(schur)
 
     def solve(self, t, y, fy, r, z, gamma, delta, lr):
@@ -194,22 +211,12 @@ class SystemPreconditioner:
         for part in self.bodies:
             if part not in self.coupled:
                 z[part.slice] = self._inverse[part.name] @ r[part.slice]
-        if not self.coupled:
-            self.solves += 1
-            return
-        g = self.gamma
-        rhs = np.concatenate([r[part.slice] for part in self.coupled])
-        for part in self.coupled:
-            o = self._offset[part.name]
-            for link in self.links[part.name]:
-                rhs[o:o + FREE_BODY.size] += g * link.from_rod @ z[link.columns]
-        z_b = self._schur @ rhs
-        by_rod = {}
-        for part in self.coupled:
-            o = self._offset[part.name]
-            z[part.slice] = z_b[o:o + FREE_BODY.size]
-            for link in self.links[part.name]:
-                by_rod.setdefault(link.rod, []).append((link, -g * link.to_body @ z_b[o:o + FREE_BODY.size]))
-        for rod, rows_values in by_rod.items():
-            z[parts[rod]] -= self._rod_solve(rod, rows_values)
+        if self.coupled:
+            rhs = np.concatenate([r[part.slice] for part in self.coupled]) - self._n_br @ z[self._reads]
+            z_b = self._schur @ rhs
+            for part in self.coupled:
+                o = self._offset[part.name]
+                z[part.slice] = z_b[o:o + FREE_BODY.size]
+            for rod, solved in self._solved.items():
+                z[parts[rod]] -= solved @ z_b
         self.solves += 1

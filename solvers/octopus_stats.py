@@ -1,0 +1,100 @@
+"""Why does the octopus take more right-hand sides than one arm? CVODE's
+counters and the cost against the number of arms.
+
+The octopus of ``octopus.py`` (its head, arms, cable patterns, N and
+tolerances) with 1, 2, 4 and 8 arms on the free head, against one arm alone
+(a Model, CVODE's band LU; and a one-rod System, GMRES); and two studies at
+8 arms: the head fixed (the arms then share only the step size), and the
+preconditioner as it was before the head's clamp links
+(``SystemPreconditioner`` with only its penalty-joint links: each arm and
+the head on their own, the tree coupling left to GMRES). Reported per case:
+wall time (median of --reps interleaved rounds) and its ratio to one arm
+alone, right-hand sides, and CVODE's counters (``_cvode_stats.py``): steps,
+error-test failures, Newton iterations and convergence failures, GMRES
+iterations and convergence failures, preconditioner Jacobians and setups,
+and the wall time per right-hand side.
+
+    python solvers/octopus_stats.py [--quick | --smoke] [--out DIR] [--reps K]
+"""
+
+import time
+
+import _common as C
+import _cvode_stats
+import octopus as O
+from _common import np, rodmol
+
+from rodmol.discretise import system_preconditioner
+
+SCRIPT = "octopus_stats.py"
+ARM_COUNTS = (1, 2, 4, 8)
+
+
+def _without_clamp_links(assembly, part, links=system_preconditioner.links):
+    return [link for link in links(assembly, part) if not link.clamp]
+
+
+def run(thing, t_end, options, before=False):
+    """simulate ``thing``; (wall [s], result, CVODE's counters)."""
+    links = system_preconditioner.links
+    if before:
+        system_preconditioner.links = _without_clamp_links
+    try:
+        with _cvode_stats.Recorder() as made:
+            start = time.perf_counter()
+            result = rodmol.simulate(thing, t_end, **options)
+            wall = time.perf_counter() - start
+    finally:
+        system_preconditioner.links = links
+    return wall, result, _cvode_stats.counters(made.solvers[-1], result.stats["rhs_evals"])
+
+
+def main(argv=None):
+    args = C.parse_args(__doc__.splitlines()[0], argv)
+    header = C.header_lines(args, SCRIPT)
+    n = C.pick(args, 30, 30, 8)
+    t_end = C.pick(args, 1.0, 0.3, 0.05)
+    water = dict(medium="water", gravity=(0.0, 0.0, -9.81))
+    rodmol.simulate(rodmol.System({"a": O.arm(n, 1, O.ramp(0.0))}, **water), 0.01)  # compile
+    rodmol.simulate(O.arm(n, 1, O.ramp(0.0)), 0.01, initial="straight")
+    rows = []
+    for name, pattern in O.PATTERNS.items():
+        cases = [("one arm, Model (band LU)", O.arm(n, 1, pattern(0.0)).replace(gravity=water["gravity"]),
+                  dict(initial="straight"), False),
+                 ("one arm, System (GMRES)", rodmol.System({"a": O.arm(n, 1, pattern(0.0))}, **water), {}, False)]
+        cases += [(f"{k} arm{'s' if k > 1 else ''} + free head", O.octopus(n, pattern, k), {}, False)
+                  for k in ARM_COUNTS]
+        cases += [(f"{O.ARMS} arms + fixed head", O.octopus(n, pattern, O.ARMS, "fixed"), {}, False),
+                  (f"{O.ARMS} arms + free head, before (no clamp links)", O.octopus(n, pattern), {}, True)]
+        walls = {label: [] for label, *_ in cases}
+        last = {}
+        for _ in range(args.reps):  # interleaved: a change of the machine's load falls on every case
+            for label, thing, options, before in cases:
+                wall, result, counts = run(thing, t_end, options, before)
+                walls[label].append(wall)
+                last[label] = (result, counts)
+        one = float(np.median(walls[cases[0][0]]))
+        for label, *_ in cases:
+            result, counts = last[label]
+            wall = float(np.median(walls[label]))
+            rhs = result.stats["rhs_evals"]
+            row = dict(pattern=name, case=label, state_size=result.states.shape[1], wall_s=wall,
+                       vs_one_arm=wall / one, rhs_evals=rhs, steps=counts["steps"],
+                       error_test_fails=counts["error_test_fails"], newton_iters=counts["newton_iters"],
+                       newton_conv_fails=counts["newton_conv_fails"], krylov_iters=counts["krylov_iters"],
+                       krylov_conv_fails=counts["krylov_conv_fails"], jacobians=result.stats["jac_evals"],
+                       linear_setups=counts["linear_setups"], us_per_rhs=1e6 * wall / rhs,
+                       success=result.success)
+            rows.append(row)
+            print(row, flush=True)
+    fmt = {"wall_s": ".3g", "vs_one_arm": ".2f", "us_per_rhs": ".0f"}
+    columns = ["pattern", "case", "wall_s", "vs_one_arm", "rhs_evals", "steps", "error_test_fails", "newton_iters",
+               "newton_conv_fails", "krylov_iters", "krylov_conv_fails", "jacobians", "linear_setups",
+               "us_per_rhs"]
+    C.write_results(args, "octopus_stats", "Octopus: CVODE's counters against the number of arms", header
+                    + [f"N = {n}, t_end = {t_end:g} s, medians of {args.reps} interleaved rounds"], rows,
+                    [("Results", C.markdown_table(rows, columns, fmt))])
+
+
+if __name__ == "__main__":
+    main()
