@@ -191,10 +191,10 @@ class SystemPreconditioner:
             for link in self.links[part.name]:
                 by_rod.setdefault(link.rod, []).append(link)
             for rod, rod_links in by_rod.items():
-                for k in range(size):
-                    if any(link.to_body[:, k].any() for link in rod_links):  # not a clamp's pose column
-                        self._solved[rod][:, o + k] = self._rod_solve(
-                            rod, [(link, -gamma * link.to_body[:, k]) for link in rod_links])
+                moving = np.flatnonzero(np.any([link.to_body.any(axis=0) for link in rod_links], axis=0))
+                for k in moving:  # the body entries that move the rod (a clamp's: its velocities)
+                    self._solved[rod][:, o + k] = self._rod_solve(
+                        rod, [(link, -gamma * link.to_body[:, k]) for link in rod_links])
         reads = self._reads  # every body linked to a rod reads N_rr^-1 N_rb at its links' columns
         for rod, solved in self._solved.items():
             sl = self.assembly.parts[rod]
