@@ -14,7 +14,9 @@ octopus with both linear solvers of systems (the preconditioned GMRES, the
 default, and the sparse LU); all from the straight rest state. Reported: wall
 time, simulated seconds per wall second, right-hand side evaluations, and
 the ratio of the octopus's wall time to one arm's (medians of --reps rounds,
-each round running every case once).
+each round running every case once), and the same for the process's CPU
+time (``time.process_time``: on the shared machine, a neighbour's load
+stretches the wall time of a long case more than that of a short one).
 
     python solvers/octopus.py [--quick | --smoke] [--out DIR]
 """
@@ -79,18 +81,20 @@ def timed(cases, t_end, reps):
     that a change of the shared machine's load falls on all of them); and the
     last case's last result."""
     walls = {label: [] for label, _, _ in cases}
+    cpus = {label: [] for label, _, _ in cases}
     for _ in range(reps):
         for label, thing, options in cases:
-            start = time.perf_counter()
+            start, cpu = time.perf_counter(), time.process_time()
             rodmol.simulate(thing, t_end, **options)
             walls[label].append(time.perf_counter() - start)
+            cpus[label].append(time.process_time() - cpu)
     rows = []
     for label, thing, options in cases:
         result = rodmol.simulate(thing, t_end, **options)  # for its statistics
         wall = float(np.median(walls[label]))
         rows.append(dict(case=label, state_size=result.states.shape[1], t_end_s=t_end, wall_s=wall,
-                         sim_s_per_wall_s=t_end / wall, rhs_evals=result.stats["rhs_evals"],
-                         success=result.success))
+                         sim_s_per_wall_s=t_end / wall, cpu_s=float(np.median(cpus[label])),
+                         rhs_evals=result.stats["rhs_evals"], success=result.success))
     return rows, result
 
 
@@ -112,13 +116,15 @@ def main(argv=None):
                  (f"octopus, {ARMS} arms + head, GMRES", octopus(n, pattern), {})]
         timed_rows, result = timed(cases, t_end, args.reps)
         for row in timed_rows:
-            row = dict(pattern=name, **row, N=n, wall_vs_one_arm_model=row["wall_s"] / timed_rows[0]["wall_s"])
+            row = dict(pattern=name, **row, N=n, wall_vs_one_arm_model=row["wall_s"] / timed_rows[0]["wall_s"],
+                       cpu_vs_one_arm_model=row["cpu_s"] / timed_rows[0]["cpu_s"])
             rows.append(row)
             print(row, flush=True)
         drift = max(float(np.max(result.pose_drift(rod)[0])) for rod in result.assembly.rods)
         notes += (f"- {name}: head at t_end {np.round(result['head'].position[-1], 4).tolist()} m, "
                   f"largest header-to-clamp drift of the arms {drift:.2e} m.\n")
-    fmt = {"wall_s": ".3g", "sim_s_per_wall_s": ".3g", "wall_vs_one_arm_model": ".2f", "t_end_s": ".3g"}
+    fmt = {"wall_s": ".3g", "sim_s_per_wall_s": ".3g", "wall_vs_one_arm_model": ".2f", "t_end_s": ".3g",
+           "cpu_s": ".3g", "cpu_vs_one_arm_model": ".2f"}
     C.write_results(args, "octopus", "Octopus: eight arms on a free head against one arm", header, rows,
                     [("Results", C.markdown_table(rows, None, fmt)), ("Notes", notes)])
 

@@ -9,10 +9,11 @@ preconditioner as it was before the head's clamp links
 (``SystemPreconditioner`` with only its penalty-joint links: each arm and
 the head on their own, the tree coupling left to GMRES). Reported per case:
 wall time (median of --reps interleaved rounds) and its ratio to one arm
-alone, right-hand sides, and CVODE's counters (``_cvode_stats.py``): steps,
-error-test failures, Newton iterations and convergence failures, GMRES
-iterations and convergence failures, preconditioner Jacobians and setups,
-and the wall time per right-hand side.
+alone, the same of the process's CPU time, right-hand sides, and CVODE's
+counters (``_cvode_stats.py``): steps, error-test failures, Newton
+iterations and convergence failures, GMRES iterations and convergence
+failures, preconditioner Jacobians and setups, and the CPU time per
+right-hand side.
 
     python solvers/octopus_stats.py [--quick | --smoke] [--out DIR] [--reps K]
 """
@@ -35,18 +36,18 @@ def _without_clamp_links(assembly, part, links=system_preconditioner.links):
 
 
 def run(thing, t_end, options, before=False):
-    """simulate ``thing``; (wall [s], result, CVODE's counters)."""
+    """simulate ``thing``; (wall [s], CPU [s], result, CVODE's counters)."""
     links = system_preconditioner.links
     if before:
         system_preconditioner.links = _without_clamp_links
     try:
         with _cvode_stats.Recorder() as made:
-            start = time.perf_counter()
+            start, cpu = time.perf_counter(), time.process_time()
             result = rodmol.simulate(thing, t_end, **options)
-            wall = time.perf_counter() - start
+            wall, cpu = time.perf_counter() - start, time.process_time() - cpu
     finally:
         system_preconditioner.links = links
-    return wall, result, _cvode_stats.counters(made.solvers[-1], result.stats["rhs_evals"])
+    return wall, cpu, result, _cvode_stats.counters(made.solvers[-1], result.stats["rhs_evals"])
 
 
 def main(argv=None):
@@ -70,27 +71,27 @@ def main(argv=None):
         last = {}
         for _ in range(args.reps):  # interleaved: a change of the machine's load falls on every case
             for label, thing, options, before in cases:
-                wall, result, counts = run(thing, t_end, options, before)
-                walls[label].append(wall)
+                wall, cpu, result, counts = run(thing, t_end, options, before)
+                walls[label].append((wall, cpu))
                 last[label] = (result, counts)
-        one = float(np.median(walls[cases[0][0]]))
+        one = np.median(walls[cases[0][0]], axis=0)
         for label, *_ in cases:
             result, counts = last[label]
-            wall = float(np.median(walls[label]))
+            wall, cpu = np.median(walls[label], axis=0)
             rhs = result.stats["rhs_evals"]
-            row = dict(pattern=name, case=label, state_size=result.states.shape[1], wall_s=wall,
-                       vs_one_arm=wall / one, rhs_evals=rhs, steps=counts["steps"],
+            row = dict(pattern=name, case=label, state_size=result.states.shape[1], wall_s=wall, cpu_s=cpu,
+                       vs_one_arm=wall / one[0], cpu_vs_one_arm=cpu / one[1], rhs_evals=rhs, steps=counts["steps"],
                        error_test_fails=counts["error_test_fails"], newton_iters=counts["newton_iters"],
                        newton_conv_fails=counts["newton_conv_fails"], krylov_iters=counts["krylov_iters"],
                        krylov_conv_fails=counts["krylov_conv_fails"], jacobians=result.stats["jac_evals"],
-                       linear_setups=counts["linear_setups"], us_per_rhs=1e6 * wall / rhs,
+                       linear_setups=counts["linear_setups"], cpu_us_per_rhs=1e6 * cpu / rhs,
                        success=result.success)
             rows.append(row)
             print(row, flush=True)
-    fmt = {"wall_s": ".3g", "vs_one_arm": ".2f", "us_per_rhs": ".0f"}
-    columns = ["pattern", "case", "wall_s", "vs_one_arm", "rhs_evals", "steps", "error_test_fails", "newton_iters",
+    fmt = {"wall_s": ".3g", "vs_one_arm": ".2f", "cpu_s": ".3g", "cpu_vs_one_arm": ".2f", "cpu_us_per_rhs": ".0f"}
+    columns = ["pattern", "case", "wall_s", "vs_one_arm", "cpu_s", "cpu_vs_one_arm", "rhs_evals", "steps", "error_test_fails", "newton_iters",
                "newton_conv_fails", "krylov_iters", "krylov_conv_fails", "jacobians", "linear_setups",
-               "us_per_rhs"]
+               "cpu_us_per_rhs"]
     C.write_results(args, "octopus_stats", "Octopus: CVODE's counters against the number of arms", header
                     + [f"N = {n}, t_end = {t_end:g} s, medians of {args.reps} interleaved rounds"], rows,
                     [("Results", C.markdown_table(rows, columns, fmt))])
