@@ -35,6 +35,8 @@ N_rb z_b.
 import numpy as np
 
 from .joints import block_entries
+from .physics import jit
+from .preconditioner import block_solve
 from .rigid import FREE_BODY
 
 #: A joint node's rows (its velocities) and columns (what the joint reads), within its element block.
@@ -45,6 +47,13 @@ CLAMP_COLUMNS = block_entries("q", "k", "v", "w")
 
 #: Relative step of the body blocks' differences, times each entry's scale.
 BODY_STEP = 1e-7
+
+
+@jit
+def _solve_rows(gamma, head, fac, rhs, out, y_x, y_p, h):
+    """out[j] = (I - gamma J)^-1 rhs[j] for each row j, with a rod's factors (:func:`block_solve`)."""
+    for j in range(rhs.shape[0]):
+        block_solve(gamma, head, fac, rhs[j], out[j], y_x, y_p, h)
 
 
 class Link:
@@ -164,14 +173,6 @@ class SystemPreconditioner:
         if link.clamp:
             rod(t, y[sl], self._out[sl])
 
-    def _rod_solve(self, name, rows_values):
-        """N_rr^-1 of a right-hand side nonzero at link rows only: [(link, values)] of rod ``name``."""
-        rhs = np.zeros(self.assembly.rods[name].size)
-        start = self.assembly.parts[name].start
-        for link, values in rows_values:
-            rhs[link.rows - start] += values
-        return self.rods[name].apply(rhs)
-
     def _factor_schur(self, gamma):
         """S = N_bb - N_br N_rr^-1 N_rb over the coupled bodies, inverted; N_rr^-1 N_rb and N_br kept."""
         schur, size = np.zeros_like(self._schur), FREE_BODY.size
@@ -191,10 +192,16 @@ class SystemPreconditioner:
             for link in self.links[part.name]:
                 by_rod.setdefault(link.rod, []).append(link)
             for rod, rod_links in by_rod.items():
+                # The body entries that move the rod (a clamp's: its velocities), one rod solve each.
                 moving = np.flatnonzero(np.any([link.to_body.any(axis=0) for link in rod_links], axis=0))
-                for k in moving:  # the body entries that move the rod (a clamp's: its velocities)
-                    self._solved[rod][:, o + k] = self._rod_solve(
-                        rod, [(link, -gamma * link.to_body[:, k]) for link in rod_links])
+                start = self.assembly.parts[rod].start
+                rhs = np.zeros((len(moving), self.assembly.rods[rod].size))
+                for link in rod_links:
+                    rhs[:, link.rows - start] -= gamma * link.to_body[:, moving].T
+                out = np.empty_like(rhs)
+                g, head, fac, scratch = self.rods[rod].factors
+                _solve_rows(g, head, fac, rhs, out, *scratch)
+                self._solved[rod][:, o + moving] = out.T
         reads = self._reads  # every body linked to a rod reads N_rr^-1 N_rb at its links' columns
         for rod, solved in self._solved.items():
             sl = self.assembly.parts[rod]

@@ -19,8 +19,9 @@ The coupled Jacobian is not banded (a body's rows read its rods' first cells
 and joint nodes) but sparse: each rod's band, and the rows and columns of the
 couplings. :class:`CoupledDifferences` takes it in few evaluations as a
 sparse matrix, factorised by a sparse LU (SuperLU through scipy), so the cost
-grows about as the number of unknowns rather than its cube: an octopus of
-eight arms at N = 30 took 2.5 GB and minutes densely (docs/performance.md).
+grows about as the number of unknowns rather than its cube: on eight arms at
+N = 30 on a free head (3126 unknowns) 7 MB and 0.8 s CPU against the dense
+LU's 239 MB and 3.9 s (``solvers/system_equilibrium_speed.py``).
 """
 
 import numpy as np
