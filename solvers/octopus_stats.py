@@ -7,7 +7,10 @@ tolerances) with 1, 2, 4 and 8 arms on the free head, against one arm alone
 8 arms: the head fixed (the arms then share only the step size), and the
 preconditioner as it was before the head's clamp links
 (``SystemPreconditioner`` with only its penalty-joint links: each arm and
-the head on their own, the tree coupling left to GMRES). Reported per case:
+the head on their own, the tree coupling left to GMRES); and the octopus's eight arms each run
+alone (a Model, its own cable and phase), and their sum: with the pulsing
+pattern an arm whose phase makes it start under tension at t = 0 takes
+more steps than the first arm, which starts from zero. Reported per case:
 wall time (median of --reps interleaved rounds) and its ratio to one arm
 alone, the same of the process's CPU time, right-hand sides, and CVODE's
 counters (``_cvode_stats.py``): steps, error-test failures, Newton
@@ -67,6 +70,10 @@ def main(argv=None):
                   for k in ARM_COUNTS]
         cases += [(f"{O.ARMS} arms + fixed head", O.octopus(n, pattern, O.ARMS, "fixed"), {}, False),
                   (f"{O.ARMS} arms + free head, before (no clamp links)", O.octopus(n, pattern), {}, True)]
+        # The octopus's other arms alone (Models), each with its cable and phase (arm 1 is the one above).
+        alone = [(f"arm {i + 1} alone, Model", O.arm(n, 1 if i % 2 == 0 else 3, pattern(2.0 * np.pi * i / O.ARMS))
+                  .replace(gravity=water["gravity"]), dict(initial="straight"), False) for i in range(1, O.ARMS)]
+        cases += alone
         walls = {label: [] for label, *_ in cases}
         last = {}
         for _ in range(args.reps):  # interleaved: a change of the machine's load falls on every case
@@ -88,6 +95,11 @@ def main(argv=None):
                        success=result.success)
             rows.append(row)
             print(row, flush=True)
+        arms = [row for row in rows[-len(cases):] if row["case"] in ([cases[0][0]] + [c[0] for c in alone])]
+        total = {key: sum(row[key] for row in arms) for key in ("wall_s", "cpu_s", "rhs_evals", "steps")}
+        rows.append(dict(pattern=name, case=f"the {O.ARMS} arms alone, summed", state_size=O.ARMS * rows[-1]["state_size"],
+                         **total, vs_one_arm=total["wall_s"] / one[0], cpu_vs_one_arm=total["cpu_s"] / one[1],
+                         cpu_us_per_rhs=1e6 * total["cpu_s"] / total["rhs_evals"], success=True))
     fmt = {"wall_s": ".3g", "vs_one_arm": ".2f", "cpu_s": ".3g", "cpu_vs_one_arm": ".2f", "cpu_us_per_rhs": ".0f"}
     columns = ["pattern", "case", "wall_s", "vs_one_arm", "cpu_s", "cpu_vs_one_arm", "rhs_evals", "steps", "error_test_fails", "newton_iters",
                "newton_conv_fails", "krylov_iters", "krylov_conv_fails", "jacobians", "linear_setups",
