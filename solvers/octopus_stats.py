@@ -16,7 +16,8 @@ alone, the same of the process's CPU time, right-hand sides, and CVODE's
 counters (``_cvode_stats.py``): steps, error-test failures, Newton
 iterations and convergence failures, GMRES iterations and convergence
 failures, preconditioner Jacobians and setups, and the CPU time per
-right-hand side.
+right-hand side; and the accuracy of the octopus's head and tips, with and
+without the clamp links, against a run at rtol = 1e-8.
 
     python solvers/octopus_stats.py [--quick | --smoke] [--out DIR] [--reps K]
 """
@@ -53,6 +54,11 @@ def run(thing, t_end, options, before=False):
     return wall, cpu, result, _cvode_stats.counters(made.solvers[-1], result.stats["rhs_evals"])
 
 
+def _motion(result):
+    """The head's position (n, 3) and the arms' tips (arms, n, 3) [m], global, of an octopus run."""
+    return result["head"].position, np.array([result[name].tip for name in result.assembly.rods])
+
+
 def main(argv=None):
     args = C.parse_args(__doc__.splitlines()[0], argv)
     header = C.header_lines(args, SCRIPT)
@@ -61,7 +67,7 @@ def main(argv=None):
     water = dict(medium="water", gravity=(0.0, 0.0, -9.81))
     rodmol.simulate(rodmol.System({"a": O.arm(n, 1, O.ramp(0.0))}, **water), 0.01)  # compile
     rodmol.simulate(O.arm(n, 1, O.ramp(0.0)), 0.01, initial="straight")
-    rows = []
+    rows, accuracy = [], []
     for name, pattern in O.PATTERNS.items():
         cases = [("one arm, Model (band LU)", O.arm(n, 1, pattern(0.0)).replace(gravity=water["gravity"]),
                   dict(initial="straight"), False),
@@ -95,6 +101,12 @@ def main(argv=None):
                        success=result.success)
             rows.append(row)
             print(row, flush=True)
+        # Accuracy: the octopus's head and tips against a run at rtol 1e-8, with and without the clamp links.
+        reference = _motion(run(O.octopus(n, pattern), t_end, dict(rtol=1e-8))[2])
+        for label in (f"{O.ARMS} arms + free head", f"{O.ARMS} arms + free head, before (no clamp links)"):
+            head, tips = _motion(last[label][0])
+            accuracy.append(dict(pattern=name, case=label, head_error_m=float(np.abs(head - reference[0]).max()),
+                                 tip_error_m=float(np.abs(tips - reference[1]).max()), head_z_end_m=float(head[-1, 2])))
         arms = [row for row in rows[-len(cases):] if row["case"] in ([cases[0][0]] + [c[0] for c in alone])]
         total = {key: sum(row[key] for row in arms) for key in ("wall_s", "cpu_s", "rhs_evals", "steps")}
         rows.append(dict(pattern=name, case=f"the {O.ARMS} arms alone, summed", state_size=O.ARMS * rows[-1]["state_size"],
@@ -106,7 +118,10 @@ def main(argv=None):
                "cpu_us_per_rhs"]
     C.write_results(args, "octopus_stats", "Octopus: CVODE's counters against the number of arms", header
                     + [f"N = {n}, t_end = {t_end:g} s, medians of {args.reps} interleaved rounds"], rows,
-                    [("Results", C.markdown_table(rows, columns, fmt))])
+                    [("Results", C.markdown_table(rows, columns, fmt)),
+                     ("Accuracy (against the same octopus at rtol = 1e-8; largest error over the output times)",
+                      C.markdown_table(accuracy, None, {"head_error_m": ".2e", "tip_error_m": ".2e",
+                                                        "head_z_end_m": ".6f"}))])
 
 
 if __name__ == "__main__":
