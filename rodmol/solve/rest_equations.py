@@ -183,7 +183,8 @@ def continuation(at, z, tol, max_iter, jacobian, t, end=1.0):
 def damped_newton(fun, z, tol, max_iter, jacobian):
     """Damped Newton with the difference Jacobian ``jacobian``: banded
     (:class:`BandedDifferences`), the step accepted when it lowers |R|, or
-    dense (``bands`` None: a system's coupled equations), the step accepted
+    unbanded (``bands`` None: a system's coupled equations, a scipy sparse
+    matrix or a dense array), the step accepted
     when it lowers the Newton correction |J^-1 R| (Deuflhard's natural
     monotonicity test: blind to the rows' scales, where a stiff penalty
     joint's rows would otherwise make |R| rise along every step); None if it
