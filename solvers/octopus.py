@@ -14,7 +14,9 @@ octopus with both linear solvers of systems (the preconditioned GMRES, the
 default, and the sparse LU); all from the straight rest state. Reported: wall
 time, simulated seconds per wall second, right-hand side evaluations, and
 the ratio of the octopus's wall time to one arm's (medians of --reps rounds,
-each round running every case once).
+each round running every case once), and the same for the process's CPU
+time (``time.process_time``: on the shared machine, a neighbour's load
+stretches the wall time of a long case more than that of a short one).
 
     python solvers/octopus.py [--quick | --smoke] [--out DIR]
 """
@@ -47,7 +49,7 @@ def arm(n, cable, tension):
     return rodmol.paper_arm(n, tensions={cable: tension}, markers=())
 
 
-def head():
+def head(motion="free"):
     water = rodmol.MEDIA["water"].rho
     volume = 4.0 / 3.0 * np.pi * HEAD_RADIUS**3
     mass = 1.1 * water * volume
@@ -55,20 +57,22 @@ def head():
     added = 0.5 * water * volume  # a sphere's added mass
     drag = 0.5 * water * 0.47 * np.pi * HEAD_RADIUS**2  # C_d = 0.47
     return rodmol.RigidBody(mass, (inertia,) * 3, volume=volume, added_mass=(added,) * 3 + (0.0,) * 3,
-                            drag=(drag,) * 3 + (1e-4,) * 3)
+                            drag=(drag,) * 3 + (1e-4,) * 3, motion=motion)
 
 
-def octopus(n, pattern):
+def octopus(n, pattern, arms=ARMS, motion="free", tilt=30.0):
+    """``arms`` arms spread evenly round the head (``motion``: free, or fixed for a study), their
+    phases spread over a period, leaving it ``tilt`` degrees below the horizontal."""
     rods, joints = {}, []
-    tilt = np.radians(30.0)
-    for i in range(ARMS):
-        angle = 2.0 * np.pi * i / ARMS
+    tilt = np.radians(tilt)
+    for i in range(arms):
+        angle = 2.0 * np.pi * i / arms
         out = np.array([np.cos(angle) * np.cos(tilt), np.sin(angle) * np.cos(tilt), -np.sin(tilt)])
         side = np.array([-np.sin(angle), np.cos(angle), 0.0])
         frame = np.column_stack([out, side, np.cross(out, side)])  # the arm's base frame in the head's
-        rods[f"arm{i + 1}"] = arm(n, 1 if i % 2 == 0 else 3, pattern(2.0 * np.pi * i / ARMS))
+        rods[f"arm{i + 1}"] = arm(n, 1 if i % 2 == 0 else 3, pattern(2.0 * np.pi * i / arms))
         joints.append(rodmol.Joint(("head", HEAD_RADIUS * out, frame), (f"arm{i + 1}", "base")))
-    return rodmol.System(rods, {"head": head()}, joints, medium="water", gravity=(0.0, 0.0, -9.81))
+    return rodmol.System(rods, {"head": head(motion)}, joints, medium="water", gravity=(0.0, 0.0, -9.81))
 
 
 def timed(cases, t_end, reps):
@@ -77,18 +81,20 @@ def timed(cases, t_end, reps):
     that a change of the shared machine's load falls on all of them); and the
     last case's last result."""
     walls = {label: [] for label, _, _ in cases}
+    cpus = {label: [] for label, _, _ in cases}
     for _ in range(reps):
         for label, thing, options in cases:
-            start = time.perf_counter()
+            start, cpu = time.perf_counter(), time.process_time()
             rodmol.simulate(thing, t_end, **options)
             walls[label].append(time.perf_counter() - start)
+            cpus[label].append(time.process_time() - cpu)
     rows = []
     for label, thing, options in cases:
         result = rodmol.simulate(thing, t_end, **options)  # for its statistics
         wall = float(np.median(walls[label]))
         rows.append(dict(case=label, state_size=result.states.shape[1], t_end_s=t_end, wall_s=wall,
-                         sim_s_per_wall_s=t_end / wall, rhs_evals=result.stats["rhs_evals"],
-                         success=result.success))
+                         sim_s_per_wall_s=t_end / wall, cpu_s=float(np.median(cpus[label])),
+                         rhs_evals=result.stats["rhs_evals"], success=result.success))
     return rows, result
 
 
@@ -110,13 +116,15 @@ def main(argv=None):
                  (f"octopus, {ARMS} arms + head, GMRES", octopus(n, pattern), {})]
         timed_rows, result = timed(cases, t_end, args.reps)
         for row in timed_rows:
-            row = dict(pattern=name, **row, N=n, wall_vs_one_arm_model=row["wall_s"] / timed_rows[0]["wall_s"])
+            row = dict(pattern=name, **row, N=n, wall_vs_one_arm_model=row["wall_s"] / timed_rows[0]["wall_s"],
+                       cpu_vs_one_arm_model=row["cpu_s"] / timed_rows[0]["cpu_s"])
             rows.append(row)
             print(row, flush=True)
         drift = max(float(np.max(result.pose_drift(rod)[0])) for rod in result.assembly.rods)
         notes += (f"- {name}: head at t_end {np.round(result['head'].position[-1], 4).tolist()} m, "
                   f"largest header-to-clamp drift of the arms {drift:.2e} m.\n")
-    fmt = {"wall_s": ".3g", "sim_s_per_wall_s": ".3g", "wall_vs_one_arm_model": ".2f", "t_end_s": ".3g"}
+    fmt = {"wall_s": ".3g", "sim_s_per_wall_s": ".3g", "wall_vs_one_arm_model": ".2f", "t_end_s": ".3g",
+           "cpu_s": ".3g", "cpu_vs_one_arm_model": ".2f"}
     C.write_results(args, "octopus", "Octopus: eight arms on a free head against one arm", header, rows,
                     [("Results", C.markdown_table(rows, None, fmt)), ("Notes", notes)])
 

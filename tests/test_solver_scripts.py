@@ -174,6 +174,22 @@ def _octopus(out):
     assert octopus == 8 * one + 13  # eight arms and a free head's block
 
 
+def _octopus_stats(out):
+    table = rows(out / "octopus_stats.csv")  # CVODE's counters read and checked against the run's count
+    assert all(row["success"] is True for row in table), table
+    for pattern in {row["pattern"] for row in table}:
+        sizes = {row["case"]: row["state_size"] for row in table if row["pattern"] == pattern}
+        one = sizes["one arm, System (GMRES)"]
+        assert all(sizes[f"{k} arm{'s' if k > 1 else ''} + free head"] == k * one + 13 for k in (1, 2, 4, 8))
+
+
+def _system_equilibrium_speed(out):
+    table = rows(out / "system_equilibrium_speed.csv")  # both paths find the same rest; sparse needs less memory
+    assert {row["jacobian"] for row in table} == {"sparse", "dense"}
+    assert all(row["max_difference_over_scale"] < 1e-8 for row in table), table
+    assert all(row["peak_vs_dense"] < 1.0 for row in table if row["jacobian"] == "sparse"), table
+
+
 def _rest_strains_speed(out):
     with open(out / "rest_strains_speed.md") as f:  # the default rest strains change no number
         assert "tip trajectories bitwise equal: True" in f.read()
@@ -241,6 +257,9 @@ SCRIPTS = {
     "linear_mpc.py": (["linear_mpc.csv", "linear_mpc.md"], _linear_mpc),
     "quaternion_norm.py": (["quaternion_norm.csv", "quaternion_norm.md"], _quaternion_norm),
     "octopus.py": (["octopus.csv", "octopus.md"], _octopus),
+    "octopus_stats.py": (["octopus_stats.csv", "octopus_stats.md"], _octopus_stats),
+    "system_equilibrium_speed.py": (["system_equilibrium_speed.csv", "system_equilibrium_speed.md"],
+                                    _system_equilibrium_speed),
     "rest_strains_speed.py": (["rest_strains_speed.csv", "rest_strains_speed.md"], _rest_strains_speed),
     "holds.py": (["holds.csv", "holds.md"], _holds),
     "loops.py": (["loops.csv", "loops.md"], _loops),

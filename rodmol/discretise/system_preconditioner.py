@@ -8,71 +8,88 @@ inverted directly, J_bb by differences in the body's own entries: of the
 full right-hand side in its velocities (they move the rods' bases), of its
 own rates in its rotation and, if it has penalty joints (whose held points
 it moves), its position; no rate of a body without them reads its
-position. The tree joints' coupling blocks are left out: GMRES's products
-J v are differences of the full right-hand side, so it sees them, only
-converging in more iterations.
+position.
 
-A body's joints to the world or to fixed or driven bodies are in its own
-block; a joint between two free bodies couples their blocks as stiffly as
-it holds them: both bodies join the Schur complement below, with the
-coupling blocks N_b1b2 (by differences of the full right-hand side in one
-body's entries, the other's rows).
-
-A penalty joint between a rod node and a free body couples them as stiffly
-as it holds them: left out, GMRES needs hundreds of times the right-hand
-sides or fails. Its blocks are kept, and the free bodies with penalty
-joints are eliminated by their Schur complement: with N = I - gamma J split
-into the rods (r) and those bodies (b), N_rb holding each joint node's
-velocity rows against its body's entries and N_br the body's rows against
-the node's u, Q, v, w (both by differences), S = N_bb - N_br N_rr^-1 N_rb
-(dense, one block of ``rigid.FREE_BODY.size`` rows per body) is formed at each setup from one rod solve per
-body column and joined rod; a solve is z_r' = N_rr^-1 r_r, z_b = S^-1
-(r_b - N_br z_r'), z_r = z_r' - N_rr^-1 N_rb z_b.
+A free body is coupled to its rods both ways, and the coupling blocks are
+kept: the free bodies that carry rods, have penalty joints or are joined to
+other free bodies are eliminated by their Schur complement. Each coupling is a link between a body and a
+rod: a rod clamped to the body (a tree joint) links the rod's header and
+first element (their rows read the body's velocities: :meth:`Assembly.pattern`)
+and that element's strains and velocities (the body's rows read cell 0's
+stress from them: :data:`CLAMP_COLUMNS`), a penalty joint links its node's
+velocity rows (they read the body's pose and velocities) and its u, Q, v, w
+(the body's rows read the joint's reaction). A penalty joint couples as
+stiffly as it holds: left out, GMRES needed hundreds of times the
+right-hand sides or failed. A clamp's coupling left out (as it was until
+the octopus was measured) cost GMRES a second iteration per Newton
+iteration (solvers/octopus_stats.py). A joint between two free bodies
+couples their blocks as stiffly as it holds them: both are in the Schur
+complement, with the coupling blocks N_b1b2 (by differences of the full
+right-hand side in one body's entries, the other's rows); a body's joints
+to the world or to fixed or driven bodies are in its own block (left out,
+two clamped bodies took 19 times the right-hand sides, a pinned base's
+segment 240 times: solvers/body_joints.py).
+With N = I - gamma J split into the rods (r) and
+those bodies (b), N_rb holding the links' rod rows against the body's
+entries and N_br the body's rows against the links' rod entries (both by
+differences), S = N_bb - N_br N_rr^-1 N_rb (dense, one block of
+``rigid.FREE_BODY.size`` rows per body) is formed at each setup from one
+rod solve per body column that moves the rod and joined rod; a solve is
+z_r' = N_rr^-1 r_r, z_b = S^-1 (r_b - N_br z_r'), z_r = z_r' - N_rr^-1
+N_rb z_b.
 """
-
-from dataclasses import dataclass
 
 import numpy as np
 
 from .joints import block_entries
+from .physics import jit
+from .preconditioner import block_solve
 from .rigid import FREE_BODY
 
 #: A joint node's rows (its velocities) and columns (what the joint reads), within its element block.
 JOINT_ROWS, JOINT_COLUMNS = block_entries("v", "w"), block_entries("u", "Q", "v", "w")
+#: What a body reads of a rod clamped to it, within the rod's first element block: the stress of
+#: cell 0, from its strains and (the viscous law) their rates.
+CLAMP_COLUMNS = block_entries("q", "k", "v", "w")
 
 #: Relative step of the body blocks' differences, times each entry's scale.
 BODY_STEP = 1e-7
 
 
-@dataclass(eq=False)
-class Coupling:
-    """A coupling of a Schur body with rod ``rod``: the rod's ``rows`` its
-    entries move and the ``columns`` its rates read (state indices), and
-    the blocks by differences, ``rod_to_body`` (N_rb / -gamma, rows x body)
-    and ``body_to_rod`` (N_br / -gamma, body x columns). ``full``: the
-    body's rates read the columns through the rod's rates (a clamp: cell
-    0's stress), so their differences take the rod's rates first."""
-
-    rod: str
-    rows: np.ndarray
-    columns: np.ndarray
-    full: bool
-
-    def __post_init__(self):
-        self.rod_to_body = np.zeros((len(self.rows), FREE_BODY.size))
-        self.body_to_rod = np.zeros((FREE_BODY.size, len(self.columns)))
+@jit
+def _solve_rows(gamma, head, fac, rhs, out, y_x, y_p, h):
+    """out[j] = (I - gamma J)^-1 rhs[j] for each row j, with a rod's factors (:func:`block_solve`)."""
+    for j in range(rhs.shape[0]):
+        block_solve(gamma, head, fac, rhs[j], out[j], y_x, y_p, h)
 
 
-def couplings(assembly, part):
-    """The :class:`Coupling` of a Schur body ``part``: its penalty joints'
-    nodes and, for a pinned base (``segment_only``), its rods' clamps (the
-    header and first element: they outweigh the segment's own mass)."""
-    found = [Coupling(j.joint.rod, j.node + JOINT_ROWS, j.node + JOINT_COLUMNS, False) for j in part.joints]
-    for name, sd in zip(part.rods, part.systems) if part.segment_only else ():
+class Link:
+    """One coupling of a free body with a rod in the Schur complement: the
+    rod's ``rows`` that read the body and its entries (``columns``) that
+    the body's rows read, state indices; ``to_body`` (rows x body entries)
+    and ``from_rod`` (body entries x columns) are their Jacobian blocks,
+    J_rb and J_br (N = -gamma J off the diagonal). ``clamp``: the rod's base
+    is clamped to the body (the body's rows read the columns through the
+    rod's stress, so a column's difference re-evaluates the rod), else a
+    penalty joint (through the joint's reaction)."""
+
+    def __init__(self, rod, rows, columns, clamp):
+        self.rod, self.rows, self.columns, self.clamp = rod, rows, columns, clamp
+        self.to_body = np.zeros((len(rows), FREE_BODY.size))
+        self.from_rod = np.zeros((FREE_BODY.size, len(columns)))
+
+
+def links(assembly, part):
+    """The :class:`Link` s of free body ``part``: its clamped rods' header and
+    first element, its penalty joints' nodes."""
+    out = []
+    for name, sd in zip(part.rods, part.systems):
         start = assembly.parts[name].start
         first = np.arange(start, start + sd.layout.header + sd.layout.block)
-        found.append(Coupling(name, first, first, True))
-    return found
+        out.append(Link(name, first, start + sd.layout.header + CLAMP_COLUMNS, True))
+    for joint in part.joints:
+        out.append(Link(joint.joint.rod, joint.node + JOINT_ROWS, joint.node + JOINT_COLUMNS, False))
+    return out
 
 
 class SystemPreconditioner:
@@ -89,17 +106,23 @@ class SystemPreconditioner:
         self._field_of = {p.name: [f for f, n in p.layout.fields.items() for _ in range(n)] for p in self.bodies}
         self._out = np.empty(assembly.size)
         self._scale, self.gamma = scale, np.nan
-        # The Schur complement's bodies (free, with penalty joints, joints to other free bodies or a
-        # pinned base's), their offsets in S, their couplings with rods and with their free partners.
+        # The Schur complement's bodies (free, with rods, penalty joints or free partners joined to them),
+        # their links and offsets in S, and the blocks of their joints to their free partners.
         self._partners = {p.name: [o for j in p.body_joints for o in j.parts if o is not p and o.body.free]
                           for p in self.bodies}
-        self.coupled = [p for p in self.bodies
-                        if p.body.free and (p.joints or self._partners[p.name] or (p.segment_only and p.rods))]
-        self._couplings = {p.name: couplings(assembly, p) for p in self.coupled}
+        self.coupled = [p for p in self.bodies if p.body.free and (p.rods or p.joints or self._partners[p.name])]
         self._pairs = {(p.name, o.name): np.zeros((FREE_BODY.size, FREE_BODY.size))
                        for p in self.coupled for o in self._partners[p.name]}  # o's rows, p's columns
+        self.links = {p.name: links(assembly, p) for p in self.coupled}
         self._offset = dict(zip((p.name for p in self.coupled), FREE_BODY.size * np.arange(len(self.coupled))))
-        self._schur = np.eye(FREE_BODY.size * len(self.coupled))
+        size = FREE_BODY.size * len(self.coupled)
+        self._schur = np.eye(size)
+        # Per linked rod, N_rr^-1 N_rb (its columns: S's); all links' rod entries and N_br over them.
+        linked = dict.fromkeys(link.rod for p in self.coupled for link in self.links[p.name])
+        self._solved = {rod: np.zeros((assembly.rods[rod].size, size)) for rod in linked}
+        self._reads = np.concatenate([link.columns for p in self.coupled for link in self.links[p.name]]
+                                     or [np.zeros(0, dtype=int)])
+        self._n_br = np.zeros((size, len(self._reads)))
         self.jac_evals = self.setups = self.solves = 0
 
     def setup(self, t, y, fy, jok, jnew, gamma):
@@ -114,23 +137,26 @@ class SystemPreconditioner:
             z = np.array(y)
             for part in self.bodies:
                 assembly(t, y, self._out)  # the rods' stress at y (their Jacobians and other bodies moved it)
-                coupled = part in self.coupled
-                if coupled:
-                    self._coupling_columns(part, t, y, fy, z)
+                part_links = self.links.get(part.name, ())
+                for link in part_links:
+                    self._rod_columns(part, link, t, y, fy, z)
                 jac, steps = self._jac[part.name], self._steps[part.name]
                 for j, index in enumerate(range(part.slice.start, part.slice.stop)):
                     field = self._field_of[part.name][j]
                     if field == "x" and not (part.joints or part.body_joints) and part.contacts is None:
-                        continue
+                        continue  # no rate reads its position
                     z[index] = y[index] + steps[j]
-                    if field in ("x", "Q") and not coupled:  # of the rates kept, only the body's read its pose
-                        assembly.body_rates(part, t, z, self._out)
-                    else:  # its velocities move the rods' bases, its pose the joints' held points
+                    # Its velocities move the rods' bases, its pose the joints' held points and its free
+                    # partners' rates; of the rest only the body's own rates read its pose.
+                    full = field in ("v", "w") or bool(part.joints) or bool(self._partners[part.name])
+                    if full:
                         assembly(t, z, self._out)
+                    else:
+                        assembly.body_rates(part, t, z, self._out)
                     jac[:, j] = (self._out[part.slice] - fy[part.slice]) / steps[j]
-                    for c in self._couplings[part.name] if coupled else ():
-                        c.rod_to_body[:, j] = (self._out[c.rows] - fy[c.rows]) / steps[j]
-                    for other in self._partners[part.name] if coupled else ():
+                    for link in part_links:
+                        link.to_body[:, j] = (self._out[link.rows] - fy[link.rows]) / steps[j] if full else 0.0
+                    for other in self._partners[part.name] if part in self.coupled else ():
                         rows = other.slice
                         self._pairs[part.name, other.name][:, j] = (self._out[rows] - fy[rows]) / steps[j]
                     z[index] = y[index]
@@ -146,55 +172,59 @@ class SystemPreconditioner:
             self._factor_schur(gamma)
         self.setups += 1
 
-    def _coupling_columns(self, part, t, y, fy, z):
-        """The body's rows against each coupling's columns (N_br / -gamma), by differences of its rates."""
+    def _rod_columns(self, part, link, t, y, fy, z):
+        """The body's rows against the link's rod entries (J_br), by differences of its rates; a
+        clamp's through its rod's rates (its stress), left as at y."""
         assembly = self.assembly
-        for c in self._couplings[part.name]:
-            rod = assembly.parts[c.rod]
-            for k, index in enumerate(c.columns):
-                step = BODY_STEP * max(self._scale[index], 1e-300)
-                z[index] = y[index] + step
-                if c.full:  # the rod's rates (its cell 0's stress), its base velocities as at y
-                    assembly.rods[c.rod](t, z[rod], self._out[rod])
-                assembly.body_rates(part, t, z, self._out)
-                c.body_to_rod[:, k] = (self._out[part.slice] - fy[part.slice]) / step
-                z[index] = y[index]
-        assembly(t, y, self._out)
-
-    def _rod_solve(self, name, rows_values):
-        """N_rr^-1 of a right-hand side nonzero at coupling rows only: [(coupling, values)] of rod ``name``."""
-        rhs = np.zeros(self.assembly.rods[name].size)
-        start = self.assembly.parts[name].start
-        for c, values in rows_values:
-            rhs[c.rows - start] += values
-        return self.rods[name].apply(rhs)
-
-    def _by_rod(self, part):
-        """``part``'s couplings grouped by rod."""
-        by_rod = {}
-        for c in self._couplings[part.name]:
-            by_rod.setdefault(c.rod, []).append(c)
-        return by_rod
+        rod, sl = assembly.rods[link.rod], assembly.parts[link.rod]
+        for c, index in enumerate(link.columns):
+            step = BODY_STEP * max(self._scale[index], 1e-300)
+            z[index] = y[index] + step
+            if link.clamp:
+                rod(t, z[sl], self._out[sl])
+            assembly.body_rates(part, t, z, self._out)
+            link.from_rod[:, c] = (self._out[part.slice] - fy[part.slice]) / step
+            z[index] = y[index]
+        if link.clamp:
+            rod(t, y[sl], self._out[sl])
 
     def _factor_schur(self, gamma):
-        """S = N_bb - N_br N_rr^-1 N_rb over the coupled bodies, inverted."""
+        """S = N_bb - N_br N_rr^-1 N_rb over the coupled bodies, inverted; N_rr^-1 N_rb and N_br kept."""
         schur, size = np.zeros_like(self._schur), FREE_BODY.size
+        column = 0
         for part in self.coupled:
             o = self._offset[part.name]
             schur[o:o + size, o:o + size] = np.eye(size) - gamma * self._jac[part.name]
+            for link in self.links[part.name]:
+                self._n_br[:, column:column + len(link.columns)] = 0.0
+                self._n_br[o:o + size, column:column + len(link.columns)] = -gamma * link.from_rod
+                column += len(link.columns)
         for (name, other), block in self._pairs.items():  # the body joints' coupling of two free bodies
             o, oo = self._offset[name], self._offset[other]
             schur[oo:oo + size, o:o + size] -= gamma * block
+        for solved in self._solved.values():
+            solved[:] = 0.0
         for part in self.coupled:
             o = self._offset[part.name]
-            for rod, found in self._by_rod(part).items():
+            by_rod = {}
+            for link in self.links[part.name]:
+                by_rod.setdefault(link.rod, []).append(link)
+            for rod, rod_links in by_rod.items():
+                # The body entries that move the rod (a clamp's: its velocities), one rod solve each.
+                moving = np.flatnonzero(np.any([link.to_body.any(axis=0) for link in rod_links], axis=0))
                 start = self.assembly.parts[rod].start
-                for k in range(size):
-                    x = self._rod_solve(rod, [(c, -gamma * c.rod_to_body[:, k]) for c in found])
-                    for other in self.coupled:  # every body coupled to this rod reads x at its columns
-                        oo = self._offset[other.name]
-                        for c in self._by_rod(other).get(rod, ()):
-                            schur[oo:oo + size, o + k] -= -gamma * c.body_to_rod @ x[c.columns - start]
+                rhs = np.zeros((len(moving), self.assembly.rods[rod].size))
+                for link in rod_links:
+                    rhs[:, link.rows - start] -= gamma * link.to_body[:, moving].T
+                out = np.empty_like(rhs)
+                g, head, fac, scratch = self.rods[rod].factors
+                _solve_rows(g, head, fac, rhs, out, *scratch)
+                self._solved[rod][:, o + moving] = out.T
+        reads = self._reads  # every body linked to a rod reads N_rr^-1 N_rb at its links' columns
+        for rod, solved in self._solved.items():
+            sl = self.assembly.parts[rod]
+            inside = (reads >= sl.start) & (reads < sl.stop)
+            schur -= self._n_br[:, inside] @ solved[reads[inside] - sl.start]
         self._schur = np.linalg.inv(schur)
 
     def solve(self, t, y, fy, r, z, gamma, delta, lr):
@@ -206,22 +236,12 @@ class SystemPreconditioner:
         for part in self.bodies:
             if part not in self.coupled:
                 z[part.slice] = self._inverse[part.name] @ r[part.slice]
-        if not self.coupled:
-            self.solves += 1
-            return
-        g = self.gamma
-        rhs = np.concatenate([r[part.slice] for part in self.coupled])
-        for part in self.coupled:
-            o = self._offset[part.name]
-            for c in self._couplings[part.name]:
-                rhs[o:o + FREE_BODY.size] -= -g * c.body_to_rod @ z[c.columns]
-        z_b = self._schur @ rhs
-        by_rod = {}
-        for part in self.coupled:
-            o = self._offset[part.name]
-            z[part.slice] = z_b[o:o + FREE_BODY.size]
-            for c in self._couplings[part.name]:
-                by_rod.setdefault(c.rod, []).append((c, -g * c.rod_to_body @ z_b[o:o + FREE_BODY.size]))
-        for rod, rows_values in by_rod.items():
-            z[parts[rod]] -= self._rod_solve(rod, rows_values)
+        if self.coupled:
+            rhs = np.concatenate([r[part.slice] for part in self.coupled]) - self._n_br @ z[self._reads]
+            z_b = self._schur @ rhs
+            for part in self.coupled:
+                o = self._offset[part.name]
+                z[part.slice] = z_b[o:o + FREE_BODY.size]
+            for rod, solved in self._solved.items():
+                z[parts[rod]] -= solved @ z_b
         self.solves += 1

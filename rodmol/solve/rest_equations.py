@@ -12,7 +12,9 @@ dynamics' v, w rows with zero velocities).
 import weakref
 
 import numpy as np
+from scipy import sparse
 from scipy.linalg import lu_factor, lu_solve, solve_banded
+from scipy.sparse.linalg import splu
 
 from ..discretise import centreline, external, rotations
 from ..discretise.jacobian import BandedDifferences
@@ -181,7 +183,8 @@ def continuation(at, z, tol, max_iter, jacobian, t, end=1.0):
 def damped_newton(fun, z, tol, max_iter, jacobian):
     """Damped Newton with the difference Jacobian ``jacobian``: banded
     (:class:`BandedDifferences`), the step accepted when it lowers |R|, or
-    dense (``bands`` None: a system's coupled equations), the step accepted
+    unbanded (``bands`` None: a system's coupled equations, a scipy sparse
+    matrix or a dense array), the step accepted
     when it lowers the Newton correction |J^-1 R| (Deuflhard's natural
     monotonicity test: blind to the rows' scales, where a stiff penalty
     joint's rows would otherwise make |R| rise along every step); None if it
@@ -194,12 +197,12 @@ def damped_newton(fun, z, tol, max_iter, jacobian):
         try:
             matrix = jacobian(fun, z, f)
             if jacobian.bands is None:
-                factors = lu_factor(matrix, check_finite=False)
+                inverse = _factored(matrix)
 
-                def measure(g, factors=factors):
-                    return np.linalg.norm(lu_solve(factors, g, check_finite=False))
+                def measure(g, inverse=inverse):
+                    return np.linalg.norm(inverse(g))
 
-                dz = -lu_solve(factors, f, check_finite=False)
+                dz = -inverse(f)
                 norm = np.linalg.norm(dz)
             else:
                 measure, dz = np.linalg.norm, solve_banded(jacobian.bands, matrix, -f)
@@ -217,3 +220,14 @@ def damped_newton(fun, z, tol, max_iter, jacobian):
                 return None
         z, f, norm = z_try, f_try, norm_try
     return z if np.all(np.abs(f) < tol) else None
+
+
+def _factored(matrix):
+    """g -> matrix^-1 g by an LU of ``matrix``: sparse (scipy's SuperLU) or dense."""
+    if sparse.issparse(matrix):
+        try:
+            return splu(sparse.csc_matrix(matrix)).solve
+        except RuntimeError as exc:  # SuperLU's "Factor is exactly singular"
+            raise np.linalg.LinAlgError(str(exc)) from exc
+    factors = lu_factor(matrix, check_finite=False)
+    return lambda g: lu_solve(factors, g, check_finite=False)

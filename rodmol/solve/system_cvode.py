@@ -5,8 +5,8 @@ The Newton systems are solved (``linsolver``) by
 
 * ``"gmres"`` (default, unless two rods are joined): GMRES preconditioned by the rods' exact block
   preconditioners, the bodies' own blocks and, for free bodies with
-  penalty joints, their Schur complement
-  (:mod:`rodmol.discretise.system_preconditioner`); about 2x faster than
+  clamped rods or penalty joints, their Schur complement
+  (:mod:`rodmol.discretise.system_preconditioner`); about 2-3x faster than
   ``"sparse"`` on the octopus (``solvers/octopus.py``, docs/performance.md),
   as fast or faster on loops (``solvers/loops.py``, docs/systems.md);
 * ``"sparse"`` (default, and the only choice but "dense", when a

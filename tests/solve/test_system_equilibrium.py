@@ -1,7 +1,8 @@
 """The static equilibrium of systems with free bodies
 (rodmol.solve.system_equilibrium): a payload hanging on a rod from the world
 against the extensible bar's stretch, a tilted one started at rest, and the
-refusal of a body that nothing holds. The parallel robot's equilibrium is
+refusal of a body that nothing holds; the sparse Jacobian against the
+dense one. The parallel robot's equilibrium is
 tested against its shooting solution in tests/test_system_joints.py."""
 
 import numpy as np
@@ -9,6 +10,8 @@ import pytest
 
 import rodmol
 from rodmol.discretise.assembly import Assembly
+from rodmol.solve.rest_equations import continuation
+from rodmol.solve.system_equilibrium import CoupledDifferences, FreeRestEquations
 
 ROD_L, ROD_R, ROD_E, ROD_RHO, PAYLOAD_M, G = 0.5, 0.01, 1e6, 1000.0, 0.5, 9.81
 UP = ((0.0, -1.0, 0.0), (1.0, 0.0, 0.0), (0.0, 0.0, 1.0))  # the rod's x axis along global y
@@ -68,3 +71,26 @@ def test_free_body_held_by_nothing_has_no_equilibrium():
                           gravity=(0.0, -G, 0.0))
     with pytest.raises(rodmol.EquilibriumError, match="free body 'payload' is held by nothing"):
         rodmol.equilibrium(loose)
+
+
+def test_sparse_jacobian_equals_the_dense_one_and_finds_the_same_rest():
+    # Two rods hang a tilted payload (their bases clamped to it, their tips to the world): the
+    # sparse Jacobian holds every entry of the dense one, bitwise (the same differences, placed
+    # apart), and the continuation through SuperLU ends where the dense LU's does.
+    material = rodmol.Material(E=ROD_E, nu=0.5, mu=0.0, rho=ROD_RHO)
+    rod = rodmol.Model(rodmol.Rod(ROD_L, radius=ROD_R, material=material), 6)
+    payload = rodmol.RigidBody(PAYLOAD_M, (1e-4, 1e-4, 1e-4), centre_of_mass=(0.003, 0.0, 0.001))
+    joints = [rodmol.Joint(("payload", (0.0, 0.0, z), UP), (name, "base")) for name, z in (("a", -0.02), ("b", 0.02))]
+    joints += [rodmol.Joint("world", (name, "tip")) for name in ("a", "b")]
+    system = rodmol.System({"a": rod, "b": rod}, {"payload": payload}, joints, gravity=(0.0, -G, 0.0))
+    equations = FreeRestEquations(Assembly(system), 0.0)
+    z = equations.unknowns() + 1e-3 * np.random.default_rng(4).standard_normal(equations.size)
+    f = equations.residual(z)
+    sparse, dense = CoupledDifferences(equations), CoupledDifferences(equations, dense=True)
+    matrix = sparse(equations.residual, z, f)
+    assert matrix.nnz < 0.2 * equations.size**2
+    np.testing.assert_array_equal(matrix.toarray(), dense(equations.residual, z, f))
+    rests = [continuation(equations.residual, equations.unknowns(), equations.tolerance(1e-10), 40, jacobian, 0.0)
+             for jacobian in (sparse, dense)]
+    assert np.abs(rests[0][equations.slices["payload"]][3:]).max() > 1e-3  # the payload turned
+    np.testing.assert_allclose(rests[0], rests[1], rtol=0.0, atol=1e-10)
