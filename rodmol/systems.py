@@ -16,12 +16,13 @@ Two methods hold the joints:
   point of each body, is the same penalty law between the two points (one
   body's joint frame held by the other's), equal and opposite on the two
   bodies (:class:`BodyJoint`);
-* a rod's base *pinned* to the world or to a body is a small free body of
-  its own, the rod's base segment (the half cell the velocity nodes leave
-  out), its base clamped to it (eliminated) and the body pinned by a body
-  joint (:attr:`System.pinned_bases`).
+* a rod's base *pinned* to the world or to a body, or joined to another
+  rod's node (a branch), is a small free body of its own, the rod's base
+  segment (the half cell the velocity nodes leave out), its base clamped to
+  it (eliminated) and the body pinned by a body joint, or held to the other
+  rod's node by a penalty joint (:attr:`System.base_bodies`).
 
-A base joined to a rod raises :class:`rodmol.errors.NotSupportedYet`.
+Two rods' bases joined to each other raise :class:`rodmol.errors.NotSupportedYet`.
 """
 
 import numpy as np
@@ -69,10 +70,10 @@ class System:
     body_joints : list of BodyJoint
         The joints between bodies or a body and the world (with the pins of
         the pinned bases).
-    pinned_bases : dict of str to str
-        The rods whose base is pinned, each to the name of its base body
-        (``"<rod>.base"``, in ``bodies``: a free body carrying the rod's base
-        segment only; its result is the base's pose).
+    base_bodies : dict of str to str
+        The rods whose base is pinned or joined to another rod, each to the
+        name of its base body (``"<rod>.base"``, in ``bodies``: a free body
+        carrying the rod's base segment only; its result is the base's pose).
     """
 
     def __init__(self, rods, bodies=None, joints=(), *, medium=None, gravity=(0.0, -9.81, 0.0)):
@@ -102,7 +103,7 @@ class System:
                      for name, m in rods.items()}
         self.bodies = dict(bodies)
         self.joints = _checks.items("joints", joints, Joint, "a rodmol.Joint")
-        self.body_joints, self.pinned_bases = [], {}
+        self.body_joints, self.base_bodies = [], {}
         self.clamps, self.penalty_joints = self._joints()
 
     def _joints(self):
@@ -120,6 +121,17 @@ class System:
                 if isinstance(e, tuple) and e[0] == "body" and e[1] not in self.bodies:
                     raise ParameterError(f"`joints[{i}]` names the body {e[1]!r}, which is not in `bodies`"
                                          f"{_checks.did_you_mean(e[1], self.bodies)}")
+            bases = [e for e in rod_ends if e[2] == "base"]
+            if len(rod_ends) == 2 and len(bases) == 1:  # a branch: the base's body held by the other's node
+                (_, rod, _), (_, other_rod, where) = bases[0], next(e for e in rod_ends if e is not bases[0])
+                if rod in clamps:
+                    raise ParameterError(f"`joints[{i}]`: the base of rod {rod!r} is already jointed")
+                if rod == other_rod:
+                    raise ParameterError(f"`joints[{i}]` joins the base of rod {rod!r} to its own node")
+                name, clamps[rod] = self._base_body(i, rod, ("rod", other_rod, where))
+                penalties.append(self._node_joint(i, joint, other_rod, where, ("body", name, np.zeros(3), None),
+                                                  holds))
+                continue
             if len(rod_ends) == 2:
                 penalties += self._rod_to_rod(i, joint, rod_ends, holds)
                 continue
@@ -140,31 +152,36 @@ class System:
                                          "(exact), it takes no `stiffness` or `damping`")
                 clamps[rod] = self._clamp(i, rod, other)
                 continue
-            model = self.rods[rod]
-            s = model.rod.length if where == "tip" else where
-            name = f"joints[{i}]"
-            if other == "world":
-                hold = Hold(s, joint.kind, stiffness=joint.stiffness, damping=joint.damping, name=name)
-                body, point, rotation = None, None, None
-            else:
-                _, body, point, rotation = other
-                b = self.bodies[body]
-                held = None if rotation is None else b.rotation @ rotation
-                hold = Hold(s, joint.kind, position=b.position + b.rotation @ point, rotation=held,
-                            stiffness=joint.stiffness, damping=joint.damping, name=name)
-            penalties.append(PenaltyJoint(i, rod, len(model.loads) + len(holds[rod]), body, point, rotation,
-                                          joint.kind))
-            holds[rod].append(hold)
+            penalties.append(self._node_joint(i, joint, rod, where, other, holds))
         self.rods = {name: m.replace(loads=tuple(m.loads) + tuple(holds[name])) if holds[name] else m
                      for name, m in self.rods.items()}
         return clamps, penalties
 
+    def _node_joint(self, i, joint, rod, where, other, holds):
+        """The :class:`PenaltyJoint` of ``joints[i]`` holding rod ``rod``'s node
+        ``where`` (its tip or an arc length) to ``other`` (the world or a body
+        point); its hold is appended to ``holds[rod]``."""
+        model = self.rods[rod]
+        s = model.rod.length if where == "tip" else where
+        name = f"joints[{i}]"
+        if other == "world":
+            hold = Hold(s, joint.kind, stiffness=joint.stiffness, damping=joint.damping, name=name)
+            body, point, rotation = None, None, None
+        else:
+            _, body, point, rotation = other
+            b = self.bodies[body]
+            held = None if rotation is None else b.rotation @ rotation
+            hold = Hold(s, joint.kind, position=b.position + b.rotation @ point, rotation=held,
+                        stiffness=joint.stiffness, damping=joint.damping, name=name)
+        holds[rod].append(hold)
+        return PenaltyJoint(i, rod, len(model.loads) + len(holds[rod]) - 1, body, point, rotation, joint.kind)
+
     def _rod_to_rod(self, i, joint, rod_ends, holds):
         """The two penalty joints of ``joints[i]`` between two rods' nodes (not
         bases): each rod's hold held by the other's node, appended to ``holds``."""
-        if any(where == "base" for _, _, where in rod_ends):
-            raise NotSupportedYet(f"`joints[{i}]` joins a rod's base to a rod: a base can only be clamped to a "
-                                  "body or the world yet (join a rod's tip or node s to the other rod)")
+        if all(where == "base" for _, _, where in rod_ends):
+            raise NotSupportedYet(f"`joints[{i}]` joins two rods' bases: join a base to the other rod's tip or "
+                                  "node s, or both bases to a body")
         (_, a, where_a), (_, b, where_b) = rod_ends
         if a == b and where_a == where_b:
             raise ParameterError(f"`joints[{i}]` joins a node of rod {a!r} to itself")
@@ -229,20 +246,28 @@ class System:
                          joint.stiffness, joint.damping)
 
     def _pinned_base(self, i, joint, rod, other):
-        """Pin rod ``rod``'s base to ``other`` (``joints[i]``): its base body
-        (a free :class:`RigidBody` standing for the rod's base segment, its
-        mass properties replaced by the segment's when discretised), the base
-        clamped to it; returns the clamp."""
+        """Pin rod ``rod``'s base to ``other`` (``joints[i]``) through its base
+        body (:meth:`_base_body`); returns the clamp."""
+        name, clamp = self._base_body(i, rod, other)
+        self.body_joints.append(self._body_joint(i, joint, ("body", name, np.zeros(3), None), other))
+        return clamp
+
+    def _base_body(self, i, rod, other):
+        """Rod ``rod``'s base body for ``joints[i]`` (a free :class:`RigidBody`
+        standing for the rod's base segment, its mass properties replaced by
+        the segment's when discretised), placed at the point of body ``other``
+        or else (the world, another rod's node) at the Model's base; returns
+        its name and the clamp of the rod's base to it."""
         name = f"{rod}.base"
         if name in self.bodies or name in self.rods:
-            raise ParameterError(f"`joints[{i}]` pins the base of rod {rod!r}, whose base body is named {name!r}, "
+            raise ParameterError(f"`joints[{i}]` joins the base of rod {rod!r}, whose base body is named {name!r}, "
                                  "but that name is taken: rename the rod or the body")
         model = self.rods[rod]
-        if other == "world":
+        if not (isinstance(other, tuple) and other[0] == "body"):
             base = model.base
             if not base.fixed:
-                raise ParameterError(f"`joints[{i}]` pins rod {rod!r} to the world, but its Model's `base` "
-                                     "moves: drop the joint or the motion")
+                raise ParameterError(f"`joints[{i}]` joins the base of rod {rod!r} to {_describe(other)}, but its "
+                                     "Model's `base` moves: drop the joint or the motion")
             position, rotation = np.array(base.position, dtype=float), np.array(base.rotation, dtype=float)
         else:
             self._clamp(i, rod, other)  # the same checks of the Model's base as for a clamp
@@ -252,9 +277,8 @@ class System:
         half = 0.5 * model.ds * model.rod.material.rho  # a stand-in: the discretisation carries the segment
         self.bodies[name] = RigidBody(half * float(model.rod.area(0.0)), half * model.rod.second_moments(0.0),
                                       position=position, rotation=rotation)
-        self.pinned_bases[rod] = name
-        self.body_joints.append(self._body_joint(i, joint, ("body", name, np.zeros(3), None), other))
-        return (name, np.zeros(3), np.eye(3))
+        self.base_bodies[rod] = name
+        return name, (name, np.zeros(3), np.eye(3))
 
     def rods_on(self, body):
         """Names of the rods whose base is clamped to ``body``, in ``rods`` order."""

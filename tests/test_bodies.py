@@ -91,14 +91,17 @@ def test_system_graph_checks():
     # A pinned base is clamped to a body of its own (named after the rod), pinned where the joint says.
     pinned = rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint(("head", (0.1, 0, 0)), ("arm", "base"),
                                                                           "pin")])
-    assert pinned.pinned_bases == {"arm": "arm.base"} and pinned.rods_on("arm.base") == ["arm"]
+    assert pinned.base_bodies == {"arm": "arm.base"} and pinned.rods_on("arm.base") == ["arm"]
     (pin,) = pinned.body_joints
     assert (pin.a, pin.b, pin.kind, tuple(pin.point_b)) == ("arm.base", "head", "pin", (0.1, 0.0, 0.0))
     np.testing.assert_array_equal(pinned.bodies["arm.base"].position, (0.1, 0.0, 0.0))
     with pytest.raises(rodmol.ParameterError, match="'arm.base'.*taken"):
         rodmol.System({"arm": _arm()}, {"arm.base": head}, [rodmol.Joint("world", ("arm", "base"), "pin")])
-    with pytest.raises(rodmol.NotSupportedYet, match="joins a rod's base to a rod"):
-        rodmol.System({"arm": _arm(), "arm2": _arm()}, joints=[rodmol.Joint(("arm", "tip"), ("arm2", "base"))])
+    branched = rodmol.System({"arm": _arm(), "arm2": _arm()}, joints=[rodmol.Joint(("arm", "tip"), ("arm2", "base"))])
+    (held,) = branched.penalty_joints  # arm2's base body held by arm's tip (tests/test_system_branches.py)
+    assert branched.base_bodies == {"arm2": "arm2.base"} and (held.rod, held.body) == ("arm", "arm2.base")
+    with pytest.raises(rodmol.NotSupportedYet, match="two rods' bases"):
+        rodmol.System({"arm": _arm(), "arm2": _arm()}, joints=[rodmol.Joint(("arm", "base"), ("arm2", "base"))])
     with pytest.raises(rodmol.ParameterError, match="to itself"):
         rodmol.System({"arm": _arm()}, joints=[rodmol.Joint(("arm", "tip"), ("arm", "tip"))])
     with pytest.raises(rodmol.ParameterError, match="velocity node"):

@@ -100,7 +100,7 @@ class Assembly:
             self.parts[name] = slice(start, start + sd.size)
             start += sd.size
         self.scheme = next(iter(self.rods.values())).scheme
-        pinned = set(system.pinned_bases.values())
+        pinned = set(system.base_bodies.values())
         for name, body in system.bodies.items():
             part = BodyPart(name, body, start, system.medium.rho, segment_only=name in pinned)
             for rod in system.rods_on(name):

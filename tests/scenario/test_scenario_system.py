@@ -298,4 +298,4 @@ b = "world"
     system = parse_scenario(text).model
     assert [(j.a, j.b, j.kind) for j in system.body_joints] == [("head", "tail", "pin"), ("tail", None, "clamp")]
     pinned = parse_scenario(text.replace('b = ["right", "base"]', 'b = ["right", "base"]\nkind = "pin"')).model
-    assert pinned.pinned_bases == {"right": "right.base"} and pinned.clamps["right"][0] == "right.base"
+    assert pinned.base_bodies == {"right": "right.base"} and pinned.clamps["right"][0] == "right.base"
