@@ -22,6 +22,7 @@ from .arm import paper_arm
 from .base_motion import Base, BaseMotion
 from .bodies import RigidBody
 from .cables import Cable, read_tension_csv
+from .contacts import Contact
 from .calibrate import (
     LinearModel,
     calibrate_dlt,
@@ -67,7 +68,7 @@ from .solve.equilibrium import equilibrium
 from .systems import Joint, System
 
 __all__ = [
-    "BACKENDS", "Base", "BaseMotion", "Cable", "CapsuleContact", "DistributedForce",
+    "BACKENDS", "Base", "BaseMotion", "Cable", "CapsuleContact", "Contact", "DistributedForce",
     "DistributedMoment", "Hold", "PlaneContact", "PointForce", "PointMoment", "SphereContact", "EquilibriumError", "IntegrationError", "MEDIA",
     "Joint", "Marker", "Material", "Medium", "Model", "NotSupportedYet", "RigidBody", "System", "ParameterError", "Result", "Rod", "RodmolError",
     "SCHEMES", "ScenarioError", "SemiDiscrete", "Simulator", "StateLayout", "StateView", "UserFunctionError",

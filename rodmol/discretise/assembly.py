@@ -56,6 +56,7 @@ from scipy import sparse
 
 from ..bodies import mass_matrix_about_origin
 from .body_contact import BodyContacts
+from .contact_parts import contact_parts
 from .joints import JointPart, RecordedJoints, RodJointPart, block_entries
 from .layout import BlockLayout
 from .physics import quaternion_rate
@@ -189,6 +190,7 @@ class Assembly:
             elif joint.partner is not None:
                 self.rod_joints.append(RodJointPart(joint, *rod, self.rods[joint.partner],
                                                     self.parts[joint.partner].start))
+        self.joints += contact_parts(system, self.rods, {n: p.start for n, p in self.parts.items()}, self.bodies)
         self.free = [p for p in self.bodies.values() if p.body.free]
         self.lightly_damped = any(sd.lightly_damped for sd in self.rods.values())
         self._gravity = np.ascontiguousarray(system.gravity, dtype=float)

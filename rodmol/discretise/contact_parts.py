@@ -1,0 +1,96 @@
+"""Rods touching rigid bodies (:class:`rodmol.Contact`): the body's shape is
+one of the rod's contact loads (:class:`rodmol.PlaneContact`,
+:class:`rodmol.CapsuleContact`) whose geometry the body moves.
+
+As a penalty joint's hold (:mod:`rodmol.discretise.joints`), every velocity
+node's entry of that load is one part of the system: before each
+right-hand side its parameter row gets the shape where the body's pose puts
+it (global) and the obstacle's motion there (the velocity of the body's
+point at the row's first point and the body's angular velocity, global:
+the law's damping and friction act on the relative sliding), and the body
+feels the node's contact force with the opposite sign, acting at the
+contact point on the tube's surface, with its moment about the body's
+origin. The parts have a penalty joint part's interface (``joint.rod``,
+``part``, ``node``, ``entry``, ``row``, ``value``, :meth:`ContactPart.wrench`),
+so the assembly, its Jacobian pattern, the preconditioner's Schur
+complement, the equilibrium and the rebuilt Results take them as joints.
+"""
+
+import numpy as np
+
+from ..loads import KERNELS, P_OBSTACLE_SPIN, P_OBSTACLE_VELOCITY, P_RADIUS
+from .external import PLANE, contact, contact_depth
+from .layout import QUAT, U, V, W
+from .load_entries import count
+from .physics import add, cross, jit, rotation, scale, sub, to_global, to_local
+from .rigid import BQ, BV, BW, BX, _row3
+
+
+@jit
+def contact_reaction(kind, row, y, node, body, shape, length):
+    """Move a contact entry's obstacle with a body and return its reaction.
+
+    Writes into ``row`` (the entry's parameter row) the shape ``shape``
+    (6,), body frame (a capsule's start and end [m], a plane's point [m]
+    and normal), placed by the body in the state ``body`` (x, Q, v, w:
+    origin [m], quaternion, global; velocities [m/s, rad/s], body frame),
+    and the obstacle's motion (global). Returns the force and moment [N,
+    N m] about the body's origin, body frame, on the body: the opposite of
+    the force on the rod node whose element block starts at ``y[node]``
+    (its density times the node's ``length`` [m]), acting at the contact
+    point."""
+    x_b = _row3(body, BX)
+    r_b = rotation((body[BQ], body[BQ + 1], body[BQ + 2], body[BQ + 3]))
+    v_b, w_b = _row3(body, BV), _row3(body, BW)
+    first = _row3(shape, 0)
+    start = add(x_b, to_global(r_b, first))
+    second = to_global(r_b, _row3(shape, 3))
+    if kind != PLANE:
+        second = add(x_b, second)
+    velocity, spin = to_global(r_b, add(v_b, cross(w_b, first))), to_global(r_b, w_b)
+    for i in range(3):
+        row[i], row[3 + i] = start[i], second[i]
+        row[P_OBSTACLE_VELOCITY + i], row[P_OBSTACLE_SPIN + i] = velocity[i], spin[i]
+    u = _row3(y, node + U)
+    r = rotation((y[node + QUAT], y[node + QUAT + 1], y[node + QUAT + 2], y[node + QUAT + 3]))
+    f, _ = contact(kind, row, u, r, _row3(y, node + V), _row3(y, node + W))
+    _, normal = contact_depth(kind, row, u)
+    at = sub(u, scale(row[P_RADIUS], normal))  # the contact point on the tube's surface, global
+    force = to_local(r_b, scale(-length, to_global(r, f)))
+    return force, cross(to_local(r_b, sub(at, x_b)), force)
+
+
+class ContactPart:
+    """The entry of rod contact ``contact`` (a :class:`rodmol.systems`
+    ``RodContact``: its rod, load and shape in the body frame) at one
+    velocity node (element block ``block``) of the rod of system ``sd``
+    (state from ``rod_start``), moved by the body ``part``."""
+
+    def __init__(self, contact, sd, rod_start, part, block):
+        model = sd.model
+        self.joint, self.part = contact, part
+        self.entry = sum(count(item, model.s_nodes) for item in model.loads[:contact.load]) + block
+        self.kind = KERNELS[contact.shape.kernel].code
+        self.row, self.value = sd.entry_params[self.entry], sd.entry_values[self.entry]
+        self.node = rod_start + sd.layout.header + sd.layout.block * block
+        self.length = float(sd.grid_loads.weight[self.entry] * sd.node_lengths[block])
+        self.shape = np.ascontiguousarray(contact.geometry(), dtype=float)
+
+    def wrench(self, y, body, row, value):
+        """Write the obstacle's place and motion into ``row`` and return the body's reaction
+        (:func:`contact_reaction`; ``value`` is not read)."""
+        return contact_reaction(self.kind, row, y, self.node, body, self.shape, self.length)
+
+
+def contact_parts(system, rods, starts, bodies):
+    """The :class:`ContactPart` of every node of every rod contact of
+    ``system`` (``system.rod_contacts``), each appended to its body's
+    ``joints``: rod systems ``rods`` and their state ``starts`` by name,
+    ``bodies`` the BodyParts by name."""
+    parts = []
+    for contact in system.rod_contacts:
+        sd, part = rods[contact.rod], bodies[contact.body]
+        for block in range(sd.layout.n_blocks):
+            part.joints.append(ContactPart(contact, sd, starts[contact.rod], part, block))
+            parts.append(part.joints[-1])
+    return parts
