@@ -22,7 +22,6 @@ from .arm import paper_arm
 from .base_motion import Base, BaseMotion
 from .bodies import RigidBody
 from .cables import Cable, read_tension_csv
-from .contacts import Contact
 from .calibrate import (
     LinearModel,
     calibrate_dlt,
@@ -33,6 +32,7 @@ from .calibrate import (
     triangulate,
     worsened_models,
 )
+from .contacts import Contact
 from .control import Simulator, StaticFit, inverse_statics, inverse_statics_path
 from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES

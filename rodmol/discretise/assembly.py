@@ -180,7 +180,7 @@ class Assembly:
             self.parts[name] = part.slice
             start = part.slice.stop
         self.size = start
-        self.joints, self.rod_joints = [], []  # penalty joints to bodies, between rods (each side)
+        self.joints, self.rod_joints = contact_parts(self), []  # to bodies (rods' contacts first), between rods
         for joint in system.penalty_joints:
             rod = (self.rods[joint.rod], self.parts[joint.rod].start)
             if joint.body is not None:
@@ -190,7 +190,6 @@ class Assembly:
             elif joint.partner is not None:
                 self.rod_joints.append(RodJointPart(joint, *rod, self.rods[joint.partner],
                                                     self.parts[joint.partner].start))
-        self.joints += contact_parts(system, self.rods, {n: p.start for n, p in self.parts.items()}, self.bodies)
         self.free = [p for p in self.bodies.values() if p.body.free]
         self.lightly_damped = any(sd.lightly_damped for sd in self.rods.values())
         self._gravity = np.ascontiguousarray(system.gravity, dtype=float)

@@ -61,20 +61,20 @@ def contact_reaction(kind, row, y, node, body, shape, length):
 
 
 class ContactPart:
-    """The entry of rod contact ``contact`` (a :class:`rodmol.systems`
-    ``RodContact``: its rod, load and shape in the body frame) at one
+    """The entry of rod contact ``record`` (a :class:`rodmol.contacts.RodContact`:
+    its rod, load and shape in the body frame) at one
     velocity node (element block ``block``) of the rod of system ``sd``
     (state from ``rod_start``), moved by the body ``part``."""
 
-    def __init__(self, contact, sd, rod_start, part, block):
+    def __init__(self, record, sd, rod_start, part, block):
         model = sd.model
-        self.joint, self.part = contact, part
-        self.entry = sum(count(item, model.s_nodes) for item in model.loads[:contact.load]) + block
-        self.kind = KERNELS[contact.shape.kernel].code
+        self.joint, self.part = record, part
+        self.entry = sum(count(item, model.s_nodes) for item in model.loads[:record.load]) + block
+        self.kind = KERNELS[record.shape.kernel].code
         self.row, self.value = sd.entry_params[self.entry], sd.entry_values[self.entry]
         self.node = rod_start + sd.layout.header + sd.layout.block * block
         self.length = float(sd.grid_loads.weight[self.entry] * sd.node_lengths[block])
-        self.shape = np.ascontiguousarray(contact.geometry(), dtype=float)
+        self.shape = np.ascontiguousarray(record.geometry(), dtype=float)
 
     def wrench(self, y, body, row, value):
         """Write the obstacle's place and motion into ``row`` and return the body's reaction
@@ -82,15 +82,14 @@ class ContactPart:
         return contact_reaction(self.kind, row, y, self.node, body, self.shape, self.length)
 
 
-def contact_parts(system, rods, starts, bodies):
+def contact_parts(assembly):
     """The :class:`ContactPart` of every node of every rod contact of
-    ``system`` (``system.rod_contacts``), each appended to its body's
-    ``joints``: rod systems ``rods`` and their state ``starts`` by name,
-    ``bodies`` the BodyParts by name."""
+    ``assembly``'s system (``System.rod_contacts``), each appended to its
+    body's ``joints`` (the assembly's rods, parts and bodies made)."""
     parts = []
-    for contact in system.rod_contacts:
-        sd, part = rods[contact.rod], bodies[contact.body]
+    for record in assembly.system.rod_contacts:
+        sd, part = assembly.rods[record.rod], assembly.bodies[record.body]
         for block in range(sd.layout.n_blocks):
-            part.joints.append(ContactPart(contact, sd, starts[contact.rod], part, block))
+            part.joints.append(ContactPart(record, sd, assembly.parts[record.rod].start, part, block))
             parts.append(part.joints[-1])
     return parts
