@@ -10,6 +10,7 @@ import pytest
 
 import rodmol
 from rodmol.discretise.assembly import Assembly
+from rodmol.discretise.contact_parts import ContactPart
 from rodmol.discretise.rotations import matrices
 
 G, L, RADIUS, N = 9.81, 0.2, 0.01, 10
@@ -17,8 +18,8 @@ BALL_R, BALL_M = 0.03, 0.02
 MATERIAL = rodmol.Material(E=1e6, nu=0.5, mu=5e3, rho=1000.0)
 
 
-def _beam(n=N, **options):
-    return rodmol.Model(rodmol.Rod(L, radius=RADIUS, material=MATERIAL), n, **options)
+def _beam(n=N, material=MATERIAL, **options):
+    return rodmol.Model(rodmol.Rod(L, radius=RADIUS, material=material), n, **options)
 
 
 def _ball(**options):
@@ -35,6 +36,8 @@ def _reaction(assembly, name, t, y):
     body = assembly.body_state(part, t, y)
     total = np.zeros(6)
     for joint in part.joints:
+        if not isinstance(joint, ContactPart):
+            continue
         force, moment = joint.wrench(y, body, joint.row.copy(), joint.value.copy())
         total += (*force, *moment)
     rot = matrices(body[3:7])
@@ -106,14 +109,16 @@ def test_a_fixed_body_is_the_rods_fixed_obstacle_exactly():
 
 
 def _held_ball_on_a_beam():
-    # The ball hangs at the tip of a horizontal holder and rests on a beam across under it.
-    holder = _beam(n=6)
+    # The ball hangs at the tip of a horizontal holder and rests on a clamped beam across under it.
+    stiff = rodmol.Material(E=1e7, nu=0.5, mu=5e3, rho=1000.0)
+    holder = _beam(n=6, material=stiff)
     ball = _ball(position=(L + BALL_R, 0.0, 0.0))
     across = rodmol.BaseMotion(position=(L + BALL_R, -(RADIUS + BALL_R) + 1e-3, -L / 2),
                                rotation=((0.0, 0.0, -1.0), (0.0, 1.0, 0.0), (1.0, 0.0, 0.0)))
-    beam = _beam(n=6, base=across)
+    beam = _beam(n=6, material=stiff, base=across)
     return rodmol.System({"holder": holder, "beam": beam}, {"ball": ball},
-                         [rodmol.Joint(("ball", (-BALL_R, 0.0, 0.0)), ("holder", "tip"))],
+                         [rodmol.Joint(("ball", (-BALL_R, 0.0, 0.0)), ("holder", "tip")),
+                          rodmol.Joint(("beam", "tip"), "world")],
                          contacts=[rodmol.Contact("ball", "beam", _shape(stiffness=5e3))], gravity=(0.0, -G, 0.0))
 
 
