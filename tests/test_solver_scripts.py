@@ -206,6 +206,12 @@ def _body_contact(out):
     assert untouched["head_gap_at_rest_mm"] == example["head_gap_at_rest_mm"]
 
 
+def _rod_contact(out):
+    table = rows(out / "rod_contact.csv")
+    assert all(row["success"] is True for row in table)
+    assert all(row["rhs_ratio"] > 1.0 for row in table)  # the touched nodes' parts are evaluated
+
+
 SCRIPTS = {
     "scaling.py": (["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"], _scaling),
     "temporal.py": (["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv", "temporal_options.csv"],
@@ -232,6 +238,7 @@ SCRIPTS = {
     "holds.py": (["holds.csv", "holds.md"], _holds),
     "loops.py": (["loops.csv", "loops.md"], _loops),
     "body_contact.py": (["body_contact.csv", "body_contact.md"], _body_contact),
+    "rod_contact.py": (["rod_contact.csv", "rod_contact.md"], _rod_contact),
 }
 
 
