@@ -25,6 +25,9 @@ from .load_entries import count
 from .physics import add, cross, jit, rotation, scale, sub, to_global, to_local
 from .rigid import BQ, BV, BW, BX, _row3
 
+#: A part's reaction when its group's first part carried it (force, moment).
+NOTHING = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+
 
 @jit
 def contact_reaction(kind, row, y, node, body, shape, length):
@@ -60,26 +63,56 @@ def contact_reaction(kind, row, y, node, body, shape, length):
     return force, cross(to_local(r_b, sub(at, x_b)), force)
 
 
+@jit
+def group_reaction(kind, rows, y, nodes, body, shape, lengths):
+    """:func:`contact_reaction` of the entries ``rows`` (n, N_PARAMS) at the
+    element blocks starting at ``y[nodes]`` (n,) of nodes of ``lengths``
+    (n,) [m], all moved by one body: their total force and moment on it."""
+    force, moment = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+    for i in range(nodes.shape[0]):
+        f, m = contact_reaction(kind, rows[i], y, nodes[i], body, shape, lengths[i])
+        force, moment = add(force, f), add(moment, m)
+    return force, moment
+
+
 class ContactPart:
     """The entry of rod contact ``record`` (a :class:`rodmol.contacts.RodContact`:
-    its rod, load and shape in the body frame) at one
-    velocity node (element block ``block``) of the rod of system ``sd``
-    (state from ``rod_start``), moved by the body ``part``."""
+    its rod, load and shape in the body frame) at one velocity node
+    (element block ``block``) of the rod of system ``sd`` (state from
+    ``rod_start``), moved by the body ``part``. ``group`` is the first
+    part of the same record and rod (None for that one), which moves the
+    whole group's rows in one compiled call."""
 
-    def __init__(self, record, sd, rod_start, part, block):
+    def __init__(self, record, sd, rod_start, part, block, group=None):
         model = sd.model
-        self.joint, self.part = record, part
+        self.joint, self.part, self.leader = record, part, group is None
         self.entry = sum(count(item, model.s_nodes) for item in model.loads[:record.load]) + block
         self.kind = KERNELS[record.shape.kernel].code
         self.row, self.value = sd.entry_params[self.entry], sd.entry_values[self.entry]
         self.node = rod_start + sd.layout.header + sd.layout.block * block
         self.length = float(sd.grid_loads.weight[self.entry] * sd.node_lengths[block])
         self.shape = np.ascontiguousarray(record.geometry(), dtype=float)
+        if self.leader:  # the group's arrays, filled by the others as they are made
+            self.rows = sd.entry_params[self.entry:self.entry]
+            self.nodes, self.lengths = np.zeros(0, dtype=np.int64), np.zeros(0)
+            group = self
+        group.rows = sd.entry_params[group.entry:self.entry + 1]
+        group.nodes = np.append(group.nodes, self.node)
+        group.lengths = np.append(group.lengths, self.length)
 
     def wrench(self, y, body, row, value):
-        """Write the obstacle's place and motion into ``row`` and return the body's reaction
-        (:func:`contact_reaction`; ``value`` is not read)."""
-        return contact_reaction(self.kind, row, y, self.node, body, self.shape, self.length)
+        """Write the obstacle's place and motion into ``row`` and return the
+        body's reaction (:func:`contact_reaction`; ``value`` is not read).
+        Given its own row (the kernel's: the right-hand side, the
+        equilibrium's residual), the group's first part writes the whole
+        group's rows and returns their total reaction, the others nothing
+        (their rows are written); given another row (scratch, or a frame's
+        replay), each part its own node."""
+        if row is not self.row:
+            return contact_reaction(self.kind, row, y, self.node, body, self.shape, self.length)
+        if not self.leader:
+            return NOTHING
+        return group_reaction(self.kind, self.rows, y, self.nodes, body, self.shape, self.lengths)
 
 
 def contact_parts(assembly):
@@ -89,7 +122,9 @@ def contact_parts(assembly):
     parts = []
     for record in assembly.system.rod_contacts:
         sd, part = assembly.rods[record.rod], assembly.bodies[record.body]
+        group = None
         for block in range(sd.layout.n_blocks):
-            part.joints.append(ContactPart(record, sd, assembly.parts[record.rod].start, part, block))
+            part.joints.append(ContactPart(record, sd, assembly.parts[record.rod].start, part, block, group))
             parts.append(part.joints[-1])
+            group = parts[-1] if group is None else group
     return parts

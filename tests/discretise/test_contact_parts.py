@@ -157,6 +157,28 @@ def test_the_pattern_holds_every_entry_the_coupling_makes():
     assert not (seen & ~pattern).any()
 
 
+def test_a_contact_moves_its_rows_in_one_call_as_each_node_alone():
+    # On the right-hand side the first node's part moves every row of its rod in one compiled
+    # call and carries the total reaction; alone (scratch rows, a frame's replay) each part
+    # moves its own row: the same rows and the same total.
+    system = _ball_on_beam()
+    assembly = Assembly(system)
+    part = assembly.bodies["ball"]
+    y = assembly.initial_state()
+    y[part.fields["x"]] += (0.0, -0.003, 0.001)  # into the beam, moving and turning
+    y[part.fields["v"]], y[part.fields["w"]] = (0.02, -0.01, 0.005), (0.3, -0.2, 0.5)
+    body = assembly.body_state(part, 0.0, y)
+    parts = [joint for joint in part.joints if isinstance(joint, ContactPart)]
+    alone = [np.concatenate(joint.wrench(y, body, joint.row.copy(), joint.value.copy())) for joint in parts]
+    scratch = [joint.row.copy() for joint in parts]
+    for joint, row in zip(parts, scratch):
+        joint.wrench(y, body, row, joint.value.copy())
+    together = sum(np.concatenate(joint.wrench(y, body, joint.row, joint.value)) for joint in parts)
+    np.testing.assert_array_equal([joint.row for joint in parts], scratch)
+    assert sum(np.abs(a[:3]).max() > 0.0 for a in alone) >= 2  # two nodes touch
+    np.testing.assert_allclose(together, np.sum(alone, axis=0), rtol=1e-14, atol=1e-16)
+
+
 @pytest.mark.parametrize("kwargs, match", [
     (dict(contacts=[rodmol.Contact("cup", "beam", _shape())]), "body 'cup'"),
     (dict(contacts=[rodmol.Contact("ball", ("beam", "arm"), _shape())]), "rod 'arm'"),
