@@ -130,7 +130,7 @@ def test_equilibrium_of_a_held_ball_on_a_beam_is_its_settled_run():
     assembly = Assembly(system)
     part = assembly.bodies["ball"]
     carried = _reaction(assembly, "ball", 0.0, rest)[1]
-    assert 0.1 * BALL_M * G < carried  # the beam carries a share of the weight
+    assert carried > BALL_M * G  # the beam carries the ball and props the holder
     np.testing.assert_allclose(settled.states[-1, part.slice][:7], rest[part.slice][:7], atol=1e-7)
     np.testing.assert_allclose(_reaction(assembly, "ball", 2.0, settled.states[-1])[1], carried, rtol=1e-4)
 
