@@ -108,6 +108,33 @@ def test_a_fixed_body_is_the_rods_fixed_obstacle_exactly():
         np.testing.assert_array_equal(other(t, y), one(t, y))
 
 
+def test_a_rod_on_a_body_carried_along_with_it_slides_as_at_rest():
+    # Galilean invariance: a cantilever lying with friction on a driven ball, its base, its nodes
+    # and the ball all moving at V from the start, is the one at rest carried at V (no fluid:
+    # nothing else reads the absolute velocity). The law's damping and friction act on the sliding relative to the
+    # ball: on the absolute velocity the ball would brake the rod.
+    speed = np.array([0.05, 0.0, 0.02])
+    centre = np.array([0.15, -(RADIUS + BALL_R) + 0.002, 0.0])
+    runs = []
+    for v in (np.zeros(3), speed):
+        ball = _ball(motion=rodmol.BaseMotion(lambda t, v=v: tuple(v), lambda t: (0.0, 0.0, 0.0), position=centre))
+        arm = _beam(base=rodmol.BaseMotion(lambda t, v=v: tuple(v), lambda t: (0.0, 0.0, 0.0)))
+        shape = _shape(friction=0.5, slip_speed=1e-3)
+        system = rodmol.System({"arm": arm}, {"ball": ball}, contacts=[rodmol.Contact("ball", "arm", shape)],
+                               gravity=(0.0, -G, 0.0))
+        assembly = Assembly(system)
+        y0, sd = assembly.initial_state(), assembly.rods["arm"]
+        rod = y0[assembly.parts["arm"]]
+        sd.layout.field(rod, "v")[:] = v  # moving with its base from the start (local = global: straight along x)
+        y0[assembly.parts["arm"]] = rod
+        runs.append(rodmol.simulate(system, 0.3, output_dt=0.05, rtol=1e-8, initial=y0))
+    at_rest, carried = runs
+    assert at_rest.success and carried.success
+    assert np.abs(at_rest["arm"].external_force).max() > 1.0  # it lies on the ball
+    shift = carried.t[:, None, None] * speed
+    np.testing.assert_allclose(carried["arm"].positions - shift, at_rest["arm"].positions, atol=1e-6 * L)
+
+
 def _held_ball_on_a_beam():
     # The ball hangs at the tip of a horizontal holder and rests on a clamped beam across under it.
     stiff = rodmol.Material(E=1e7, nu=0.5, mu=5e3, rho=1000.0)
