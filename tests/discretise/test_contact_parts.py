@@ -109,6 +109,31 @@ def test_a_fixed_body_is_the_rods_fixed_obstacle_exactly():
         np.testing.assert_array_equal(other(t, y), one(t, y))
 
 
+def test_a_fixed_turned_body_carries_its_plane_where_its_pose_puts_it():
+    # A floor given in the frame of a body turned about z and x: the rows are the floor's
+    # to rounding, the right-hand side to 1e-10 (the depth's rounding over its millimetres),
+    # the run to 1e-8 L.
+    c, s = np.cos(0.4), np.sin(0.4)
+    turn = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ np.array([[1.0, 0.0, 0.0], [0.0, c, -s],
+                                                                              [0.0, s, c]])
+    origin, point, normal = np.array([0.1, -0.05, 0.02]), np.array([0.0, -0.006, 0.0]), np.array([0.0, 1.0, 0.1])
+    floor = dict(stiffness=2e3, damping=100.0, friction=0.4)
+    body = rodmol.RigidBody(1.0, (1e-3,) * 3, position=origin, rotation=turn, motion="fixed")
+    loaded = rodmol.System({"arm": _beam(loads=[rodmol.PlaneContact(point, normal, **floor)])}, {"b": body},
+                           gravity=(0.0, -G, 0.0))
+    shape = rodmol.PlaneContact(turn.T @ (point - origin), turn.T @ normal, **floor)
+    touched = rodmol.System({"arm": _beam()}, {"b": body}, gravity=(0.0, -G, 0.0),
+                            contacts=[rodmol.Contact("b", "arm", shape)])
+    runs = [rodmol.simulate(system, 0.2, output_dt=0.05, rtol=1e-9) for system in (loaded, touched)]
+    assert all(run.success for run in runs)
+    assert np.abs(runs[0]["arm"].external_force).max() > 1.0  # it touched
+    one, other = Assembly(loaded), Assembly(touched)
+    for t, y in zip(runs[0].t, runs[0].states):
+        expected = one(t, y)
+        np.testing.assert_allclose(other(t, y), expected, rtol=1e-10, atol=1e-10 * np.abs(expected).max())
+    np.testing.assert_allclose(runs[1]["arm"].positions, runs[0]["arm"].positions, rtol=0, atol=1e-8 * L)
+
+
 def test_a_rod_on_a_body_carried_along_with_it_slides_as_at_rest():
     # Galilean invariance: a cantilever lying with friction on a driven ball, its base, its nodes
     # and the ball all moving at V from the start, is the one at rest carried at V (no fluid:
