@@ -32,6 +32,7 @@ from .calibrate import (
     triangulate,
     worsened_models,
 )
+from .contacts import Contact
 from .control import Simulator, StaticFit, inverse_statics, inverse_statics_path
 from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
@@ -67,7 +68,7 @@ from .solve.equilibrium import equilibrium
 from .systems import Joint, System
 
 __all__ = [
-    "BACKENDS", "Base", "BaseMotion", "Cable", "CapsuleContact", "DistributedForce",
+    "BACKENDS", "Base", "BaseMotion", "Cable", "CapsuleContact", "Contact", "DistributedForce",
     "DistributedMoment", "Hold", "PlaneContact", "PointForce", "PointMoment", "SphereContact", "EquilibriumError", "IntegrationError", "MEDIA",
     "Joint", "Marker", "Material", "Medium", "Model", "NotSupportedYet", "RigidBody", "System", "ParameterError", "Result", "Rod", "RodmolError",
     "SCHEMES", "ScenarioError", "SemiDiscrete", "Simulator", "StateLayout", "StateView", "UserFunctionError",

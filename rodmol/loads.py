@@ -70,9 +70,13 @@ KERNELS = {
 # stiffness, damping, turning stiffness and turning damping, and the held
 # point's velocity and angular velocity (3 + 3, global: zero for the world,
 # a body's for a joint of rodmol.System, written at each call by the assembly).
-N_PARAMS = 17
+# A contact row ends with its obstacle's motion (3 + 3, global: the velocity
+# of the obstacle's point at the row's first point and its angular
+# velocity), zero for a fixed obstacle, a body's for a rodmol.Contact.
+N_PARAMS = 19
 P_STIFFNESS, P_DAMPING, P_FRICTION, P_SLIP, P_RADIUS, P_SMOOTHING = 7, 8, 9, 10, 11, 12
 P_TURN_STIFFNESS, P_TURN_DAMPING, P_HELD_VELOCITY, P_HELD_SPIN = 9, 10, 11, 14
+P_OBSTACLE_VELOCITY, P_OBSTACLE_SPIN = 13, 16
 
 
 def _frame(frame, name):

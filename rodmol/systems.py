@@ -30,6 +30,7 @@ import numpy as np
 from . import _checks
 from .base_motion import BaseMotion
 from .bodies import RigidBody
+from .contacts import Contact, attach
 from .errors import NotSupportedYet, ParameterError
 from .holds import Hold
 from .model import Model
@@ -56,6 +57,8 @@ class System:
         The fluid around every rod and body (a preset name as for Model).
     gravity : (3,) float
         Gravitational acceleration [m/s^2], global.
+    contacts : sequence of Contact
+        Bodies' shapes that rods touch (:class:`rodmol.Contact`).
 
     Attributes
     ----------
@@ -74,9 +77,12 @@ class System:
         The rods whose base is pinned or joined to another rod, each to the
         name of its base body (``"<rod>.base"``, in ``bodies``: a free body
         carrying the rod's base segment only; its result is the base's pose).
+    rod_contacts : list of rodmol.contacts.RodContact
+        Each rod's side of each contact; the rod's Model carries the shape
+        (named ``"contacts[i]"``, placed at the body's initial pose) after the holds.
     """
 
-    def __init__(self, rods, bodies=None, joints=(), *, medium=None, gravity=(0.0, -9.81, 0.0)):
+    def __init__(self, rods, bodies=None, joints=(), *, medium=None, gravity=(0.0, -9.81, 0.0), contacts=()):
         bodies = {} if bodies is None else bodies
         for what, mapping, kind in (("rods", rods, Model), ("bodies", bodies, RigidBody)):
             if not isinstance(mapping, dict):
@@ -105,6 +111,8 @@ class System:
         self.joints = _checks.items("joints", joints, Joint, "a rodmol.Joint")
         self.body_joints, self.base_bodies = [], {}
         self.clamps, self.penalty_joints = self._joints()
+        self.contacts = _checks.items("contacts", contacts, Contact, "a rodmol.Contact")
+        self.rods, self.rod_contacts = attach(self.contacts, self.rods, self.bodies)
 
     def _joints(self):
         """Each base-jointed rod's clamp: (body or None, point, rotation), and

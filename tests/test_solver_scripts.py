@@ -235,6 +235,13 @@ def _system_output(out):
     assert new["index_last_kb"] < 0.1 * old["index_last_kb"]  # an index of chunk files
 
 
+def _rod_contact(out):
+    table = rows(out / "rod_contact.csv")
+    assert all(row["success"] is True for row in table)
+    # the beam carries the resting ball's weight through the contact (measured within 3e-4)
+    assert all(abs(row["force_over_weight"] - 1.0) < 5e-3 for row in table), table
+
+
 SCRIPTS = {
     "scaling.py": (["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"], _scaling),
     "temporal.py": (["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv", "temporal_options.csv"],
@@ -266,6 +273,7 @@ SCRIPTS = {
     "body_contact.py": (["body_contact.csv", "body_contact.md"], _body_contact),
     "body_joints.py": (["body_joints.csv", "body_joints.md"], _body_joints),
     "system_output.py": (["system_output.csv", "system_output.md"], _system_output),
+    "rod_contact.py": (["rod_contact.csv", "rod_contact.md"], _rod_contact),
 }
 
 

@@ -62,6 +62,7 @@ from scipy import sparse
 
 from .body_joints import BodyJointPart, joint_frequency
 from .body_part import BodyPart, clamp_velocities, cross
+from .contact_parts import contact_parts
 from .joints import JointPart, RecordedJoints, RodJointPart, block_entries
 from .physics import quaternion_rate
 from .rigid import clamp_wrench, free_body_rates
@@ -110,7 +111,7 @@ class Assembly:
             self.parts[name] = part.slice
             start = part.slice.stop
         self.size = start
-        self.joints, self.rod_joints = [], []  # penalty joints to bodies, between rods (each side)
+        self.joints, self.rod_joints = contact_parts(self), []  # to bodies (rods' contacts first), between rods
         for joint in system.penalty_joints:
             rod = (self.rods[joint.rod], self.parts[joint.rod].start)
             if joint.body is not None:

@@ -22,6 +22,8 @@ from ..loads import (
     P_FRICTION,
     P_HELD_SPIN,
     P_HELD_VELOCITY,
+    P_OBSTACLE_SPIN,
+    P_OBSTACLE_VELOCITY,
     P_RADIUS,
     P_SLIP,
     P_SMOOTHING,
@@ -81,14 +83,20 @@ def penalty(depth, smoothing):
 @jit
 def contact(kind, p, u, r, v, w):
     """Penalty contact with regularised Coulomb friction (see rodmol.loads),
-    acting at the surface point; returns (force, moment) densities, local."""
+    acting at the surface point; returns (force, moment) densities, local.
+    The damping and friction act on the surface point's velocity relative to
+    the obstacle's material point there (the row's obstacle motion: zero for
+    a fixed obstacle)."""
     depth, n_global = contact_depth(kind, p, u)
     measure, ramp = penalty(depth, p[P_SMOOTHING])
     if measure <= 0.0:
         return (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
     n = to_local(r, n_global)
     arm = scale(-p[P_RADIUS], n)  # from the centreline to the contact point
-    vp = add(v, cross(w, arm))
+    spin = (p[P_OBSTACLE_SPIN], p[P_OBSTACLE_SPIN + 1], p[P_OBSTACLE_SPIN + 2])
+    at = sub(sub(u, scale(p[P_RADIUS], n_global)), (p[0], p[1], p[2]))  # the surface point from the row's first
+    moving = add((p[P_OBSTACLE_VELOCITY], p[P_OBSTACLE_VELOCITY + 1], p[P_OBSTACLE_VELOCITY + 2]), cross(spin, at))
+    vp = sub(add(v, cross(w, arm)), to_local(r, moving))
     vn = dot(vp, n)
     normal = p[P_STIFFNESS] * measure - ramp * p[P_DAMPING] * vn  # d_t = -vn
     if normal <= 0.0:
