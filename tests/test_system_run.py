@@ -163,7 +163,9 @@ def test_mirrored_pair_of_arms_leaves_the_head_unrotated():
     np.testing.assert_allclose(direct["head"].velocity, head.velocity, atol=1e-5)
 
 
-def test_a_failing_input_ends_the_run_with_the_frames_before_it():
+@pytest.mark.parametrize("linsolver", ["gmres", "sparse"])
+def test_a_failing_input_ends_the_run_with_the_frames_before_it(linsolver):
+    """Under "sparse" an exception raised through scikit-sundae's SuperLU_MT path crashed the process."""
     def tension(t):
         if t > 0.055:
             raise RuntimeError("sensor lost")
@@ -173,8 +175,9 @@ def test_a_failing_input_ends_the_run_with_the_frames_before_it():
     head = rodmol.RigidBody(0.05, (2e-5, 2e-5, 2e-5))
     system = rodmol.System({"arm": arm}, {"head": head}, [rodmol.Joint(("head", (0.0, 0.0, 0.0)), ("arm", "base"))])
     with pytest.warns(RuntimeWarning, match="sensor lost"):
-        run = rodmol.simulate(system, 0.2, output_dt=0.01)
+        run = rodmol.simulate(system, 0.2, output_dt=0.01, linsolver=linsolver)
     assert not run.success and isinstance(run.error, rodmol.UserFunctionError)
+    assert run.stats["linear_solver"] == linsolver
     assert 0.04 <= run.t[-1] <= 0.05 and "after t = " in run.message
     assert run["arm"].positions.shape[0] == len(run.t) and np.all(np.isfinite(run.states))
 

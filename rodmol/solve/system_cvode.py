@@ -82,8 +82,12 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
     # Right-hand sides; those with non-finite rates since the last output frame; the first count then.
     evals = [0, 0, 0]
     origin = [None]  # the first of those from a finite state: where the rates turned non-finite
+    # An exception raised through scikit-sundae's sparse (SuperLU_MT) path crashes the process
+    # (a segmentation fault, found by review): there the right-hand side keeps it, returns NaN
+    # rates, which fail CVODE's step at once, and the step's caller raises it.
+    kept = [None]
 
-    def rhs(t, y, yp):
+    def rates(t, y, yp):
         evals[0] += 1
         if max_wall_time is not None and time.perf_counter() - start > max_wall_time:
             raise _OutOfTime
@@ -94,6 +98,20 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
                 origin[0] = _nonfinite(assembly, t, yp)
             if evals[1] >= NONFINITE_RATES:
                 raise _NonFinite(origin[0] or _nonfinite(assembly, t, yp))
+
+    def kept_rates(t, y, yp):
+        if kept[0] is None:
+            try:
+                return rates(t, y, yp)
+            except BaseException as exc:  # noqa: BLE001 (raised again by the step's caller)
+                kept[0] = exc
+        yp[:] = np.nan
+
+    def step(t_k):
+        r = solver.step(t_k)
+        if kept[0] is not None:
+            raise kept[0]
+        return r
 
     options = dict(method="BDF", rtol=rtol, atol=atol, linsolver=linsolver, max_num_steps=1_000_000,
                    max_step=max_step, max_order=int(max_order))
@@ -108,12 +126,12 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
     if progress is not None:
         progress(float(t_out[0]), float(t_out[-1]))
     frames, message, error, jac_evals = [np.array(y0, dtype=float)], "", None, 0
-    solver = CVODE(rhs, **options)
+    solver = CVODE(kept_rates if linsolver == "sparse" else rates, **options)
     solver.init_step(float(t_out[0]), frames[0])
     for t_k in t_out[1:]:
         reached = float(t_out[len(frames) - 1])
         try:
-            r = solver.step(float(t_k))
+            r = step(float(t_k))
         except KeyboardInterrupt:
             message = f"CVODE interrupted after t = {reached:.6g} s"
             break
