@@ -309,6 +309,8 @@ class RunWriter:
         """Resuming: restart from the earlier restart point ``point`` (a frame index, a multiple
         of ``chunk_frames``, at or before :meth:`resume_point`'s), dropping the chunks after it
         (a system's run restarts all its rods from the frame its own index reached)."""
+        if point == self.restart[0]:  # there already: reopening rolled back to it (a first chunk cut short)
+            return
         if point % self.chunk_frames or point > self.restart[0]:
             raise ParameterError(f"cannot restart {str(self.directory)!r} at frame {point}: its restart "
                                  f"points are multiples of {self.chunk_frames} up to {self.restart[0]}")
