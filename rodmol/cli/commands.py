@@ -28,7 +28,7 @@ from pathlib import Path
 from .._files import output_directory
 from .._progress import Progress
 from .._version import __version__
-from ..errors import ParameterError
+from ..errors import ParameterError, RodmolError
 from ..output import h5result
 from ..output.formats import FORMATS, get_format
 from ..output.lock import OutputLock
@@ -51,6 +51,9 @@ def main(argv=None):
     except ParameterError as exc:
         print(f"rodmol: error: {exc}", file=sys.stderr)
         return EXIT_USAGE
+    except RodmolError as exc:  # e.g. no equilibrium to start from: the run could not start
+        print(f"rodmol: error: {exc}", file=sys.stderr)
+        return EXIT_FAILED
     except KeyboardInterrupt:
         print("rodmol: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED

@@ -77,17 +77,18 @@ class SystemRunWriter:
         self.t, self.chunks = [], {}  # the times listed in system.h5, and its chunk files (name -> frames)
         self.restart, self._resumed, self._layout = None, None, None
         self._parts = None  # (rod keys, body keys, body surfaces, the parts' slices) of the run
-        if resume:
+        self._cleared = bool(resume)  # an earlier run replaced (`overwrite`) when the run begins,
+        if resume:                     # after the caller's checks and initial state (they may fail)
             self._reopen()
         else:
             self._refuse_replacing(overwrite)
-            run_files.clear(self.directory)
 
     # ----------------------------------------------------------------- the sink protocol
 
     def begin(self, system, t_out):
         """Start (or continue) the run of the assembly ``system`` (``system.assembly`` if it
         carries one) through the output times ``t_out``."""
+        self._clear()
         assembly = getattr(system, "assembly", system)
         self.assembly = assembly
         if self.t_out is None:
@@ -181,6 +182,7 @@ class SystemRunWriter:
     def write_result(self, result):
         """Write a finished SystemResult (each rod's files as a single rod's, then the system's
         chunks); returns the path of ``system.h5``."""
+        self._clear()
         self.t_out = np.asarray(result.t, dtype=float)
         self._plan(result, len(result.t))
         for name, key in self._parts[0].items():
@@ -191,6 +193,12 @@ class SystemRunWriter:
         return self.directory / INDEX
 
     # ----------------------------------------------------------------- internals
+
+    def _clear(self):
+        """Remove an earlier run's files (once, before the first file of this one)."""
+        if not self._cleared:
+            run_files.clear(self.directory)
+            self._cleared = True
 
     def _plan(self, result, n_frames):
         """The run's parts (file keys, the bodies' surfaces, the state's layout) and the views' step."""

@@ -181,3 +181,21 @@ def test_the_command_line_resumes_a_system_anyway(tmp_path, killed_system, capsy
                  "--quiet"]) == 0
     result = rodmol.load_result(tmp_path)
     assert result.success and len(result.t) == 11
+
+
+def test_an_overwrite_that_cannot_start_keeps_the_earlier_run(tmp_path, capsys):
+    """`--overwrite` replaces the earlier run when the new one begins, after its checks and its
+    initial state: here the equilibrium start fails (the head is held by nothing), and the
+    earlier run stays whole (the writer cleared it on construction, before the equilibrium)."""
+    from rodmol.cli.commands import main
+
+    scenario = Path(__file__).parents[2] / "examples" / "two_arms.toml"
+    out = tmp_path / "run"
+    assert main(["run", str(scenario), "--out", str(out), "--t-end", "0.05", "--quiet"]) == 0
+    before = rodmol.load_result(out)
+    failing = tmp_path / "equilibrium.toml"
+    failing.write_text(scenario.read_text().replace("t_end = 0.5", 't_end = 0.05\ninitial = "equilibrium"'))
+    assert main(["run", str(failing), "--out", str(out), "--overwrite", "--quiet"]) == 1
+    assert "rodmol: error:" in capsys.readouterr().err  # a message, not a traceback
+    after = rodmol.load_result(out)
+    assert after.success and np.array_equal(after.states, before.states)
