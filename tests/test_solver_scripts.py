@@ -229,10 +229,11 @@ def _body_joints(out):
 
 
 def _system_output(out):
-    old, new = rows(out / "system_output.csv")
-    assert old["version"] == "old" and new["version"] == "new" and old["frames"] == new["frames"]
-    assert old["index_last_kb"] > 2 * old["index_first_kb"]  # every frame so far, rewritten at each chunk
-    assert new["index_last_kb"] < 0.1 * old["index_last_kb"]  # an index of chunk files
+    (new,) = rows(out / "system_output.csv")  # the smoke run measures the working tree only
+    assert new["version"] == "new" and new["chunks"] == 4
+    # system.h5 an index of chunk files: it grows by a few bytes a chunk, not by the chunk's states
+    # (the old one, rewritten whole, grew with every chunk: 400 kB to 24.5 MB over 80, docs/performance.md)
+    assert new["index_last_kb"] < 1.2 * new["index_first_kb"]
 
 
 def _rod_contact(out):
