@@ -84,7 +84,7 @@ def _end(name, value):
         if np.ndim(where) == 0 and not isinstance(where, bool):
             return ("rod", value[0], _checks.positive(f"{name}` arc length `s", where, " m"))
     if isinstance(value, tuple) and len(value) in (2, 3) and isinstance(value[0], str):
-        point = _checks.vector3(f"{name}` point `", value[1])
+        point = _checks.vector3(f"{name} point", value[1])
         rotation = _checks.rotation(f"joint end {name} rotation", value[2], tol=1e-9) if len(value) == 3 else None
         return ("body", value[0], point, rotation)
     raise ParameterError(f"joint end `{name}` must be 'world', (body_name, point[, rotation]) or "

@@ -239,8 +239,8 @@ class System:
             turn_b = body_b.rotation.T @ frame if b[3] is None else b[3]
             gap = float(np.linalg.norm(body_b.position + body_b.rotation @ point_b - at_rest))
             if gap > 1e-9 * max(1.0, float(np.linalg.norm(at_rest))):
-                raise ParameterError(f"`joints[{i}]` joins body {name_a!r} at {tuple(point_a)} to body {name_b!r} "
-                                     f"at {tuple(point_b)}, but at rest the two points are {gap:.3g} m apart: "
+                raise ParameterError(f"`joints[{i}]` joins body {name_a!r} at {tuple(map(float, point_a))} to body {name_b!r} "
+                                     f"at {tuple(map(float, point_b))}, but at rest the two points are {gap:.3g} m apart: "
                                      "place the bodies (their `position`, `rotation`) so that they meet")
             turn_gap = float(np.linalg.norm(body_b.rotation @ turn_b - frame))
             if joint.kind == "clamp" and turn_gap > 1e-9:
