@@ -1,13 +1,15 @@
 """A system file's [[contact]] tables: rods touching a body (rodmol.Contact)."""
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import rodmol
-from rodmol.scenario.file import ScenarioError, parse_scenario
+from rodmol.scenario.file import ScenarioError, load_scenario, parse_scenario
 
+ROOT = Path(__file__).resolve().parents[2]
 G, L, RADIUS, N = 9.81, 0.2, 0.01, 10
 BALL_R, BALL_M = 0.03, 0.02
 
@@ -174,3 +176,16 @@ def test_a_contact_naming_no_body_is_placed_at_its_table_with_the_names_nearby()
     text = BALL_ON_BEAM.replace('rods = "beam"', 'rods = ["beam", "bam"]')
     with pytest.raises(ScenarioError, match="did you mean 'beam'"):
         parse_scenario(text)
+
+
+def test_the_arm_pushing_a_ball_example_runs_coarse_and_pushes_it():
+    spec = load_scenario(ROOT / "examples" / "arm_pushing_ball.toml",
+                         overrides={"solver.t_end": 0.6, "solver.output_dt": 0.1, "discretization.n_elements": 6})
+    run = spec.simulate()
+    assert run.success
+    ball, arm = run["ball"], run["arm"]
+    on_ball = np.einsum("nij,nj->ni", ball.rotation, ball.rod_contact_force)  # global
+    on_arm = np.einsum("tni,n->ti", arm.external_force, arm.node_length)  # its contact forces only
+    assert np.abs(on_ball[:, 2]).max() > 1e-3  # the arm touched it, pushing toward +z
+    np.testing.assert_allclose(on_ball, -on_arm, rtol=0, atol=1e-9)
+    assert ball.position[-1, 2] > ball.position[0, 2]
