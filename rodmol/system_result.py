@@ -3,6 +3,7 @@
 import numpy as np
 
 from .base_motion import BaseMotion
+from .discretise.contact_parts import ContactPart
 from .discretise.rotations import matrices
 from .discretise.system import SemiDiscrete
 from .errors import ParameterError
@@ -20,15 +21,50 @@ class BodyResult:
     quaternion : (n_t, 4) the same rotations as unit quaternions (scalar first).
     velocity : (n_t, 3) velocity of the body origin [m/s], body frame.
     angular_velocity : (n_t, 3) angular velocity [rad/s], body frame.
+    contact_force, contact_moment : (n_t, 3) force [N] and moment about the
+        body origin [N m] of its contacts with fixed obstacles (its
+        ``contacts``), on the body, body frame; zeros without any.
+    rod_contact_force, rod_contact_moment : (n_t, 3) the same of the rods
+        touching it (:class:`rodmol.Contact`): minus the sum of their
+        contact forces, acting where each touches.
     surface : (points (n, 3) [m], body frame; triangles (m, 3)) or None
         How the body is drawn, for a result read from files (else from the RigidBody).
+
+    The contact forces are those the run's right-hand side applied at the
+    frames (:func:`contact_wrenches`); a file of an older rodmol has none
+    (zeros).
     """
 
-    def __init__(self, t, position, quaternion, velocity, angular_velocity):
+    def __init__(self, t, position, quaternion, velocity, angular_velocity, contact=None, rod_contact=None):
         self.t, self.position, self.quaternion = t, position, quaternion
         self.rotation = matrices(quaternion)
         self.velocity, self.angular_velocity = velocity, angular_velocity
+        none = np.zeros((len(t), 6))
+        contact, rod_contact = (none if w is None else np.asarray(w, dtype=float) for w in (contact, rod_contact))
+        self.contact_force, self.contact_moment = contact[:, :3], contact[:, 3:]
+        self.rod_contact_force, self.rod_contact_moment = rod_contact[:, :3], rod_contact[:, 3:]
         self.surface = None
+
+
+def contact_wrenches(assembly, part, t, states):
+    """Force and moment [N, N m] about the origin, body frame, on the body
+    ``part`` (an assembly's BodyPart) at the frames ``states`` (n_t, size) at
+    ``t``: of its contacts with fixed obstacles (a free body's, as its rates
+    apply them) and of the rods' contacts (:class:`ContactPart`), each
+    (n_t, 6), through the compiled functions of the right-hand side."""
+    obstacles, rods = np.zeros((len(t), 6)), np.zeros((len(t), 6))
+    touching = [joint for joint in part.joints if isinstance(joint, ContactPart)]
+    if not touching and (part.contacts is None or not part.body.free):
+        return obstacles, rods
+    for k, (tk, y) in enumerate(zip(t, states)):
+        y = np.ascontiguousarray(y)
+        body = assembly.body_state(part, tk, y)
+        if part.contacts is not None and part.body.free:
+            obstacles[k] = part.contacts.wrench(body)
+        for joint in touching:  # each node on its own row: the run's rows stay as they are
+            force, moment = joint.wrench(y, body, joint.row.copy(), joint.value.copy())
+            rods[k] += (*force, *moment)
+    return obstacles, rods
 
 
 class SystemResult:
@@ -91,7 +127,8 @@ class SystemResult:
         else:
             pairs = [self.assembly.body_velocities(part, ti, None) for ti in self.t]
             v, w = (np.array([p[j] for p in pairs]).reshape(n_t, 3) for j in (0, 1))
-        return BodyResult(self.t, y[:, part.fields["x"]], y[:, part.fields["Q"]], v, w)
+        return BodyResult(self.t, y[:, part.fields["x"]], y[:, part.fields["Q"]], v, w,
+                          *contact_wrenches(self.assembly, part, self.t, y))
 
     def _rod(self, name):
         assembly = self.assembly

@@ -14,7 +14,10 @@ A system's run directory (``simulate(system, ..., out=DIR)``,
 * ``frames/chunk_NNNNNN.h5``: the frames of one chunk: ``t``, the assembled
   ``states`` and each body's ``bodies/KEY/position`` [m] and ``quaternion``
   (body to global), ``velocity`` [m/s] and ``angular_velocity`` [rad/s],
-  body frame; in the group ``view``, each body's triangles and its points at
+  body frame, and the force [N] and moment [N m] of its contacts
+  (``contact_force``, ``contact_moment``: with fixed obstacles;
+  ``rod_contact_force``, ``rod_contact_moment``: of the rods touching it;
+  about its origin, body frame); in the group ``view``, each body's triangles and its points at
   the shown frames (``KEY_points``, global, single precision); and
   ``frames/chunk_NNNNNN.xmf``, the bodies' grids of its shown frames. Each is
   written under a temporary name and renamed when complete, and never
@@ -49,6 +52,8 @@ INDEX, BODIES_VIEW = SYSTEM
 FORMAT = "rodmol-system"
 #: The body fields stored per frame.
 BODY_FIELDS = ("position", "quaternion", "velocity", "angular_velocity")
+#: The body's contact forces and moments stored per frame, body frame (none in an older rodmol's files).
+CONTACT_FIELDS = ("contact_force", "contact_moment", "rod_contact_force", "rod_contact_moment")
 #: A drawn body's surface, body frame: points [m] and triangles (:func:`body_surface`).
 SURFACE = ("surface_points", "surface_triangles")
 #: Rings and meridians of the drawn ellipsoid.
@@ -101,7 +106,7 @@ def chunk_batch(result, frames, shown, surfaces, keys):
     batch = {"t": result.t[frames], "states": result.states[frames]}
     for name, key in keys.items():
         body = result[name]
-        for field in BODY_FIELDS:
+        for field in BODY_FIELDS + CONTACT_FIELDS:
             batch[f"bodies/{key}/{field}"] = getattr(body, field)[frames]
         points, triangles = surfaces[name]
         position, rotation = body.position[frames][shown], body.rotation[frames][shown]
@@ -196,7 +201,8 @@ def read_system(directory):
     rods = {name: (lambda key=key: h5result.read_result(directory / key / h5result.INDEX))
             for name, key in info["rods"].items()}
     bodies = {name: (lambda key=key: _body(t, {f: read_series(directory, index, f"bodies/{key}/{f}")
-                                               for f in BODY_FIELDS}, index["surfaces"].get(key)))
+                                               for f in BODY_FIELDS + _stored(directory, index, key)},
+                                           index["surfaces"].get(key)))
               for name, key in info["bodies"].items()}
     message = info["message"]
     if not info.get("complete", True):
@@ -206,8 +212,21 @@ def read_system(directory):
                         saved=(rods, bodies))
 
 
+def _stored(directory, index, key):
+    """The :data:`CONTACT_FIELDS` the run's files hold for the body of file key ``key``
+    (those of an older rodmol, none)."""
+    import h5py
+
+    if not index["chunks"]:
+        return ()
+    with h5py.File(Path(directory) / next(iter(index["chunks"])), "r") as handle:
+        return tuple(f for f in CONTACT_FIELDS if f"bodies/{key}/{f}" in handle)
+
+
 def _body(t, fields, surface):
-    body = BodyResult(t, *(fields[f] for f in BODY_FIELDS))
+    contact, rods = (np.hstack([fields[f"{kind}_force"], fields[f"{kind}_moment"]]) if f"{kind}_force" in fields
+                     else None for kind in ("contact", "rod_contact"))
+    body = BodyResult(t, *(fields[f] for f in BODY_FIELDS), contact, rods)
     body.surface = surface
     return body
 

@@ -1,5 +1,6 @@
 """The ``[[load]]`` tables of a scenario file: external loads (:mod:`rodmol.loads`),
-and a rigid body's ``[[body.contact]]`` tables, its obstacles.
+a rigid body's ``[[body.contact]]`` tables, its obstacles, and a system file's
+``[[contact]]`` tables, rods touching a body (:class:`rodmol.Contact`).
 
 Each table has a ``type`` (a key of :data:`rodmol.loads.SCENARIO_TYPES`) and
 the arguments of the Python class it builds, checked by that class. Point-load
@@ -7,10 +8,13 @@ values are a 3-vector, ``[t, x, y, z]`` knots or a CSV file relative to the
 scenario file; distributed loads take a constant 3-vector.
 """
 
+import inspect
+
 from .. import _checks
+from ..contacts import Contact
 from .arm import build_table, entries
 from .problems import FAILED, failed
-from .tables import BODY_CONTACTS, LOADS
+from .tables import BODY_CONTACTS, CONTACTS, LOADS
 
 
 def loads(data, ctx, at=()):
@@ -25,15 +29,34 @@ def contacts(data, ctx, at=()):
     return _typed(data, ctx, at, "contact", BODY_CONTACTS)
 
 
-def _typed(data, ctx, at, kind, types):
+def rod_contacts(data, ctx):
+    """The :class:`rodmol.Contact` of a system file's ``[[contact]]`` tables: a
+    ``body``, its ``rods`` and a contact [[load]] type's shape in the body frame;
+    FAILED if any has a problem."""
+    return _typed(data, ctx, (), "contact", CONTACTS, _contact)
+
+
+def _contact(table):
+    """The builder of a [[contact]] table ``table``: its shape's keyword
+    arguments (``table.sources[0]``) made the shape of a Contact."""
+    shape = table.sources[0].build
+
+    def build(body, rods, **keys):
+        return Contact(body, rods, shape(**keys))
+
+    build.__signature__ = inspect.Signature([p.replace(kind=p.KEYWORD_ONLY) for p in table.parameters().values()])
+    return build
+
+
+def _typed(data, ctx, at, kind, types, builder=None):
     tables = entries(data, ctx, kind, at)
     if tables is FAILED:
         return FAILED
-    built = [_load(ctx, at + (kind, i), entry, types) for i, entry in enumerate(tables)]
+    built = [_load(ctx, at + (kind, i), entry, types, builder) for i, entry in enumerate(tables)]
     return FAILED if failed(*built) else built
 
 
-def _load(ctx, path, entry, types):
+def _load(ctx, path, entry, types, builder=None):
     kind = path[-2]
     if not isinstance(entry, dict):
         ctx.add(path[:-1], f"`{kind}` must be an array of tables `[[{kind}]]`, got {entry!r}")
@@ -45,4 +68,5 @@ def _load(ctx, path, entry, types):
     if name is FAILED:
         return FAILED  # its keys depend on the type: they cannot be checked
     table = types[name]
-    return build_table(entry, ctx, path, table, table.sources[0].build, hint=f" (for `type = {name!r}`)")
+    build = table.sources[0].build if builder is None else builder(table)
+    return build_table(entry, ctx, path, table, build, hint=f" (for `type = {name!r}`)")

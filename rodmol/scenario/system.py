@@ -6,7 +6,9 @@ keys (``[rod]``'s), its ``name`` and ``n_elements`` (default
 ``[discretization]``'s) and its own tables nested: ``[rod.material]``,
 ``[[rod.cable]]``, ``[[rod.marker]]``, ``[[rod.load]]``, ``[rod.base]``, read
 by the single-rod readers (:mod:`rodmol.scenario.arm`,
-:mod:`rodmol.scenario.loads`) at the entry's path. ``[system]`` gives the
+:mod:`rodmol.scenario.loads`) at the entry's path; ``[[contact]]`` tables
+are rods touching a body (:class:`rodmol.Contact`, the shape as a contact
+``[[load]]`` in the body frame). ``[system]`` gives the
 medium (a preset name or a ``[system.medium]`` table, whose switches apply to
 every rod) and gravity. The tables' keys come from the constructors
 (:mod:`rodmol.scenario.tables`).
@@ -26,6 +28,7 @@ from . import arm as arm_tables
 from . import tables
 from .loads import contacts as contact_tables
 from .loads import loads as load_tables
+from .loads import rod_contacts
 from .problems import FAILED, failed
 
 #: Top-level keys and tables of a single-rod file, and where a system file has them instead.
@@ -53,6 +56,7 @@ def system(data, ctx, n_elements):
     rods = _named(data, ctx, "rod", lambda entry, path: _rod(entry, ctx, path, n_elements, switches))
     bodies = _named(data, ctx, "body", lambda entry, path: _body(entry, ctx, path))
     joints = arm_tables.numbered(data, ctx, "joint", tables.JOINT, _joint)
+    contacts = rod_contacts(data, ctx)
     if "rod" not in data:
         ctx.add((), "missing `[[rod]]`: a system holds at least one rod")
     if failed(rods, bodies, joints, gravity):
@@ -65,10 +69,11 @@ def system(data, ctx, n_elements):
               if not failed(name)}
     rods = rods or {"": STAND_IN_ROD()}
     built = ctx.construct(("system",), System, dict(rods=rods, bodies=bodies, joints=joints,
-                                                    medium=None if failed(medium) else medium, **gravity),
+                                                    medium=None if failed(medium) else medium, **gravity,
+                                                    contacts=() if failed(contacts) else contacts),
                           given=gravity, keys=("gravity",),
                           where=lambda key, message: _system_problem(key, message))
-    return FAILED if parts_failed else built
+    return FAILED if parts_failed or failed(contacts) else built
 
 
 def _joint(name=None, **arguments):
@@ -188,11 +193,12 @@ def _meshed(mesh, density, **options):
 
 
 def _system_problem(key, message):
-    """Where a System error belongs: its key in [system], the [[joint]] it numbers, else the top level."""
+    """Where a System error belongs: its key in [system], the [[joint]] or
+    [[contact]] it numbers, else the top level."""
     if key is not None:
         return ("system", key)
-    found = re.search(r"joints\[(\d+)\]", message)
-    return ("joint", int(found.group(1))) if found else ()
+    found = re.search(r"(joint|contact)s\[(\d+)\]", message)
+    return (found.group(1), int(found.group(2))) if found else ()
 
 
 def STAND_IN_ROD():  # noqa: N802 (a constant made on demand)

@@ -23,6 +23,7 @@ from ..arm import paper_arm
 from ..base_motion import BaseMotion
 from ..bodies import BODY_CONTACT_UNITS, RigidBody
 from ..cables import Cable
+from ..contacts import Contact
 from ..inputs import as_time_input
 from ..loads import CONTACT_TYPES, SCENARIO_TYPES
 from ..markers import Marker
@@ -132,7 +133,7 @@ LOADS = {kind: Table((Source(build),), own=("type",), units=units)
 #: [medium], and gravity), [[rod]] (a rod's keys, its name and grid, and its
 #: own [material], [[cable]], [[marker]], [[load]] and [base] nested),
 #: [[body]] (a RigidBody, or one filling a mesh of a given density, its
-#: [[body.contact]] obstacles) and [[joint]].
+#: [[body.contact]] obstacles), [[joint]] and [[contact]] (rods touching a body).
 SYSTEM = Table((Source(System, only=("medium", "gravity")),))
 SYSTEM_ROD = Table((Source(Rod, skip=("material",)), Source(Model, only=("n_elements",))),
                    own=("name", "material", "cable", "marker", "load", "base"))
@@ -142,18 +143,24 @@ BODY = Table((Source(RigidBody, skip=("contacts",)), Source(RigidBody.from_mesh,
 #: [[load]] types, their law per contact point.
 BODY_CONTACTS = {kind: Table(LOADS[kind].sources, own=("type",), units={**LOADS[kind].units, **BODY_CONTACT_UNITS})
                  for kind in CONTACT_TYPES}
+#: A system file's ``[[contact]]`` tables (a :class:`rodmol.Contact` each), by
+#: ``type``: the contact [[load]] types, in the body frame (the System names
+#: the shape), with the contact's ``body`` and ``rods``.
+CONTACTS = {kind: Table((Source(LOADS[kind].sources[0].build, skip=("name",)), Source(Contact, only=("body", "rods"))),
+                        own=("type",), units=LOADS[kind].units)
+            for kind in CONTACT_TYPES}
 #: A driven body's ``motion`` table (its position and rotation are the body's).
 BODY_MOTION = Table((Source(BaseMotion, only=("velocity", "angular_velocity")),))
 JOINT = Table((Source(Joint),))
 #: The tables of a system file only.
-SYSTEM_TABLES = ("system", "body", "joint")
+SYSTEM_TABLES = ("system", "body", "joint", "contact")
 
-#: The tables, by name (``[[...]]`` arrays of tables: cable, marker, load, body, joint;
-#: in a system file, rod too, as :data:`SYSTEM_ROD`).
+#: The tables, by name (``[[...]]`` arrays of tables: cable, marker, load, body, joint,
+#: contact; in a system file, rod too, as :data:`SYSTEM_ROD`). load and contact: by type.
 TABLES = {"rod": ROD, "material": MATERIAL, "medium": MEDIUM, "cable": CABLE, "marker": MARKER,
           "load": None, "base": BASE, "discretization": DISCRETIZATION, "solver": SOLVER,
-          "output": OUTPUT, "system": SYSTEM, "body": BODY, "joint": JOINT}
-ARRAYS = ("cable", "marker", "load", "body", "joint")
+          "output": OUTPUT, "system": SYSTEM, "body": BODY, "joint": JOINT, "contact": None}
+ARRAYS = ("cable", "marker", "load", "body", "joint", "contact")
 TOP = Table((Source(Model, only=("gravity",)),), own=("name", "description", "arm", "scenario")
             + tuple(TABLES))
 ARMS = ("paper",)

@@ -24,7 +24,7 @@ import rodmol
 
 @pytest.mark.subprocess
 def test_run_a_system_file_writes_every_part(tmp_path):
-    (scenario,) = SYSTEM_SCENARIOS
+    scenario = next(p for p in SYSTEM_SCENARIOS if p.stem == "two_arms")
     out = tmp_path / "out"
     run = rodmol_cli("run", scenario, "--out", out, "--t-end", 0.05, "--quiet")
     assert run.returncode == 0 and run.stdout == "", (run.stdout, run.stderr)  # --quiet: nothing but errors

@@ -40,7 +40,7 @@ def gaps(documented, table):
 SECTIONS = sections(REFERENCE.read_text(encoding="utf-8"))
 
 
-@pytest.mark.parametrize("name", [n for n in tables.TABLES if n not in ("cable", "load")])
+@pytest.mark.parametrize("name", [n for n in tables.TABLES if n not in ("cable", "load", "contact")])
 def test_each_table_documents_exactly_its_constructors_keys(name):
     title = f"`[[{name}]]`" if name in tables.ARRAYS else f"`[{name}]`"
     section = next(text for head, text in SECTIONS.items() if head.startswith(title))
@@ -69,6 +69,19 @@ def test_loads_document_every_type_its_required_keys_and_every_key():
         assert set(re.findall(r"`(\w+)`", rows[kind])) == set(table.required()), kind
     every = tables.Table(tuple(s for t in tables.LOADS.values() for s in t.sources), own=("type",))
     assert gaps(documented_keys(section), every) == ([], [])
+
+
+def test_rod_contacts_document_every_type_its_required_keys_and_every_key():
+    section = next(text for head, text in SECTIONS.items() if head.startswith("`[[contact]]`"))
+    rows = {m.group(1): m.group(2) for m in re.finditer(r'^\| `"(\w+)"` \| `\w+` \| ([^|]*) \|', section, re.M)}
+    assert set(rows) == set(tables.CONTACTS)
+    for kind, table in tables.CONTACTS.items():
+        assert set(re.findall(r"`(\w+)`", rows[kind])) == set(table.required()), kind
+    every = tables.Table(tuple(s for t in tables.CONTACTS.values() for s in t.sources), own=("type",))
+    assert gaps(documented_keys(section), every) == ([], [])
+    for match in re.finditer(r"^\| `(\w+)` \| [^|]* \| `([-\w.\"]+)` \|", section, re.M):
+        key, shown = match.groups()
+        assert float(shown) == every.default(key), key
 
 
 def test_a_new_constructor_parameter_is_a_new_key_and_a_reference_gap():
