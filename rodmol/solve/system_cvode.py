@@ -25,7 +25,7 @@ import time
 import numpy as np
 
 from ..discretise.system_preconditioner import SystemPreconditioner
-from ..errors import NotSupportedYet, ParameterError
+from ..errors import ParameterError
 from .outputs import cause
 from .watch import state_problem
 
@@ -74,9 +74,6 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
         linsolver = "sparse" if assembly.rod_joints else "gmres"
     if linsolver not in SYSTEM_LINEAR_SOLVERS:
         raise ParameterError(f"unknown `linsolver` {linsolver!r} for a system; valid: {list(SYSTEM_LINEAR_SOLVERS)}")
-    if linsolver == "gmres" and assembly.rod_joints:
-        raise NotSupportedYet("`linsolver='gmres'` does not handle joints between two rods yet (its "
-                              "preconditioner leaves their coupling out, and the runs go wrong): use 'sparse'")
     if max_order == "auto":
         max_order = 2 if assembly.lightly_damped else 5
     # Right-hand sides; those with non-finite rates since the last output frame; the first count then.
