@@ -37,7 +37,7 @@ class RodJointCoupling:
         self._jac = [np.zeros((len(rows), len(side.partner_fields))) for side in self.sides]
         self._blocks = [np.zeros_like(jac) for jac in self._jac]
         self.rows = np.concatenate(self._rows) if self.sides else np.zeros(0, dtype=int)
-        self._solved = np.zeros((assembly.size, len(self.rows)))
+        self._solved = np.zeros((len(self.rows), assembly.size))  # Z^T: a row per solve, contiguous
         self._inverse = np.eye(len(self.rows))
         self._out = np.empty(assembly.size)
 
@@ -64,13 +64,13 @@ class RodJointCoupling:
         unit = np.zeros(self.assembly.size)
         for i, row in enumerate(self.rows):
             unit[row] = 1.0
-            solve(unit, self._solved[:, i])
+            solve(unit, self._solved[i])
             unit[row] = 0.0
         k = np.eye(len(self.rows))
         for s, (side, jac) in enumerate(zip(self.sides, self._jac)):
             self._blocks[s][:] = -gamma * jac
             sl = self._side(s)
-            k[sl] += self._blocks[s] @ self._solved[side.partner_fields]
+            k[sl] += self._blocks[s] @ self._solved[:, side.partner_fields].T
         self._inverse = np.linalg.inv(k)
 
     def correct(self, z):
@@ -78,7 +78,7 @@ class RodJointCoupling:
         product = np.empty(len(self.rows))
         for s, (side, block) in enumerate(zip(self.sides, self._blocks)):
             product[self._side(s)] = block @ z[side.partner_fields]
-        z -= self._solved @ (self._inverse @ product)
+        z -= (self._inverse @ product) @ self._solved
 
     def _side(self, s):
         """Side s's rows within U's columns (and K's rows)."""
