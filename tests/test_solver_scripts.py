@@ -209,9 +209,13 @@ def _holds(out):
 
 def _loops(out):
     table = rows(out / "loops.csv")
-    sparse = [row for row in table if row["linear_solver"] == "sparse"]
-    assert sparse and all(row["success"] for row in sparse), sparse
-    assert all(row["max_drift_over_L"] < 1e-4 for row in sparse), sparse  # the default factor or stiffer
+    assert {row["linear_solver"] for row in table} == {"gmres", "sparse"}
+    assert all(row["success"] for row in table), table
+    assert all(row["max_drift_over_L"] < 1e-4 for row in table), table  # the default factor or stiffer
+    by_size = rows(out / "loops_by_size.csv")  # GMRES with the rod-rod joints' blocks against sparse
+    assert {row["problem"] for row in by_size} == {"two half beams", "three rods", "ring"}
+    assert all(row["success"] and row["rhs_ratio"] < 1.5 and row["max_difference_over_L"] < 1e-3
+               for row in by_size), by_size
 
 
 def _body_contact(out):
@@ -270,7 +274,7 @@ SCRIPTS = {
                                     _system_equilibrium_speed),
     "rest_strains_speed.py": (["rest_strains_speed.csv", "rest_strains_speed.md"], _rest_strains_speed),
     "holds.py": (["holds.csv", "holds.md"], _holds),
-    "loops.py": (["loops.csv", "loops.md"], _loops),
+    "loops.py": (["loops.csv", "loops.md", "loops_by_size.csv"], _loops),
     "body_contact.py": (["body_contact.csv", "body_contact.md"], _body_contact),
     "body_joints.py": (["body_joints.csv", "body_joints.md"], _body_joints),
     "system_output.py": (["system_output.csv", "system_output.md"], _system_output),

@@ -36,15 +36,19 @@ differences), S = N_bb - N_br N_rr^-1 N_rb (dense, one block of
 ``rigid.FREE_BODY.size`` rows per body) is formed at each setup from one
 rod solve per body column that moves the rod and joined rod; a solve is
 z_r' = N_rr^-1 r_r, z_b = S^-1 (r_b - N_br z_r'), z_r = z_r' - N_rr^-1
-N_rb z_b.
+N_rb z_b. A penalty joint between two rods' nodes couples them as
+stiffly: its blocks are kept on top of all this, by their own Schur
+complement (:mod:`rodmol.discretise.rod_joint_coupling`).
 """
 
 import numpy as np
 
+from .jacobian import read_only
 from .joints import block_entries
 from .physics import jit
 from .preconditioner import block_solve
 from .rigid import FREE_BODY
+from .rod_joint_coupling import RodJointCoupling
 
 #: A joint node's rows (its velocities) and columns (what the joint reads), within its element block.
 JOINT_ROWS, JOINT_COLUMNS = block_entries("v", "w"), block_entries("u", "Q", "v", "w")
@@ -123,6 +127,7 @@ class SystemPreconditioner:
         self._reads = np.concatenate([link.columns for p in self.coupled for link in self.links[p.name]]
                                      or [np.zeros(0, dtype=int)])
         self._n_br = np.zeros((size, len(self._reads)))
+        self.rod_joints = RodJointCoupling(assembly, BODY_STEP * np.maximum(scale, 1e-300), JOINT_ROWS)
         self.jac_evals = self.setups = self.solves = 0
 
     def setup(self, t, y, fy, jok, jnew, gamma):
@@ -161,6 +166,8 @@ class SystemPreconditioner:
                         self._pairs[part.name, other.name][:, j] = (self._out[rows] - fy[rows]) / steps[j]
                     z[index] = y[index]
             assembly(t, y, self._out)  # leave the rods as at y
+            if self.rod_joints.sides:
+                self.rod_joints.evaluate(t, y, fy)
             self.jac_evals += 1
             jnew[0] = 1
         for prec in self.rods.values():
@@ -170,6 +177,8 @@ class SystemPreconditioner:
         self.gamma = gamma
         if self.coupled:
             self._factor_schur(gamma)
+        if self.rod_joints.sides:
+            self.rod_joints.factor(gamma, self._solve_blocks)
         self.setups += 1
 
     def _rod_columns(self, part, link, t, y, fy, z):
@@ -229,10 +238,18 @@ class SystemPreconditioner:
 
     def solve(self, t, y, fy, r, z, gamma, delta, lr):
         """z = P^-1 r with the last factors."""
+        self._solve_blocks(r, z)
+        if self.rod_joints.sides:
+            self.rod_joints.correct(z)
+        self.solves += 1
+
+    def _solve_blocks(self, r, z):
+        """z = P^-1 r without the rod-rod joints' coupling: the rods', the bodies' blocks and S."""
         parts = self.assembly.parts
         for name, prec in self.rods.items():
             sl = parts[name]
-            prec.solve(t, y[sl], fy[sl], r[sl], z[sl], gamma, delta, lr)
+            g, head, fac, scratch = prec.factors
+            block_solve(g, head, fac, read_only(r[sl]), z[sl], *scratch)
         for part in self.bodies:
             if part not in self.coupled:
                 z[part.slice] = self._inverse[part.name] @ r[part.slice]
@@ -244,4 +261,3 @@ class SystemPreconditioner:
                 z[part.slice] = z_b[o:o + FREE_BODY.size]
             for rod, solved in self._solved.items():
                 z[parts[rod]] -= solved @ z_b
-        self.solves += 1

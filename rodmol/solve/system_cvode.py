@@ -3,16 +3,16 @@
 
 The Newton systems are solved (``linsolver``) by
 
-* ``"gmres"`` (default, unless two rods are joined): GMRES preconditioned by the rods' exact block
+* ``"gmres"`` (default): GMRES preconditioned by the rods' exact block
   preconditioners, the bodies' own blocks and, for free bodies with
   clamped rods or penalty joints, their Schur complement
-  (:mod:`rodmol.discretise.system_preconditioner`); about 2-3x faster than
+  (:mod:`rodmol.discretise.system_preconditioner`), and the blocks of
+  penalty joints between two rods' nodes by theirs
+  (:mod:`rodmol.discretise.rod_joint_coupling`); about 2-3x faster than
   ``"sparse"`` on the octopus (``solvers/octopus.py``, docs/performance.md),
-  as fast or faster on loops (``solvers/loops.py``, docs/systems.md);
-* ``"sparse"`` (default, and the only choice but "dense", when a
-  penalty joint joins two rods' nodes: the preconditioner leaves the
-  rod-rod blocks out, and GMRES's runs then drifted off the true
-  trajectory, so it is refused): SuperLU_MT (scikit-sundae)
+  as fast or faster on loops, also between rods, where it is 1.1 to 2
+  times faster from N = 32 per rod (``solvers/loops.py``, docs/systems.md);
+* ``"sparse"``: SuperLU_MT (scikit-sundae)
   on the assembly's Jacobian pattern, the rods' banded patterns on the
   diagonal and the joints' coupling blocks; scikit-sundae fills the
   Jacobian by its own coloured differences over that pattern;
@@ -25,7 +25,7 @@ import time
 import numpy as np
 
 from ..discretise.system_preconditioner import SystemPreconditioner
-from ..errors import NotSupportedYet, ParameterError
+from ..errors import ParameterError
 from .outputs import cause
 from .watch import state_problem
 
@@ -71,12 +71,9 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
     from sksundae.cvode import CVODE, CVODEPrecond
 
     if linsolver is None:
-        linsolver = "sparse" if assembly.rod_joints else "gmres"
+        linsolver = "gmres"
     if linsolver not in SYSTEM_LINEAR_SOLVERS:
         raise ParameterError(f"unknown `linsolver` {linsolver!r} for a system; valid: {list(SYSTEM_LINEAR_SOLVERS)}")
-    if linsolver == "gmres" and assembly.rod_joints:
-        raise NotSupportedYet("`linsolver='gmres'` does not handle joints between two rods yet (its "
-                              "preconditioner leaves their coupling out, and the runs go wrong): use 'sparse'")
     if max_order == "auto":
         max_order = 2 if assembly.lightly_damped else 5
     # Right-hand sides; those with non-finite rates since the last output frame; the first count then.
