@@ -3,12 +3,11 @@ composed layout and Jacobian pattern."""
 
 import numpy as np
 import pytest
+from newton_check import NewtonCheck
 
 import rodmol
-from rodmol._differences import central_columns
 from rodmol.discretise.assembly import Assembly
 from rodmol.discretise.rigid import NET_MASS, NET_MOMENT
-from rodmol.discretise.system_preconditioner import SystemPreconditioner
 
 
 def _system():
@@ -92,26 +91,15 @@ def test_schur_preconditioner_inverts_the_newton_matrix_of_a_loop():
     joints = [rodmol.Joint(("bar", (0.0, 0.0, 0.0)), ("a", "tip")),
               rodmol.Joint(("bar", (0.0, 0.04, 0.0)), ("b", "tip"), kind="pin"),
               rodmol.Joint(("ring", (0.0, 0.0, 0.0)), ("a", 0.1), kind="pin")]
-    assembly = Assembly(rodmol.System(arms, {"bar": bar, "ring": ring}, joints, gravity=(0.0, -9.81, 0.0)))
-    scale = assembly.atol_scale()
-    y = assembly.initial_state() + 1e-2 * np.random.default_rng(5).standard_normal(assembly.size) * scale
-    fy = assembly(0.0, y).copy()
-    jac = central_columns(lambda z: assembly(0.0, z).copy(), y, range(assembly.size), 1e-7 * scale)
-    gamma = 1e-4
-    newton = np.eye(assembly.size) - gamma * jac
-    precond = SystemPreconditioner(assembly, scale)
-    precond.setup(0.0, y, fy, False, [0], gamma)
-    assert precond.coupled == [assembly.bodies["bar"], assembly.bodies["ring"]]
-    v = np.random.default_rng(6).standard_normal(assembly.size) * scale
-    r, z = newton @ v, np.empty_like(v)
-    precond.solve(0.0, y, fy, r, z, gamma, 0.0, 1)
-    error = np.abs((z - v) / scale).max()
+    check, gamma = NewtonCheck(Assembly(rodmol.System(arms, {"bar": bar, "ring": ring}, joints,
+                                                     gravity=(0.0, -9.81, 0.0)))), 1e-4
+    precond = check.preconditioner(gamma)
+    assert precond.coupled == [check.assembly.bodies["bar"], check.assembly.bodies["ring"]]
+    v = np.random.default_rng(6).standard_normal(check.assembly.size) * check.scale
+    r = check.newton(gamma) @ v
+    error = check.error(check.solve(precond, r, gamma), v)
     assert error < 2e-4
-    apart = np.concatenate([precond.rods["a"].apply(r[assembly.parts["a"]]),
-                            precond.rods["b"].apply(r[assembly.parts["b"]]),
-                            *[np.linalg.solve(np.eye(13) - gamma * precond._jac[b], r[assembly.parts[b]])
-                              for b in ("bar", "ring")]])
-    assert np.abs((apart - v) / scale).max() > 100 * error
+    assert check.error(check.apart(precond, r, gamma), v) > 100 * error
 
 
 def test_a_free_body_carries_the_base_half_cell_of_each_rod_clamped_to_it():
@@ -160,23 +148,13 @@ def test_schur_preconditioner_inverts_the_newton_matrix_of_a_tree():
     head = rodmol.RigidBody(0.05, (2e-5, 3e-5, 4e-5), centre_of_mass=(0.0, 0.004, 0.0), volume=2e-5)
     joints = [rodmol.Joint(("head", (0.02, 0.0, 0.0)), ("a", "base")),
               rodmol.Joint(("head", (-0.02, 0.0, 0.0), np.diag([-1.0, -1.0, 1.0])), ("b", "base"))]
-    assembly = Assembly(rodmol.System({"a": arm, "b": arm}, {"head": head}, joints, medium="water",
-                                      gravity=(0.0, 0.0, -9.81)))
-    scale = assembly.atol_scale()
-    y = assembly.initial_state() + 1e-2 * np.random.default_rng(7).standard_normal(assembly.size) * scale
-    fy = assembly(0.0, y).copy()
-    jac = central_columns(lambda z: assembly(0.0, z).copy(), y, range(assembly.size), 1e-7 * scale)
+    check = NewtonCheck(Assembly(rodmol.System({"a": arm, "b": arm}, {"head": head}, joints, medium="water",
+                                               gravity=(0.0, 0.0, -9.81))), seed=7)
     gamma = 1e-3
-    newton = np.eye(assembly.size) - gamma * jac
-    precond = SystemPreconditioner(assembly, scale)
-    precond.setup(0.0, y, fy, False, [0], gamma)
+    precond = check.preconditioner(gamma)
     assert [link.rod for link in precond.links["head"]] == ["a", "b"]
-    v = np.random.default_rng(8).standard_normal(assembly.size) * scale
-    r, z = newton @ v, np.empty_like(v)
-    precond.solve(0.0, y, fy, r, z, gamma, 0.0, 1)
-    error = np.abs((z - v) / scale).max()
+    v = np.random.default_rng(8).standard_normal(check.assembly.size) * check.scale
+    r = check.newton(gamma) @ v
+    error = check.error(check.solve(precond, r, gamma), v)
     assert error < 1e-6
-    apart = np.concatenate([precond.rods["a"].apply(r[assembly.parts["a"]]),
-                            precond.rods["b"].apply(r[assembly.parts["b"]]),
-                            np.linalg.solve(np.eye(13) - gamma * precond._jac["head"], r[assembly.parts["head"]])])
-    assert np.abs((apart - v) / scale).max() > 1e5 * error
+    assert check.error(check.apart(precond, r, gamma), v) > 1e5 * error

@@ -4,13 +4,12 @@ law; a pinned base needs a scheme that leaves its base segment to it."""
 
 import numpy as np
 import pytest
+from newton_check import NewtonCheck
 
 import rodmol
-from rodmol._differences import central_columns
 from rodmol.discretise.assembly import Assembly
 from rodmol.discretise.body_joints import joint_frequency, pair_wrench
 from rodmol.discretise.rotations import from_matrix, from_rotation_vector, matrices
-from rodmol.discretise.system_preconditioner import SystemPreconditioner
 from rodmol.loads import KERNELS, N_PARAMS, P_DAMPING, P_STIFFNESS, P_TURN_DAMPING, P_TURN_STIFFNESS
 
 
@@ -154,25 +153,14 @@ def test_the_schur_preconditioner_inverts_the_newton_matrix_with_body_joints_and
     # Every coupling of the free bodies is kept (the joints between them, the pinned base's body with its
     # rod's first cell, the bar with its rod joint): the preconditioner is the Newton matrix itself, to
     # the error of its forward differences; without the bodies' couplings it is far off.
-    assembly = _joined_bodies()
-    scale = assembly.atol_scale()
-    y = assembly.initial_state() + 1e-2 * np.random.default_rng(5).standard_normal(assembly.size) * scale
-    fy = assembly(0.0, y).copy()
-    jac = central_columns(lambda z: assembly(0.0, z).copy(), y, range(assembly.size), 1e-7 * scale)
-    gamma = 1e-4
-    newton = np.eye(assembly.size) - gamma * jac
-    precond = SystemPreconditioner(assembly, scale)
-    precond.setup(0.0, y, fy, False, [0], gamma)
+    check, gamma = NewtonCheck(_joined_bodies()), 1e-4
+    precond = check.preconditioner(gamma)
     assert [p.name for p in precond.coupled] == ["bar", "weight", "arm.base"]
-    v = np.random.default_rng(6).standard_normal(assembly.size) * scale
+    v = np.random.default_rng(6).standard_normal(check.assembly.size) * check.scale
     # The fixed post's pose has no correction (its rates read nothing else and are zero at its pose), so
     # the weight's rows against it, left out of the weight's block, never act.
-    v[assembly.bodies["post"].slice] = 0.0
-    r, z = newton @ v, np.empty_like(v)
-    precond.solve(0.0, y, fy, r, z, gamma, 0.0, 1)
-    error = np.abs((z - v) / scale).max()
+    v[check.assembly.bodies["post"].slice] = 0.0
+    r = check.newton(gamma) @ v
+    error = check.error(check.solve(precond, r, gamma), v)
     assert error < 2e-4
-    apart = np.concatenate([precond.rods["arm"].apply(r[assembly.parts["arm"]]),
-                            *[np.linalg.solve(np.eye(p.layout.size) - gamma * precond._jac[p.name], r[p.slice])
-                              for p in assembly.bodies.values()]])
-    assert np.abs((apart - v) / scale).max() > 100 * error
+    assert check.error(check.apart(precond, r, gamma), v) > 100 * error

@@ -3,11 +3,10 @@
 their Schur complement (rodmol.discretise.system_preconditioner)."""
 
 import numpy as np
+from newton_check import NewtonCheck
 
 import rodmol
-from rodmol._differences import central_columns
 from rodmol.discretise.assembly import Assembly
-from rodmol.discretise.system_preconditioner import SystemPreconditioner
 
 
 def _loop():
@@ -33,21 +32,15 @@ def test_preconditioner_inverts_the_newton_matrix_of_rods_joined_to_each_other()
     # coupling is in the preconditioner: it is I - gamma J itself, to the error of its forward
     # differences (measured 8e-7 and 6e-6 of each entry's scale); without those blocks, as GMRES had it
     # before, it is off by more than 1000 times the entries' scale.
-    assembly = _loop()
-    scale = assembly.atol_scale()
-    y = assembly.initial_state() + 1e-2 * np.random.default_rng(5).standard_normal(assembly.size) * scale
-    fy = assembly(0.0, y).copy()
-    jac = central_columns(lambda z: assembly(0.0, z).copy(), y, range(assembly.size), 1e-7 * scale)
+    check = NewtonCheck(_loop())
+    assembly = check.assembly
     for gamma, bound in ((1e-4, 1e-5), (1e-3, 1e-4)):
-        precond = SystemPreconditioner(assembly, scale)
-        precond.setup(0.0, y, fy, False, [0], gamma)
+        precond = check.preconditioner(gamma)
         assert len(precond.rod_joints.sides) == 4 and precond.coupled == [assembly.bodies["bar"]]
-        np.testing.assert_array_equal(assembly(0.0, y), fy)  # the differences left every rod as at y
-        v = np.random.default_rng(6).standard_normal(assembly.size) * scale
-        r, z = (np.eye(assembly.size) - gamma * jac) @ v, np.empty_like(v)
-        precond.solve(0.0, y, fy, r, z, gamma, 0.0, 1)
-        error = np.abs((z - v) / scale).max()
-        assert error < bound
+        np.testing.assert_array_equal(assembly(0.0, check.y), check.fy)  # the differences left every rod as at y
+        v = np.random.default_rng(6).standard_normal(assembly.size) * check.scale
+        r = check.newton(gamma) @ v
+        assert check.error(check.solve(precond, r, gamma), v) < bound
         apart = np.empty_like(v)
         precond._solve_blocks(r, apart)
-        assert np.abs((apart - v) / scale).max() > 1e3
+        assert check.error(apart, v) > 1e3
