@@ -20,9 +20,8 @@ Two methods hold the joints:
   rod's node (a branch), is a small free body of its own, the rod's base
   segment (the half cell the velocity nodes leave out), its base clamped to
   it (eliminated) and the body pinned by a body joint, or held to the other
-  rod's node by a penalty joint (:attr:`System.base_bodies`).
-
-Two rods' bases joined to each other raise :class:`rodmol.errors.NotSupportedYet`.
+  rod's node by a penalty joint, or to another such base body by a body
+  joint (:attr:`System.base_bodies`).
 """
 
 import numpy as np
@@ -31,7 +30,7 @@ from . import _checks
 from .base_motion import BaseMotion
 from .bodies import RigidBody
 from .contacts import Contact, attach
-from .errors import NotSupportedYet, ParameterError
+from .errors import ParameterError
 from .holds import Hold
 from .model import Model
 from .parameters import Medium
@@ -129,16 +128,8 @@ class System:
                 if isinstance(e, tuple) and e[0] == "body" and e[1] not in self.bodies:
                     raise ParameterError(f"`joints[{i}]` names the body {e[1]!r}, which is not in `bodies`"
                                          f"{_checks.did_you_mean(e[1], self.bodies)}")
-            bases = [e for e in rod_ends if e[2] == "base"]
-            if len(rod_ends) == 2 and len(bases) == 1:  # a branch: the base's body held by the other's node
-                (_, rod, _), (_, other_rod, where) = bases[0], next(e for e in rod_ends if e is not bases[0])
-                if rod in clamps:
-                    raise ParameterError(f"`joints[{i}]`: the base of rod {rod!r} is already jointed")
-                if rod == other_rod:
-                    raise ParameterError(f"`joints[{i}]` joins the base of rod {rod!r} to its own node")
-                name, clamps[rod] = self._base_body(i, rod, ("rod", other_rod, where))
-                penalties.append(self._node_joint(i, joint, other_rod, where, ("body", name, np.zeros(3), None),
-                                                  holds))
+            if len(rod_ends) == 2 and any(e[2] == "base" for e in rod_ends):
+                penalties += self._base_to_rod(i, joint, rod_ends, clamps, holds)
                 continue
             if len(rod_ends) == 2:
                 penalties += self._rod_to_rod(i, joint, rod_ends, holds)
@@ -165,6 +156,28 @@ class System:
                      for name, m in self.rods.items()}
         return clamps, penalties
 
+    def _base_to_rod(self, i, joint, rod_ends, clamps, holds):
+        """``joints[i]`` at a rod's base and another rod's end: the base clamped to its base
+        body, held to the other rod's node by a penalty joint (a branch) or, base to base, the
+        two base bodies joined by a body joint; returns the penalty joints."""
+        (_, a, where_a), (_, b, where_b) = rod_ends
+        if a == b:
+            raise ParameterError(f"`joints[{i}]` joins the base of rod {a!r} to its own node")
+        bases = [rod for rod, where in ((a, where_a), (b, where_b)) if where == "base"]
+        for rod in bases:
+            if rod in clamps:
+                raise ParameterError(f"`joints[{i}]`: the base of rod {rod!r} is already jointed")
+        if len(bases) == 2:
+            names = []
+            for rod in bases:
+                name, clamps[rod] = self._base_body(i, rod, "world")
+                names.append(("body", name, np.zeros(3), None))
+            self.body_joints.append(self._body_joint(i, joint, *names))
+            return []
+        (base, other, where) = (a, b, where_b) if where_a == "base" else (b, a, where_a)
+        name, clamps[base] = self._base_body(i, base, ("rod", other, where))
+        return [self._node_joint(i, joint, other, where, ("body", name, np.zeros(3), None), holds)]
+
     def _node_joint(self, i, joint, rod, where, other, holds):
         """The :class:`PenaltyJoint` of ``joints[i]`` holding rod ``rod``'s node
         ``where`` (its tip or an arc length) to ``other`` (the world or a body
@@ -187,9 +200,6 @@ class System:
     def _rod_to_rod(self, i, joint, rod_ends, holds):
         """The two penalty joints of ``joints[i]`` between two rods' nodes (not
         bases): each rod's hold held by the other's node, appended to ``holds``."""
-        if all(where == "base" for _, _, where in rod_ends):
-            raise NotSupportedYet(f"`joints[{i}]` joins two rods' bases: join a base to the other rod's tip or "
-                                  "node s, or both bases to a body")
         (_, a, where_a), (_, b, where_b) = rod_ends
         if a == b and where_a == where_b:
             raise ParameterError(f"`joints[{i}]` joins a node of rod {a!r} to itself")

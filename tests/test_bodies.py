@@ -100,8 +100,8 @@ def test_system_graph_checks():
     branched = rodmol.System({"arm": _arm(), "arm2": _arm()}, joints=[rodmol.Joint(("arm", "tip"), ("arm2", "base"))])
     (held,) = branched.penalty_joints  # arm2's base body held by arm's tip (tests/test_system_branches.py)
     assert branched.base_bodies == {"arm2": "arm2.base"} and (held.rod, held.body) == ("arm", "arm2.base")
-    with pytest.raises(rodmol.NotSupportedYet, match="two rods' bases"):
-        rodmol.System({"arm": _arm(), "arm2": _arm()}, joints=[rodmol.Joint(("arm", "base"), ("arm2", "base"))])
+    joined = rodmol.System({"arm": _arm(), "arm2": _arm()}, joints=[rodmol.Joint(("arm", "base"), ("arm2", "base"))])
+    assert [(j.a, j.b) for j in joined.body_joints] == [("arm.base", "arm2.base")]  # two base bodies joined
     with pytest.raises(rodmol.ParameterError, match="to itself"):
         rodmol.System({"arm": _arm()}, joints=[rodmol.Joint(("arm", "tip"), ("arm", "tip"))])
     with pytest.raises(rodmol.ParameterError, match="velocity node"):

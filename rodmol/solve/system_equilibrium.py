@@ -33,6 +33,7 @@ from ..discretise.joints import RodJointPart
 from ..discretise.rigid import NET_MASS, free_body_rates
 from ..discretise.system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE
 from ..errors import EquilibriumError
+from ..holds import Hold
 from ..loads import P_STIFFNESS
 from .rest_equations import STATIC_FIELDS, RestEquations, continuation
 from .watch import state_problem
@@ -223,7 +224,7 @@ class FreeRestEquations:
 def floating(system):
     """The names of the free bodies of a :class:`rodmol.System` that no chain of
     rods and joints holds to the world (a fixed or driven body, a rod's base
-    clamped to the world, a penalty joint to the world): contacts do not hold a
+    clamped to the world, a penalty joint or a rod's own Hold to the world): contacts do not hold a
     body at rest (friction acts on sliding only, so on a floor alone every
     horizontal position is a rest)."""
     edges = [(rod, "world" if clamp[0] is None else clamp[0]) for rod, clamp in system.clamps.items()]
@@ -231,6 +232,9 @@ def floating(system):
     for joint in system.penalty_joints:
         edges.append((joint.rod, joint.partner if joint.partner is not None else joint.body or "world"))
     edges += [(joint.a, joint.b or "world") for joint in system.body_joints]
+    of_joints = {(joint.rod, joint.load) for joint in system.penalty_joints}
+    edges += [(rod, "world") for rod, model in system.rods.items()  # a rod's own holds (rodmol.Hold)
+              if any(isinstance(load, Hold) and (rod, k) not in of_joints for k, load in enumerate(model.loads))]
     held = {"world"} | {name for name, body in system.bodies.items() if not body.free}
     grown = True
     while grown:
