@@ -61,9 +61,9 @@ import numpy as np
 from scipy import sparse
 
 from .body_joints import BodyJointPart, joint_frequency
-from .body_part import BodyPart, clamp_velocities, cross
+from .body_part import BodyPart, clamp_velocities, cross, first_element
 from .contact_parts import contact_parts
-from .joints import JointPart, RecordedJoints, RodJointPart, block_entries
+from .joints import JOINT_COLUMNS, JOINT_ROWS, JointPart, RecordedJoints, RodJointPart
 from .physics import quaternion_rate
 from .rigid import clamp_wrench, free_body_rates
 from .rotations import from_matrix, matrices
@@ -287,19 +287,19 @@ class Assembly:
             velocity = np.r_[part.fields["v"], part.fields["w"]]
             for name, sd in zip(part.rods, part.systems):
                 start = self.parts[name].start
-                first = np.arange(start, start + sd.layout.header + sd.layout.block)
+                first = first_element(start, sd)
                 pat[np.ix_(first, velocity)] = True
                 pat[np.ix_(velocity, first)] = True
         for joint in self.joints:
             body = joint.part.slice
-            rows = joint.node + block_entries("v", "w")
+            rows = joint.node + JOINT_ROWS
             pat[np.ix_(rows, np.arange(body.start, body.stop))] = True
             if joint.part.body.free:
-                node = joint.node + block_entries("u", "Q", "v", "w")
+                node = joint.node + JOINT_COLUMNS
                 velocity = np.r_[joint.part.fields["v"], joint.part.fields["w"]]
                 pat[np.ix_(velocity, node)] = True
         for joint in self.rod_joints:  # each side: its node's velocity rows against the partner node
-            pat[np.ix_(joint.node + block_entries("v", "w"), joint.partner_fields)] = True
+            pat[np.ix_(joint.node + JOINT_ROWS, joint.partner_fields)] = True
         for joint in self.body_joints:  # each free body's velocity rows against the other's block
             for part in joint.parts:
                 for other in joint.parts:

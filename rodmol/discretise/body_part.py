@@ -29,6 +29,12 @@ def clamp_velocities(points, turns, v, w):
                            np.einsum("rji,j->ri", turns, np.broadcast_to(w, 3))], axis=1)
 
 
+def first_element(start, sd):
+    """State indices of the header and first element block of the rod of system ``sd`` whose
+    entries start at ``start``: the rows a clamp's body velocities move (its base velocities)."""
+    return np.arange(start, start + sd.layout.header + sd.layout.block)
+
+
 class BodyPart:
     """One rigid body's place in the state, its constant data and its rods'
     clamps stacked for the coupling (points (n, 3) [m] and rotations (n, 3, 3),

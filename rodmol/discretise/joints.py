@@ -23,6 +23,11 @@ def block_entries(*fields):
     return np.concatenate([np.arange(FIELDS[f].start, FIELDS[f].stop) for f in fields])
 
 
+#: A joint node's entries within its element block: the rows its reaction moves (the velocities)
+#: and the entries the reaction reads (the node's pose and velocities).
+JOINT_ROWS, JOINT_COLUMNS = block_entries("v", "w"), block_entries("u", "Q", "v", "w")
+
+
 class JointPart:
     """A penalty joint between a rod node and a body: the rod's hold entry
     (its parameter row and value, the kernel's arrays), the node's element
@@ -89,7 +94,7 @@ class RodJointPart:
         self.row, self.value = sd.entry_params[self.entry], sd.entry_values[self.entry]
         self.node = _node(sd, rod_start, hold.s)
         self.partner_node = _node(partner, partner_start, partner_hold.s)
-        self.partner_fields = self.partner_node + block_entries("u", "Q", "v", "w")
+        self.partner_fields = self.partner_node + JOINT_COLUMNS
         partner_row = partner.entry_params[_entry(other, joint.partner_load)]
         # One law for both sides, or the pair is not equal and opposite: each hold took its own
         # rod's defaults (k from E A / ds, c from its node's mass, k_r from its radius).

@@ -43,15 +43,14 @@ complement (:mod:`rodmol.discretise.rod_joint_coupling`).
 
 import numpy as np
 
+from .body_part import first_element
 from .jacobian import read_only
-from .joints import block_entries
+from .joints import JOINT_COLUMNS, JOINT_ROWS, block_entries
 from .physics import jit
 from .preconditioner import block_solve
 from .rigid import FREE_BODY
 from .rod_joint_coupling import RodJointCoupling
 
-#: A joint node's rows (its velocities) and columns (what the joint reads), within its element block.
-JOINT_ROWS, JOINT_COLUMNS = block_entries("v", "w"), block_entries("u", "Q", "v", "w")
 #: What a body reads of a rod clamped to it, within the rod's first element block: the stress of
 #: cell 0, from its strains and (the viscous law) their rates.
 CLAMP_COLUMNS = block_entries("q", "k", "v", "w")
@@ -89,8 +88,7 @@ def links(assembly, part):
     out = []
     for name, sd in zip(part.rods, part.systems):
         start = assembly.parts[name].start
-        first = np.arange(start, start + sd.layout.header + sd.layout.block)
-        out.append(Link(name, first, start + sd.layout.header + CLAMP_COLUMNS, True))
+        out.append(Link(name, first_element(start, sd), start + sd.layout.header + CLAMP_COLUMNS, True))
     for joint in part.joints:
         out.append(Link(joint.joint.rod, joint.node + JOINT_ROWS, joint.node + JOINT_COLUMNS, False))
     return out
