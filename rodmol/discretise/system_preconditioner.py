@@ -104,10 +104,10 @@ class SystemPreconditioner:
         self.bodies = list(assembly.bodies.values())
         self._steps = {p.name: BODY_STEP * np.maximum(scale[p.slice], 1e-300) for p in self.bodies}
         self._jac = {p.name: np.zeros((p.layout.size, p.layout.size)) for p in self.bodies}
-        self._inverse = {p.name: np.eye(p.layout.size) for p in self.bodies}
+        self._inverse = {}  # the bodies outside the Schur complement: their own blocks inverted
         self._field_of = {p.name: [f for f, n in p.layout.fields.items() for _ in range(n)] for p in self.bodies}
         self._out = np.empty(assembly.size)
-        self._scale, self.gamma = scale, np.nan
+        self._scale = scale
         # The Schur complement's bodies (free, with rods, penalty joints or free partners joined to them),
         # their links and offsets in S, and the blocks of their joints to their free partners.
         self._partners = {p.name: [o for j in p.body_joints for o in j.parts if o is not p and o.body.free]
@@ -171,8 +171,8 @@ class SystemPreconditioner:
         for prec in self.rods.values():
             prec.factor(gamma)
         for part in self.bodies:
-            self._inverse[part.name] = np.linalg.inv(np.eye(part.layout.size) - gamma * self._jac[part.name])
-        self.gamma = gamma
+            if part not in self.coupled:
+                self._inverse[part.name] = np.linalg.inv(np.eye(part.layout.size) - gamma * self._jac[part.name])
         if self.coupled:
             self._factor_schur(gamma)
         if self.rod_joints.sides:
