@@ -1,0 +1,98 @@
+"""A ParaView picture of any system run directory (``simulate(system, t_end, out=DIR)``):
+
+    xvfb-run -a -s "-screen 0 1280x1024x24" pvpython docs/figures/make_system.py DIR PNG \\
+        [--time T] [--floor Z] [--floor-size HALF] [--camera X Y Z] [--focus X Y Z] [--up X Y Z] \\
+        [--dolly D] [--curvature-max K]
+
+Every rod folder's rod.xdmf (each subfolder of DIR holding one) as a tube of
+its true radius coloured by its curvature [1/m], the bodies of bodies.xdmf,
+and, with --floor, the plane z = Z (global) as a floor. The camera looks from
+--camera at --focus (global, m), --up upwards; ParaView then fits everything in
+view and --dolly moves it closer. The frame shown is the one at or before T [s]
+(default: the last). The pictures of docs/systems.md and their command lines:
+
+    python examples/octopus.py out/octopus
+    ... make_system.py out/octopus docs/figures/octopus.png --time 8 --floor -0.0922 \\
+        --floor-size 0.55 --camera 0.55 -0.75 0.42 --focus 0.02 0 -0.06 --dolly 1.7 --curvature-max 15
+"""
+
+import argparse
+import glob
+import os
+
+from paraview.simple import (
+    ColorBy,
+    CreateView,
+    ExtractSurface,
+    GetColorTransferFunction,
+    LoadPalette,
+    Plane,
+    Render,
+    SaveScreenshot,
+    Show,
+    Text,
+    Tube,
+    Xdmf3ReaderS,
+)
+
+parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+parser.add_argument("directory")
+parser.add_argument("png")
+parser.add_argument("--time", type=float, help="the time shown [s]; default: the run's last frame")
+parser.add_argument("--floor", type=float, help="draw the floor z = FLOOR [m], global")
+parser.add_argument("--floor-size", type=float, default=0.3, help="the floor's half width [m] about the focus")
+parser.add_argument("--camera", type=float, nargs=3, default=(1.0, -1.5, 0.8), help="camera position [m]")
+parser.add_argument("--focus", type=float, nargs=3, default=(0.0, 0.0, 0.0), help="focal point [m]")
+parser.add_argument("--up", type=float, nargs=3, default=(0.0, 0.0, 1.0), help="the picture's up direction")
+parser.add_argument("--dolly", type=float, default=1.0, help="move the camera closer by this factor")
+parser.add_argument("--curvature-max", type=float, help="the colour scale's top [1/m]; default: the data's range")
+parser.add_argument("--size", type=int, nargs=2, default=(1000, 600), help="the picture's width and height [px]")
+args = parser.parse_args()
+
+directory = os.path.abspath(args.directory)  # ParaView 5.11 needs absolute XDMF paths
+rods = sorted(glob.glob(os.path.join(directory, "*", "rod.xdmf")))
+if not rods:
+    raise SystemExit(f"no rod folder (*/rod.xdmf) in {directory}: is it a system run directory?")
+
+view = CreateView("RenderView")
+view.ViewSize = list(args.size)
+view.OrientationAxesVisibility = 0
+LoadPalette("WhiteBackground")
+
+readers, tubes = [], []
+for path in rods:
+    rod = Xdmf3ReaderS(registrationName=os.path.basename(os.path.dirname(path)), FileName=[path])
+    readers.append(rod)
+    tube = Tube(Input=ExtractSurface(Input=rod))
+    tube.Scalars = ["POINTS", "radius [m]"]
+    tube.VaryRadius = "By Absolute Scalar"
+    tube.NumberofSides = 24
+    tubes.append(Show(tube, view))
+    ColorBy(tubes[-1], ("POINTS", "curvature [1/m]", "Magnitude"))
+times = list(readers[0].TimestepValues) or [0.0]
+t = times[-1] if args.time is None else max([s for s in times if s <= args.time + 1e-9] or times[:1])
+view.ViewTime = t
+
+bodies = os.path.join(directory, "bodies.xdmf")
+if os.path.exists(bodies):
+    Show(Xdmf3ReaderS(registrationName="bodies", FileName=[bodies]), view).DiffuseColor = [0.85, 0.5, 0.35]
+if args.floor is not None:
+    (x, y, _), half, z = args.focus, args.floor_size, args.floor
+    plane = Plane(registrationName="floor", Origin=[x - half, y - half, z], Point1=[x + half, y - half, z],
+                  Point2=[x - half, y + half, z])
+    ground = Show(plane, view)
+    ground.DiffuseColor, ground.Opacity = [0.76, 0.70, 0.55], 0.8
+Show(Text(registrationName="time", Text=f"t = {t:.2f} s"), view).FontSize = 14
+
+view.CameraPosition, view.CameraFocalPoint, view.CameraViewUp = list(args.camera), list(args.focus), list(args.up)
+Render(view)
+view.ResetCamera()
+view.GetActiveCamera().Dolly(args.dolly)  # closer than ParaView's fit of everything
+curvature = GetColorTransferFunction("curvature [1/m]")
+if args.curvature_max is None:  # the range at the time shown, not at the first frame (often straight)
+    for i, tube in enumerate(tubes):
+        tube.RescaleTransferFunctionToDataRange(i > 0, True)
+else:
+    curvature.RescaleTransferFunction(0.0, args.curvature_max)
+Render(view)
+SaveScreenshot(args.png, view, ImageResolution=list(args.size))
