@@ -39,7 +39,8 @@ parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 parser.add_argument("directory")
 parser.add_argument("png")
 parser.add_argument("--time", type=float, help="the time shown [s]; default: the run's last frame")
-parser.add_argument("--floor", type=float, help="draw the floor z = FLOOR [m], global")
+parser.add_argument("--floor", type=float, help="draw the floor z = FLOOR [m], global (or --floor-axis's)")
+parser.add_argument("--floor-axis", choices="xyz", default="z", help="the floor's normal: a global axis")
 parser.add_argument("--floor-size", type=float, default=0.3, help="the floor's half width [m] about the focus")
 parser.add_argument("--camera", type=float, nargs=3, default=(1.0, -1.5, 0.8), help="camera position [m]")
 parser.add_argument("--focus", type=float, nargs=3, default=(0.0, 0.0, 0.0), help="focal point [m]")
@@ -59,7 +60,7 @@ view.ViewSize = list(args.size)
 view.OrientationAxesVisibility = 0
 LoadPalette("WhiteBackground")
 
-readers, tubes = [], []
+readers, tubes = [], []  # each rod's reader and tube filter
 for path in rods:
     rod = Xdmf3ReaderS(registrationName=os.path.basename(os.path.dirname(path)), FileName=[path])
     readers.append(rod)
@@ -67,8 +68,8 @@ for path in rods:
     tube.Scalars = ["POINTS", "radius [m]"]
     tube.VaryRadius = "By Absolute Scalar"
     tube.NumberofSides = 24
-    tubes.append(Show(tube, view))
-    ColorBy(tubes[-1], ("POINTS", "curvature [1/m]", "Magnitude"))
+    tubes.append(tube)
+    ColorBy(Show(tube, view), ("POINTS", "curvature [1/m]", "Magnitude"))
 times = list(readers[0].TimestepValues) or [0.0]
 t = times[-1] if args.time is None else max([s for s in times if s <= args.time + 1e-9] or times[:1])
 view.ViewTime = t
@@ -77,9 +78,14 @@ bodies = os.path.join(directory, "bodies.xdmf")
 if os.path.exists(bodies):
     Show(Xdmf3ReaderS(registrationName="bodies", FileName=[bodies]), view).DiffuseColor = [0.85, 0.5, 0.35]
 if args.floor is not None:
-    (x, y, _), half, z = args.focus, args.floor_size, args.floor
-    plane = Plane(registrationName="floor", Origin=[x - half, y - half, z], Point1=[x + half, y - half, z],
-                  Point2=[x - half, y + half, z])
+    normal, half = "xyz".index(args.floor_axis), args.floor_size
+    a, b = [k for k in range(3) if k != normal]
+    corners = []
+    for da, db in ((-1, -1), (1, -1), (-1, 1)):
+        corner = list(args.focus)
+        corner[normal], corner[a], corner[b] = args.floor, corner[a] + da * half, corner[b] + db * half
+        corners.append(corner)
+    plane = Plane(registrationName="floor", Origin=corners[0], Point1=corners[1], Point2=corners[2])
     ground = Show(plane, view)
     ground.DiffuseColor, ground.Opacity = [0.76, 0.70, 0.55], 0.8
 Show(Text(registrationName="time", Text=f"t = {t:.2f} s"), view).FontSize = 14
@@ -89,10 +95,11 @@ Render(view)
 view.ResetCamera()
 view.GetActiveCamera().Dolly(args.dolly)  # closer than ParaView's fit of everything
 curvature = GetColorTransferFunction("curvature [1/m]")
-if args.curvature_max is None:  # the range at the time shown, not at the first frame (often straight)
-    for i, tube in enumerate(tubes):
-        tube.RescaleTransferFunctionToDataRange(i > 0, True)
-else:
-    curvature.RescaleTransferFunction(0.0, args.curvature_max)
+top = args.curvature_max
+if top is None:  # the largest at the time shown, not at the first frame (often straight)
+    for tube in tubes:
+        tube.UpdatePipeline(t)
+    top = max(tube.PointData["curvature [1/m]"].GetRange(-1)[1] for tube in tubes) or 1.0
+curvature.RescaleTransferFunction(0.0, top)
 Render(view)
 SaveScreenshot(args.png, view, ImageResolution=list(args.size))
