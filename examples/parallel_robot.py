@@ -24,7 +24,8 @@ MATERIAL = rodmol.Material(E=2e8, nu=0.5, mu=2e6, rho=1000.0)  # mu: near critic
 PLATFORM_M, PLATFORM_COM, BASE_RADIUS = 0.5, (0.02, 0.01, 0.0), 0.05  # kg, m (platform frame), m
 GRAVITY = (-9.81, 0.0, -3.0)  # m/s^2, global: sideways and down
 UP = np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])  # a leg's x axis along global z
-LEG_POINTS = [(BASE_RADIUS * np.cos(a), BASE_RADIUS * np.sin(a), 0.0) for a in 2 * np.pi * np.arange(3) / 3 + 0.3]
+LEG_POINTS = [(BASE_RADIUS * np.cos(a), BASE_RADIUS * np.sin(a), 0.0)  # m, global and platform frame
+              for a in 2 * np.pi * np.arange(3) / 3 + 0.3]
 
 
 def robot(n=32):
@@ -51,5 +52,5 @@ if __name__ == "__main__":
     platform = result["platform"]
     print("success:", result.success)
     print("platform position [m]:", np.array2string(platform.position[-1], precision=6))
-    print("platform rotation vector:", np.array2string(Rotation.from_matrix(platform.rotation[-1]).as_rotvec(),
-                                                       precision=6))
+    turned = Rotation.from_matrix(platform.rotation[-1]).as_rotvec()
+    print("platform rotation vector:", np.array2string(turned, precision=6))

@@ -146,7 +146,8 @@ def test_the_payload_example_drops_to_twice_its_euler_bernoulli_sag():
     assert result.success
     ei = payload.MATERIAL.E * np.pi * payload.RADIUS**4 / 4.0
     weight = payload.MATERIAL.rho * np.pi * payload.RADIUS**2 * payload.GRAVITY  # per length [N/m]
-    reference = payload.PAYLOAD_M * payload.GRAVITY * payload.LENGTH**3 / (3 * ei) + weight * payload.LENGTH**4 / (8 * ei)
+    length = payload.LENGTH
+    reference = payload.PAYLOAD_M * payload.GRAVITY * length**3 / (3 * ei) + weight * length**4 / (8 * ei)
     assert -sag == pytest.approx(reference, rel=1e-2)  # measured 2.8e-3 (N = 8), 7e-4 (N = 16)
     factor = result["payload"].position[:, 1].min() / sag
     assert factor == pytest.approx(2.0, abs=0.02)  # measured 2.0008

@@ -39,15 +39,15 @@ parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
 parser.add_argument("directory")
 parser.add_argument("png")
 parser.add_argument("--time", type=float, help="the time shown [s]; default: the run's last frame")
-parser.add_argument("--floor", type=float, help="draw the floor z = FLOOR [m], global (or --floor-axis's)")
+parser.add_argument("--floor", type=float, help="draw the floor z = FLOOR [m], global (or the axis given)")
 parser.add_argument("--floor-axis", choices="xyz", default="z", help="the floor's normal: a global axis")
-parser.add_argument("--floor-size", type=float, default=0.3, help="the floor's half width [m] about the focus")
-parser.add_argument("--camera", type=float, nargs=3, default=(1.0, -1.5, 0.8), help="camera position [m]")
+parser.add_argument("--floor-size", type=float, default=0.3, help="its half width about the focus [m]")
+parser.add_argument("--camera", type=float, nargs=3, default=(1.0, -1.5, 0.8), help="the camera's position [m]")
 parser.add_argument("--focus", type=float, nargs=3, default=(0.0, 0.0, 0.0), help="focal point [m]")
 parser.add_argument("--up", type=float, nargs=3, default=(0.0, 0.0, 1.0), help="the picture's up direction")
 parser.add_argument("--dolly", type=float, default=1.0, help="move the camera closer by this factor")
-parser.add_argument("--curvature-max", type=float, help="the colour scale's top [1/m]; default: the data's range")
-parser.add_argument("--size", type=int, nargs=2, default=(1000, 600), help="the picture's width and height [px]")
+parser.add_argument("--curvature-max", type=float, help="the colour scale's top [1/m]; default: the largest")
+parser.add_argument("--size", type=int, nargs=2, default=(1000, 600), help="width and height [px]")
 args = parser.parse_args()
 
 directory = os.path.abspath(args.directory)  # ParaView 5.11 needs absolute XDMF paths
@@ -90,7 +90,8 @@ if args.floor is not None:
     ground.DiffuseColor, ground.Opacity = [0.76, 0.70, 0.55], 0.8
 Show(Text(registrationName="time", Text=f"t = {t:.2f} s"), view).FontSize = 14
 
-view.CameraPosition, view.CameraFocalPoint, view.CameraViewUp = list(args.camera), list(args.focus), list(args.up)
+view.CameraPosition, view.CameraFocalPoint = list(args.camera), list(args.focus)
+view.CameraViewUp = list(args.up)
 Render(view)
 view.ResetCamera()
 view.GetActiveCamera().Dolly(args.dolly)  # closer than ParaView's fit of everything
