@@ -1,7 +1,7 @@
 """A branch: a short arm pinned by its base under the middle of a beam
 clamped at both ends (a penalty joint holding the arm's base segment to the
 beam's node), released 30 degrees from hanging straight down: it swings
-about the pin as a pendulum while the beam sags and twists under it. Its
+about the pin as a pendulum while the beam sags and sways under it. Its
 period is close to the compound pendulum's, 2 pi sqrt(2 L / 3 g) for a
 uniform rod of length L, lengthened by the amplitude and the beam's give.
 tests/test_system_branches.py checks the arm hanging at rest against the

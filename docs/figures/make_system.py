@@ -1,19 +1,17 @@
 """A ParaView picture of any system run directory (``simulate(system, t_end, out=DIR)``):
 
     xvfb-run -a -s "-screen 0 1280x1024x24" pvpython docs/figures/make_system.py DIR PNG \\
-        [--time T] [--floor Z] [--floor-size HALF] [--camera X Y Z] [--focus X Y Z] [--up X Y Z] \\
-        [--dolly D] [--curvature-max K]
+        [--time T] [--floor Z] [--floor-axis {x,y,z}] [--floor-size HALF] [--camera X Y Z] \\
+        [--focus X Y Z] [--up X Y Z] [--dolly D] [--curvature-max K] [--size W H]
 
 Every rod folder's rod.xdmf (each subfolder of DIR holding one) as a tube of
 its true radius coloured by its curvature [1/m], the bodies of bodies.xdmf,
-and, with --floor, the plane z = Z (global) as a floor. The camera looks from
+and, with --floor, the plane z = Z (global; or x, y = Z by --floor-axis) as
+a floor. The camera looks from
 --camera at --focus (global, m), --up upwards; ParaView then fits everything in
 view and --dolly moves it closer. The frame shown is the one at or before T [s]
-(default: the last). The pictures of docs/systems.md and their command lines:
-
-    python examples/octopus.py out/octopus
-    ... make_system.py out/octopus docs/figures/octopus.png --time 8 --floor -0.0922 \\
-        --floor-size 0.55 --camera 0.55 -0.75 0.42 --focus 0.02 0 -0.06 --dolly 1.7 --curvature-max 15
+(default: the last). docs/systems.md, "Pictures of the examples", gives the
+command lines of its pictures (the octopus, the parallel robot, ...).
 """
 
 import argparse
