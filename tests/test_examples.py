@@ -53,10 +53,11 @@ def test_reach_policies_records_an_episode(tmp_path):
     assert (tmp_path / "episode_0001" / "rod.xdmf").is_file()
 
 
-def octopus_example():
+def example(script):
+    """examples/``script`` loaded as a module (its ``__main__`` part not run)."""
     import importlib.util
 
-    spec = importlib.util.spec_from_file_location("octopus_example", EXAMPLES / "octopus.py")
+    spec = importlib.util.spec_from_file_location(script.removesuffix(".py") + "_example", EXAMPLES / script)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
@@ -75,7 +76,7 @@ def test_the_octopus_rests_on_the_floor_and_crawls_forward():
 
     import rodmol
 
-    octopus = octopus_example()
+    octopus = example("octopus.py")
     result = rodmol.simulate(octopus.octopus(10), octopus.SETTLE + 2 * octopus.PERIOD, output_dt=0.5)
     assert result.success
     head, rest = result["head"], np.searchsorted(result.t, octopus.SETTLE)
@@ -97,7 +98,7 @@ def test_the_floor_carries_the_octopus_weight_less_its_buoyancy_to_second_order(
 
     import rodmol
 
-    octopus = octopus_example()
+    octopus = example("octopus.py")
     ns, gaps = (10, 20, 30), []
     for n in ns:
         system = octopus.octopus(n, pattern=lambda angle: {})
@@ -107,3 +108,62 @@ def test_the_floor_carries_the_octopus_weight_less_its_buoyancy_to_second_order(
     orders = np.log(np.divide(gaps[:-1], gaps[1:])) / np.log(np.divide(ns[1:], ns[:-1]))
     assert np.all(orders >= 1.8), orders
     assert gaps[-1] < 3e-4 * octopus.net_weight(system)
+
+
+# The platform's settled pose by tests/test_system_joints.py's shooting solution (position [m], rotation
+# vector, global): its numbers, printed there by parallel_robot_shooting().
+ROBOT_POSITION = (-1.20870445e-02, 1.91907638e-05, 1.99553407e-01)
+ROBOT_ROTATION = (-0.00189694, -0.00170921, 0.02563446)
+
+
+@pytest.mark.subprocess
+def test_the_parallel_robot_example_settles_at_the_shooting_pose_and_writes_its_views(tmp_path):
+    """examples/parallel_robot.py at N = 8: the robot of tests/test_system_joints.py (there at N = 32
+    against the shooting solution to 1e-3); its run directory holds what docs/figures/make_system.py
+    draws."""
+    import numpy as np
+
+    out = run("parallel_robot.py", str(tmp_path / "robot"), "8")
+    assert out.returncode == 0 and "success: True" in out.stdout, out.stderr
+    numbers = re.findall(r"\[([^\]]+)\]\s*$", out.stdout, flags=re.M)
+    position, rotation = (np.array(n.split(), dtype=float) for n in numbers)
+    moved = np.linalg.norm(np.subtract(ROBOT_POSITION, (0.0, 0.0, 0.2)))
+    # Measured at N = 8: 1.2e-2 of the displacement (12 mm), 7.6e-3 of the rotation.
+    np.testing.assert_allclose(position, ROBOT_POSITION, atol=2.5e-2 * moved)
+    np.testing.assert_allclose(rotation, ROBOT_ROTATION, atol=2e-2 * np.linalg.norm(ROBOT_ROTATION))
+    for part in ("leg0/rod.xdmf", "leg1/rod.xdmf", "leg2/rod.xdmf", "bodies.xdmf"):
+        assert (tmp_path / "robot" / part).is_file()
+
+
+def test_the_payload_example_drops_to_twice_its_euler_bernoulli_sag():
+    """examples/payload.py at N = 8: the static sag is the Euler-Bernoulli cantilever's under the tip
+    weight and its own, M g L^3 / 3 EI + rho A g L^4 / 8 EI, and the suddenly applied weight swings the
+    payload down to twice it (a linear, undamped oscillator's dynamic factor, first mode)."""
+    import numpy as np
+
+    payload = example("payload.py")
+    result, sag = payload.swing(8)
+    assert result.success
+    ei = payload.MATERIAL.E * np.pi * payload.RADIUS**4 / 4.0
+    weight = payload.MATERIAL.rho * np.pi * payload.RADIUS**2 * payload.GRAVITY  # per length [N/m]
+    length = payload.LENGTH
+    reference = payload.PAYLOAD_M * payload.GRAVITY * length**3 / (3 * ei) + weight * length**4 / (8 * ei)
+    assert -sag == pytest.approx(reference, rel=1e-2)  # measured 2.8e-3 (N = 8), 7e-4 (N = 16)
+    factor = result["payload"].position[:, 1].min() / sag
+    assert factor == pytest.approx(2.0, abs=0.02)  # measured 2.0008
+
+
+def test_the_branch_example_swings_with_the_compound_pendulum_period():
+    """examples/branch.py at N = 16: the arm pinned under the beam swings as a uniform rod pinned at
+    one end, period 2 pi sqrt(2 L / 3 g), lengthened by the amplitude a (1 + a^2 / 16) and, a
+    little, by the beam's give."""
+    import numpy as np
+
+    import rodmol
+
+    branch = example("branch.py")
+    result = rodmol.simulate(branch.branched(16), 0.8, output_dt=0.005)
+    assert result.success
+    expected = branch.compound_pendulum() * (1.0 + branch.SWING**2 / 16.0)
+    assert branch.period(result) == pytest.approx(expected, rel=1e-2)  # measured 4.7e-3
+    assert result["arm"].tip[:, 1].min() < -0.9 * branch.ARM_L * np.sin(branch.SWING)  # it swings through
