@@ -44,7 +44,9 @@ def atomic_path(path):
 def output_directory(path, name="out"):
     """Create the output directory ``path`` (and its parents) and return it as a Path; a
     :class:`ParameterError` naming the parameter ``name`` says why it cannot be (a file
-    in its place, no permission, a NUL in the name), before anything is written."""
+    in its place, no permission, a NUL in the name, an empty name), before anything is written."""
+    if isinstance(path, str) and not path.strip():  # Path("") is the current directory: never meant
+        raise ParameterError(f"`{name}` must name a directory, got {path!r}")
     try:
         path = Path(path)
         path.mkdir(parents=True, exist_ok=True)

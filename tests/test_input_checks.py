@@ -163,3 +163,15 @@ def test_scenario_output_directory_with_nul():
 ])
 def test_model_refuses_wrong_types(options, match):
     refused(match, rodmol.Model, ROD, 6, **options)
+
+
+@pytest.mark.parametrize("out", ["", "  "])
+def test_an_empty_output_directory_is_refused_before_any_work(out, tmp_path, monkeypatch):
+    """Path("") is the current directory: a run streamed there by an empty name was never meant."""
+    monkeypatch.chdir(tmp_path)
+    model = rodmol.scenarios.get("bending").model(4)
+    system = rodmol.System({"arm": model})
+    for run in (model, system):
+        with pytest.raises(rodmol.ParameterError, match="`out` must name a directory"):
+            rodmol.simulate(run, 0.01, out=out, overwrite=True)
+    assert not any(tmp_path.iterdir())
