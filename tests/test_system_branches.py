@@ -68,8 +68,8 @@ def test_two_bases_joined_converge_to_the_single_rod_of_both():
     """Rod a leaves x = 0 along +x, rod b along -x, their bases clamped to each other (two base
     bodies and a body joint) and b's tip clamped by a Hold at x = -L: one cantilever of 2L under
     its weight. Its free tip converges to the single rod's at first order (measured 7.5e-3,
-    3.7e-3, 1.9e-3 of the sag at N = 4, 8, 16 per rod): the joints at the rods' ends (the tip
-    hold's, the bases') take the ends' first-order closure of the staggered grid."""
+    3.7e-3, 1.9e-3 of the sag at N = 4, 8, 16 per rod): joints at rods' ends converge at first
+    order (docs/systems.md, the joints' table; not yet traced), at interior nodes at second."""
     length, gravity = 0.1, (0.0, 0.0, -9.81)
     errors = []
     for n in (4, 8, 16):
