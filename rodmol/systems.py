@@ -169,8 +169,8 @@ class System:
                 raise ParameterError(f"`joints[{i}]`: the base of rod {rod!r} is already jointed")
         if len(bases) == 2:
             names = []
-            for rod in bases:
-                name, clamps[rod] = self._base_body(i, rod, "world")
+            for rod, other in ((a, b), (b, a)):
+                name, clamps[rod] = self._base_body(i, rod, ("rod", other, "base"))
                 names.append(("body", name, np.zeros(3), None))
             self.body_joints.append(self._body_joint(i, joint, *names))
             return []
