@@ -1,5 +1,5 @@
 """A run of a :class:`rodmol.System` (rods and rigid bodies), reached through
-:func:`rodmol.simulate`: in memory, from rest, with CVODE or the single rod's
+:func:`rodmol.simulate`: from rest, its static equilibrium or a given state, with CVODE or the single rod's
 ``"galpha"`` and ``"rk23"`` backends (through
 :class:`rodmol.solve.system_stepping.SteppedSystem`); with ``out=DIR`` its
 frames are streamed in chunks while it goes, through the single rod's
