@@ -50,6 +50,19 @@ def _solver(scheme, backend, rtol, atol, backend_options, initial):
                 f"a state vector (fingerprint {fingerprint(np.asarray(initial, dtype=float))[:16]})")
 
 
+def resumed(recorded, scheme, backend, rtol, atol, backend_options):
+    """(scheme, backend, rtol, atol, backend_options) of a resumed run: each the call leaves
+    None taken from the run's ``recorded`` settings, and its backend options too when the call
+    gives none for the recorded backend (another backend keeps its own)."""
+    scheme = recorded.get("scheme") if scheme is None else scheme
+    backend = recorded.get("backend") if backend is None else backend
+    rtol = recorded.get("rtol") if rtol is None else rtol
+    atol = recorded.get("atol") if atol is None else atol
+    if not backend_options and backend == recorded.get("backend"):
+        backend_options = recorded.get("backend_options") or {}
+    return scheme, backend, rtol, atol, backend_options
+
+
 def differences(recorded, current):
     """(name, the run's value, this call's value) of each recorded setting that differs."""
     found = []

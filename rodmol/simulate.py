@@ -145,12 +145,8 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         plan, first, kept = sink.resume_point()
         recorded = getattr(sink, "settings", None) or {}
         t0 = float(plan[first])
-        scheme = recorded.get("scheme") if scheme is None else scheme
-        backend = recorded.get("backend") if backend is None else backend
-        rtol = recorded.get("rtol") if rtol is None else rtol
-        atol = recorded.get("atol") if atol is None else atol
-        if not backend_options and backend == recorded.get("backend"):  # (another backend: its own)
-            backend_options = recorded.get("backend_options") or {}
+        scheme, backend, rtol, atol, backend_options = _settings.resumed(recorded, scheme, backend, rtol, atol,
+                                                                         backend_options)
     args = check_run(initial=INITIAL[0] if initial is None else initial, t0=t0,
                      scheme=DEFAULT_SCHEME if scheme is None else scheme,
                      backend=DEFAULT_BACKEND if backend is None else backend, rtol=rtol, atol=atol,

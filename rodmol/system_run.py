@@ -64,12 +64,8 @@ def simulate_system(system, t_end, *, initial=None, scheme=None, backend=None, r
         sink = _sink(out, True, False)
         recorded = sink.settings or {}
         _check_plan(sink.t_out, recorded, initial, t0, t_end, output_dt, output_times)
-        scheme = recorded.get("scheme") if scheme is None else scheme
-        rtol = recorded.get("rtol") if rtol is None else rtol
-        atol = recorded.get("atol") if atol is None else atol
-        backend = recorded.get("backend") if backend is None else backend
-        if not backend_options and backend == recorded.get("backend"):  # (another backend: its own)
-            backend_options = recorded.get("backend_options") or {}
+        scheme, backend, rtol, atol, backend_options = _settings.resumed(recorded, scheme, backend, rtol, atol,
+                                                                         backend_options)
         first, initial = sink.restart[0], sink.restart[1]
         t0 = float(sink.t_out[first])
     asked_atol = atol  # None: the default, rtol times the parts' scales (recorded as None)

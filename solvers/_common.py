@@ -205,6 +205,16 @@ def timed(backend, system, y0, t_out, rtol, reps, **options):
     return float(np.median(walls)), raw
 
 
+def timed_simulate(model, t_end, reps, **options):
+    """The last of ``reps`` runs of ``rodmol.simulate`` (50 output frames) and their median
+    solver wall time [s] (as in its stats)."""
+    walls = []
+    for _ in range(max(1, reps)):
+        result = rodmol.simulate(model, t_end, output_dt=t_end / 50, **options)
+        walls.append(result.stats["wall_time_s"])
+    return result, float(np.median(walls))
+
+
 def warm_up(system, y0, **options):
     """Compile (or load) the kernels a configuration uses, outside the timings."""
     t_out = np.array([0.0, 1e-3, 2e-3])

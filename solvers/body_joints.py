@@ -110,14 +110,6 @@ def drift(run, system):
     return np.max(gaps, axis=0)
 
 
-def timed(system, t_end, reps, **options):
-    walls = []
-    for _ in range(reps):
-        run = rodmol.simulate(system, t_end, output_dt=t_end / 50, **options)
-        walls.append(run.stats["wall_time_s"])
-    return run, float(np.median(walls))
-
-
 def main(argv=None):
     args = C.parse_args(__doc__.splitlines()[0], argv)
     header = C.header_lines(args, SCRIPT)
@@ -127,10 +119,10 @@ def main(argv=None):
         t_end, n = C.pick(args, *t_ends), C.pick(args, *sizes)
         rodmol.simulate(_scaled(build, 1.0, n), t_end / 10)  # compile, warm
         for solver in ("gmres", "sparse"):
-            run_ref, wall_ref = timed(reference(n), t_end, args.reps, linsolver=solver)
+            run_ref, wall_ref = C.timed_simulate(reference(n), t_end, args.reps, linsolver=solver)
             for factor in factors:
                 system = _scaled(build, factor, n)
-                run, wall = timed(system, t_end, args.reps, linsolver=solver)
+                run, wall = C.timed_simulate(system, t_end, args.reps, linsolver=solver)
                 gap = drift(run, system) / length
                 rows.append(dict(
                     problem=name, N=n, factor=factor, linear_solver=solver, success=run.success,

@@ -161,14 +161,6 @@ def drift(run, system):
     return np.max(gaps, axis=0)
 
 
-def timed(system, t_end, reps, **options):
-    walls = []
-    for _ in range(reps):
-        run = rodmol.simulate(system, t_end, output_dt=t_end / 50, **options)
-        walls.append(run.stats["wall_time_s"])
-    return run, float(np.median(walls))
-
-
 def main(argv=None):
     args = C.parse_args(__doc__.splitlines()[0], argv)
     header = C.header_lines(args, SCRIPT)
@@ -179,11 +171,11 @@ def main(argv=None):
         free = build(n, None, joined=False)
         for solver in ("gmres", "sparse"):  # compile, warm
             rodmol.simulate(build(n, HOLD_STIFFNESS_FACTOR), t_end / 10, linsolver=solver)
-        run_free, wall_free = timed(free, t_end, args.reps)
+        run_free, wall_free = C.timed_simulate(free, t_end, args.reps)
         cases = [(f, solver) for f in factors for solver in ("gmres", "sparse")]
         for factor, solver in cases:
             system = build(n, factor)
-            run, wall = timed(system, t_end, args.reps, linsolver=solver)
+            run, wall = C.timed_simulate(system, t_end, args.reps, linsolver=solver)
             gap = drift(run, system) / system.rods[next(iter(system.rods))].rod.length
             rows.append(dict(
                 problem=name, N=n, factor=factor, default=factor == HOLD_STIFFNESS_FACTOR, linear_solver=solver,
@@ -218,8 +210,8 @@ def solvers_by_size(args):
             system = build(n, HOLD_STIFFNESS_FACTOR)
             walls = []
             for _ in range(args.reps):  # interleaved: the machine's load moves both alike
-                gmres, gmres_s = timed(system, t_end, 1, linsolver="gmres")
-                sparse, sparse_s = timed(system, t_end, 1, linsolver="sparse")
+                gmres, gmres_s = C.timed_simulate(system, t_end, 1, linsolver="gmres")
+                sparse, sparse_s = C.timed_simulate(system, t_end, 1, linsolver="sparse")
                 walls.append((gmres_s, sparse_s, gmres_s / sparse_s))
             gmres_s, sparse_s, ratio = np.median(walls, axis=0)
             length = max(model.rod.length for model in system.rods.values())

@@ -29,6 +29,7 @@ from _common import np, rodmol
 SCRIPT = "octopus.py"
 HEAD_RADIUS = 0.05  # m
 ARMS = 8
+WATER = dict(medium="water", gravity=(0.0, 0.0, -9.81))  # the octopus's medium and gravity
 
 
 PULSE_HZ = 2.0
@@ -72,7 +73,7 @@ def octopus(n, pattern, arms=ARMS, motion="free", tilt=30.0):
         frame = np.column_stack([out, side, np.cross(out, side)])  # the arm's base frame in the head's
         rods[f"arm{i + 1}"] = arm(n, 1 if i % 2 == 0 else 3, pattern(2.0 * np.pi * i / arms))
         joints.append(rodmol.Joint(("head", HEAD_RADIUS * out, frame), (f"arm{i + 1}", "base")))
-    return rodmol.System(rods, {"head": head(motion)}, joints, medium="water", gravity=(0.0, 0.0, -9.81))
+    return rodmol.System(rods, {"head": head(motion)}, joints, **WATER)
 
 
 def timed(cases, t_end, reps):
@@ -98,15 +99,20 @@ def timed(cases, t_end, reps):
     return rows, result
 
 
+def settings(args):
+    """The arms' N and the simulated time [s] of the run mode, after warming up the kernels
+    (they compile on first use; every case runs warm)."""
+    n = C.pick(args, 30, 30, 8)
+    rodmol.simulate(rodmol.System({"a": arm(n, 1, ramp(0.0))}, **WATER), 0.01)
+    rodmol.simulate(arm(n, 1, ramp(0.0)), 0.01, initial="straight")
+    return n, C.pick(args, 1.0, 0.3, 0.05)
+
+
 def main(argv=None):
     args = C.parse_args(__doc__.splitlines()[0], argv)
     header = C.header_lines(args, SCRIPT)
-    n = C.pick(args, 30, 30, 8)
-    t_end = C.pick(args, 1.0, 0.3, 0.05)
-    water = dict(medium="water", gravity=(0.0, 0.0, -9.81))
-    # Warm: the kernels compile on first use; every case below runs warm.
-    rodmol.simulate(rodmol.System({"a": arm(n, 1, ramp(0.0))}, **water), 0.01)
-    rodmol.simulate(arm(n, 1, ramp(0.0)), 0.01, initial="straight")
+    n, t_end = settings(args)
+    water = WATER
     rows, notes = [], ""
     for name, pattern in PATTERNS.items():
         single = arm(n, 1, pattern(0.0)).replace(gravity=water["gravity"])

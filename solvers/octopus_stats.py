@@ -62,11 +62,8 @@ def _motion(result):
 def main(argv=None):
     args = C.parse_args(__doc__.splitlines()[0], argv)
     header = C.header_lines(args, SCRIPT)
-    n = C.pick(args, 30, 30, 8)
-    t_end = C.pick(args, 1.0, 0.3, 0.05)
-    water = dict(medium="water", gravity=(0.0, 0.0, -9.81))
-    rodmol.simulate(rodmol.System({"a": O.arm(n, 1, O.ramp(0.0))}, **water), 0.01)  # compile
-    rodmol.simulate(O.arm(n, 1, O.ramp(0.0)), 0.01, initial="straight")
+    n, t_end = O.settings(args)
+    water = O.WATER
     rows, accuracy = [], []
     for name, pattern in O.PATTERNS.items():
         cases = [("one arm, Model (band LU)", O.arm(n, 1, pattern(0.0)).replace(gravity=water["gravity"]),

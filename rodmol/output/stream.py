@@ -354,15 +354,9 @@ class RunWriter:
         return [k for k in range(n) if (start + k) % self.every == 0 or k == n - 1]
 
     def _fragment(self, t, name):
-        """The XDMF text of the chunk ``name``'s views, showing times ``t`` (:func:`xdmf.fragment`)."""
-        h5 = name  # relative to the views, which sit in the run directory
-        fixed = self._static_views()
-        views = {"rod": xdmf.rod_grids(h5, t, len(fixed["s"]))}
-        if "cable_s" in fixed:
-            views["cables"] = xdmf.cable_grids(h5, t, len(fixed["cable_s"]), len(fixed["cable_cells"]))
-        if "marker_s" in fixed:
-            views["markers"] = xdmf.marker_grids(h5, t, len(fixed["marker_s"]))
-        return xdmf.fragment(views)
+        """The XDMF text of the chunk ``name``'s views (relative to them: they sit in the run
+        directory), showing times ``t``."""
+        return xdmf.rod_fragment(name, t, self._static_views())
 
     def _static_views(self):
         """The views' arrays that do not change in time (made once: every chunk file holds them)."""

@@ -135,6 +135,18 @@ def fragment(views):
     return text
 
 
+def rod_fragment(h5, t, fixed):
+    """The XDMF text (:func:`fragment`) of a rod's chunk file ``h5`` (its path relative to the
+    views) at times ``t``: the rod, and its cables and markers if ``fixed`` (:func:`static_views`)
+    has them."""
+    views = {"rod": rod_grids(h5, t, len(fixed["s"]))}
+    if "cable_s" in fixed:
+        views["cables"] = cable_grids(h5, t, len(fixed["cable_s"]), len(fixed["cable_cells"]))
+    if "marker_s" in fixed:
+        views["markers"] = marker_grids(h5, t, len(fixed["marker_s"]))
+    return fragment(views)
+
+
 def write_fragment(path, text):
     """Write a chunk's :func:`fragment` ``text`` to ``path``, atomically."""
     Path(path).parent.mkdir(parents=True, exist_ok=True)

@@ -61,24 +61,25 @@ def test_top_level_documents_its_keys_and_lists_every_table():
     assert set(re.findall(r"`\[+(\w+)\]+`", listed)) == set(tables.TABLES)
 
 
-def test_loads_document_every_type_its_required_keys_and_every_key():
-    section = next(text for head, text in SECTIONS.items() if head.startswith("`[[load]]`"))
+def assert_documents_types(heading, types):
+    """The section ``heading`` lists every type of ``types`` with its required keys, and documents
+    every key of them; returns the section and the table of all their keys."""
+    section = next(text for head, text in SECTIONS.items() if head.startswith(heading))
     rows = {m.group(1): m.group(2) for m in re.finditer(r'^\| `"(\w+)"` \| `\w+` \| ([^|]*) \|', section, re.M)}
-    assert set(rows) == set(tables.LOADS)
-    for kind, table in tables.LOADS.items():
+    assert set(rows) == set(types)
+    for kind, table in types.items():
         assert set(re.findall(r"`(\w+)`", rows[kind])) == set(table.required()), kind
-    every = tables.Table(tuple(s for t in tables.LOADS.values() for s in t.sources), own=("type",))
+    every = tables.Table(tuple(s for t in types.values() for s in t.sources), own=("type",))
     assert gaps(documented_keys(section), every) == ([], [])
+    return section, every
+
+
+def test_loads_document_every_type_its_required_keys_and_every_key():
+    assert_documents_types("`[[load]]`", tables.LOADS)
 
 
 def test_rod_contacts_document_every_type_its_required_keys_and_every_key():
-    section = next(text for head, text in SECTIONS.items() if head.startswith("`[[contact]]`"))
-    rows = {m.group(1): m.group(2) for m in re.finditer(r'^\| `"(\w+)"` \| `\w+` \| ([^|]*) \|', section, re.M)}
-    assert set(rows) == set(tables.CONTACTS)
-    for kind, table in tables.CONTACTS.items():
-        assert set(re.findall(r"`(\w+)`", rows[kind])) == set(table.required()), kind
-    every = tables.Table(tuple(s for t in tables.CONTACTS.values() for s in t.sources), own=("type",))
-    assert gaps(documented_keys(section), every) == ([], [])
+    section, every = assert_documents_types("`[[contact]]`", tables.CONTACTS)
     for match in re.finditer(r"^\| `(\w+)` \| [^|]* \| `([-\w.\"]+)` \|", section, re.M):
         key, shown = match.groups()
         assert float(shown) == every.default(key), key
