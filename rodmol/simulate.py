@@ -1,4 +1,5 @@
-"""The one entry point: :func:`simulate`."""
+"""The one entry point: :func:`simulate`, one path for a rod and for a system of rods and
+bodies; what differs between them is :mod:`rodmol.run_kinds`' table."""
 
 import time
 import warnings
@@ -7,27 +8,24 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from . import _checks, _settings, run_sinks
+from . import _checks, _settings
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
-from .discretise.system import SemiDiscrete
 from .errors import ParameterError
 from .model import Model
-from .result import Result, from_states
+from .run_kinds import KINDS, run_kind
 from .solve import kernels, options
 from .solve.backends import get_backend
 from .solve.chunked import run_chunked
 from .solve.equilibrium import equilibrium
 from .solve.outputs import keep_before_failure
-from .solve.scales import check_scales
-from .solve.watch import state_problem
-from .system_run import simulate_system
-from .systems import System
 
 INITIAL = ("equilibrium", "straight")
 #: Values of ``resume``: "force" continues even with settings other than the run's.
 RESUME = (False, True, "force")
 #: Defaults of the settings ``simulate`` leaves as None (a resumed run takes the run's).
 OUTPUT_DT, DEFAULT_BACKEND = 0.01, "cvode"
+#: What an ``initial`` result may be: a run's of any kind.
+RESULTS = tuple(kind.results for kind in KINDS)
 
 
 def default_atol(model, rtol):
@@ -36,8 +34,9 @@ def default_atol(model, rtol):
     strains 1, curvatures 1/L, velocities L/T, angular velocities L/(T r_min)
     with T the first bending period), so that every field's error moves the
     rod by about ``rtol`` L: ``rtol`` times the system's own
-    :meth:`~rodmol.discretise.system.SemiDiscrete.atol_scale`, as ``simulate`` takes it."""
-    return rtol * SemiDiscrete(model).atol_scale()
+    :meth:`~rodmol.discretise.system.SemiDiscrete.atol_scale` (a System's: its
+    rods' and bodies'), as ``simulate`` takes it."""
+    return rtol * run_kind(model).discretise(model).atol_scale()
 
 
 def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None, atol=None,
@@ -48,16 +47,19 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
     Parameters
     ----------
     model : Model or System
-        A System (several rods and rigid bodies) runs in memory from rest
-        and returns a ``SystemResult`` (:mod:`rodmol.system_run`, ``docs/systems.md``).
+        One rod, or a System of rods and rigid bodies (``docs/systems.md``),
+        whose run differs only where :mod:`rodmol.run_kinds` says: it starts
+        from rest by default and returns a ``SystemResult``.
     t_end : float
         End time [s], absolute (> ``t0``).
     initial : "equilibrium", "straight", Result or array
         Initial state: the static equilibrium under the loads at ``t0`` (the
-        paper's choice, the default), the unloaded rod at rest in its rest
-        shape (straight unless the rod has rest strains: ``undeformed_state``), an
-        earlier :class:`Result` (the run continues from its last state, at its
-        last time unless ``t0`` is given), or a state vector (``Result.states``).
+        paper's choice, a rod's default; a System's free bodies included), the
+        unloaded rod at rest in its rest shape (straight unless the rod has
+        rest strains: ``undeformed_state``; a System's default, its bodies at
+        rest at their poses), an earlier :class:`Result` or ``SystemResult``
+        (the run continues from its last state, at its last time unless ``t0``
+        is given), or a state vector (``Result.states``).
     scheme : str
         The spatial scheme, a name from ``rodmol.SCHEMES``: ``"centred"``
         (second order in ds, the default) or ``"upwind"`` (the paper's, first
@@ -94,13 +96,14 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
     out : path or sink, optional
         Stream the frames while the run goes into this directory
         (:class:`rodmol.output.stream.RunWriter`: ``result.h5`` and ParaView's
-        ``rod.xdmf``, see ``docs/paraview.md``) or into a sink object with the
-        same protocol; memory then stays bounded by one chunk, the solver
+        ``rod.xdmf``, see ``docs/paraview.md``; a System's:
+        :class:`rodmol.output.system_stream.SystemRunWriter`, ``system.h5``
+        and a folder per rod) or into a sink object with the same protocol; memory then stays bounded by one chunk, the solver
         restarts at every chunk boundary, and the Result returned reads its
         arrays from the files. ``result.h5`` records the run's settings
         (``scheme``, ``backend``, ``rtol``, ``atol``, the backend options, the
         grid, the initial state and a fingerprint of the model's parameters,
-        :mod:`rodmol._settings`). A directory holding an earlier run is
+        a System's of each of its parts, :mod:`rodmol._settings`). A directory holding an earlier run is
         refused unless ``overwrite`` or ``resume``.
     resume : bool or "force"
         With ``out``: continue the unfinished (killed, interrupted or failed)
@@ -123,41 +126,35 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
 
     Returns
     -------
-    Result
+    Result or SystemResult
         If the solver fails, blows up, stalls or is interrupted, the result
         holds the frames computed so far, ``success`` is False, ``message``
         says where and why (see ``docs/troubleshooting.md``), ``error`` holds
         the exception that ended it (e.g. a user function's, with its
         traceback) and a warning is issued.
     """
-    if isinstance(model, System):  # several rods and bodies: their own run (rodmol.system_run)
-        return simulate_system(model, t_end, initial=initial, scheme=scheme, backend=backend, rtol=rtol,
-                               atol=atol, output_dt=output_dt, output_times=output_times, t0=t0,
-                               progress=progress, max_wall_time=max_wall_time, out=out, resume=resume,
-                               overwrite=overwrite, **backend_options)
-    check_model(model)
+    kind = run_kind(model)
     if not (resume is True or resume is False or (isinstance(resume, str) and resume in RESUME)):
         raise ParameterError(f"`resume` must be False, True or 'force', got {_checks.short(resume)}")
     sink, first, plan, recorded, kept = None, 0, None, {}, None
     asked_plan, asked_initial = (t0, output_dt, output_times), initial
     if resume:  # the run's directory first: its settings fill in what the call leaves out
-        sink = _sink(out, resume, overwrite)
+        sink = _sink(kind, out, resume, overwrite)
         plan, first, kept = sink.resume_point()
         recorded = getattr(sink, "settings", None) or {}
         t0 = float(plan[first])
         scheme, backend, rtol, atol, backend_options = _settings.resumed(recorded, scheme, backend, rtol, atol,
                                                                          backend_options)
-    args = check_run(initial=INITIAL[0] if initial is None else initial, t0=t0,
-                     scheme=DEFAULT_SCHEME if scheme is None else scheme,
+    args = check_run(initial=initial, t0=t0, scheme=DEFAULT_SCHEME if scheme is None else scheme,
                      backend=DEFAULT_BACKEND if backend is None else backend, rtol=rtol, atol=atol,
-                     progress=progress, max_wall_time=max_wall_time, backend_options=backend_options)
+                     progress=progress, max_wall_time=max_wall_time, backend_options=backend_options, kind=kind)
     t_end = _checks.positive("t_end", t_end, " s")
     if t_end <= args.t0:
         raise ParameterError(f"`t_end` must be after the start t0 = {args.t0!r} s, got {t_end!r} s")
     output_dt = _checks.positive("output_dt", OUTPUT_DT if output_dt is None else output_dt, " s")
-    system = SemiDiscrete(model, args.scheme)  # the one system of this run (no compiling): all below reads it
-    if recorded:
-        _settings.check_grid(recorded, system, _where(sink))
+    system = kind.discretise(model, args.scheme)  # the one system of this run (no compiling): all below reads it
+    if resume:  # before anything is sized by it: the states kept fix the grid
+        getattr(sink, "check", lambda system: None)(system)
     args = fit(args, system)
     if plan is None:
         t_out = options.output_times(args.t0, t_end, output_dt, output_times, system.size)
@@ -166,16 +163,15 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
             raise ParameterError(f"`t_end` = {t_end!r} s: the run being resumed ends at {float(plan[-1])!r} s")
         _check_plan(plan, asked_plan, t_end, system.size, sink)
         t_out = plan
-    settings = _settings.record(system, backend=args.backend, rtol=args.rtol, atol=args.asked_atol,
-                                backend_options=args.backend_options,  # asked_atol None: the default
-                                initial=(recorded.get("initial") or "unknown") if resume and asked_initial is None
-                                else args.initial)
-    forced = _settings.check(recorded, settings, resume == "force", _where(sink)) if recorded else []
+    if not resume:  # after every check: with `overwrite`, making the sink clears the earlier run
+        sink = _sink(kind, out, resume, overwrite)
+    # Resuming, the sink refuses other settings than the run's (unless forced) before it touches anything.
+    getattr(sink, "record_settings", lambda system, force, **run: None)(
+        system, resume == "force", backend=args.backend, rtol=args.rtol, atol=args.asked_atol,
+        backend_options=args.backend_options,  # asked_atol None: the default
+        initial=(recorded.get("initial") or "unknown") if resume and asked_initial is None else args.initial)
     if resume:
         args = replace(args, initial=kept)
-    else:  # after every check: with `overwrite`, making the sink clears the earlier run
-        sink = _sink(out, resume, overwrite)
-    getattr(sink, "record_settings", lambda settings, forced: None)(settings, forced)
     progress = args.progress
     if progress is True:
         from ._progress import Progress
@@ -188,16 +184,14 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         if sink is None:
             raw = keep_before_failure(args.run, system, y0, t_out, **solver)
             success, message, stats, error = raw.success, raw.message, raw.stats, raw.error
-        else:  # in chunks into the sink, whose Result it is
+        else:  # in chunks into the sink, whose result it is
             success, message, stats, error = run_chunked(args.run, system, y0, t_out, sink, first, **solver)
-            stats.update(timings, backend=args.backend)
-            result = sink.end(success, message, stats)
+        stats.update(timings, backend=args.backend)
+        result = kind.result(system, raw.t, raw.y, success, message, stats) if sink is None else \
+            sink.end(success, message, stats)
     finally:
         if args.progress is True:
             progress.close()
-    if sink is None:
-        stats.update(timings, backend=args.backend)
-        result = from_states(system, raw.t, raw.y, success, message, stats)
     result.error = error
     if not success:
         warnings.warn(message, RuntimeWarning, stacklevel=2)
@@ -208,9 +202,9 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
 class RunArguments:
     """The checked arguments a run of :func:`simulate` shares with the stepping
     simulator (:class:`rodmol.control.Simulator`): :func:`check_run` checks what
-    needs no system, :func:`fit` sizes ``initial`` and ``atol`` by the system's layout."""
+    needs no system, :func:`fit` sizes ``initial`` and ``atol`` by the system's state."""
 
-    initial: object  # "equilibrium", "straight", a Result or a state vector (checked by fit)
+    initial: object  # "equilibrium", "straight", a result or a state vector (checked by fit)
     t0: float
     scheme: object
     rtol: float
@@ -220,20 +214,24 @@ class RunArguments:
     backend: str
     run: object
     backend_options: dict
+    kind: object  # the model's RunKind (rodmol.run_kinds)
     asked_atol: object = None  # after fit: the checked array the call gave, or None for the default
 
 
 def check_model(model):
-    """Refuse anything but a :class:`rodmol.Model` (a System is dispatched before)."""
+    """Refuse anything but a :class:`rodmol.Model` (what the stepping simulator takes)."""
     if not isinstance(model, Model):
-        raise ParameterError(f"`model` must be a rodmol.Model or rodmol.System, got {model!r}")
+        raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
 
 
-def check_run(*, initial, t0, scheme, backend, rtol, atol, progress, max_wall_time, backend_options):
-    """Check the arguments every run takes (see :func:`simulate`) that need no system, before
-    any work; an ``initial`` Result gives, unless ``t0`` is given, its last time. The
+def check_run(*, initial, t0, scheme, backend, rtol, atol, progress, max_wall_time, backend_options,
+              kind=KINDS[0]):
+    """Check the arguments that a run of a ``kind`` of model (default: one rod) takes (see
+    :func:`simulate`) and that need no system, before any work; ``initial`` None is the
+    kind's default, an ``initial`` result gives, unless ``t0`` is given, its last time. The
     state-sized ones (``initial``, ``atol``) are checked by :func:`fit` against the system."""
-    if isinstance(initial, Result):
+    initial = kind.default_initial if initial is None else initial
+    if isinstance(initial, RESULTS):
         t0 = float(initial.t[-1]) if t0 is None else t0
     elif isinstance(initial, str) and initial not in INITIAL:
         raise ParameterError(f"unknown `initial` {_checks.short(initial)}"
@@ -244,40 +242,41 @@ def check_run(*, initial, t0, scheme, backend, rtol, atol, progress, max_wall_ti
     rtol = options.rtol(scheme.default_rtol if rtol is None else rtol)
     progress = options.progress(progress)
     max_wall_time = options.max_wall_time(max_wall_time)
-    run = get_backend(backend)
+    run = get_backend(backend, kind.backends)
     backend_options = options.backend_options(backend, run, backend_options)
     return RunArguments(initial, t0, scheme, rtol, atol, progress, max_wall_time, backend, run,
-                        backend_options)
+                        backend_options, kind)
 
 
 def fit(args, system):
-    """``args`` with ``initial`` and ``atol`` checked against the state of ``system`` (its
-    layout): an ``initial`` Result gives its last state, ``atol=None`` the system's
-    :meth:`~rodmol.discretise.system.SemiDiscrete.atol_scale` times ``rtol``."""
-    layout, initial = system.layout, args.initial
-    if isinstance(initial, Result):
-        initial = _last_state(initial, system)
+    """``args`` with ``initial`` and ``atol`` checked against the state of ``system``: an
+    ``initial`` result gives its last state, ``atol=None`` the system's ``atol_scale()``
+    (:meth:`~rodmol.discretise.system.SemiDiscrete.atol_scale`) times ``rtol``."""
+    initial = args.initial
+    if isinstance(initial, RESULTS):
+        initial = _last_state(initial)
     if not isinstance(initial, str):
-        initial = _state_sized("initial", initial, layout)
-    atol = None if args.atol is None else _state_sized("atol", args.atol, layout, positive=True)
+        initial = _state_sized("initial", initial, system)
+    atol = None if args.atol is None else _state_sized("atol", args.atol, system, positive=True)
     return replace(args, initial=initial, asked_atol=atol,
                    atol=args.rtol * system.atol_scale() if atol is None else atol)
 
 
 def prepare_run(system, args, progress, sink=None):
-    """The compiled kernels of ``system`` made ready and the initial state, each stage
-    announced through ``progress``: returns (y0, timings [s])."""
-    timings = {}
+    """The compiled kernels of ``system`` made ready (where its kind prepares them before the
+    run: ``RunKind.prepare``) and the initial state, each stage announced through
+    ``progress``: returns (y0, timings [s])."""
+    timings, prepare = {}, args.kind.prepare
     with _stage(progress, "preparing the compiled kernels", timings, "prepare_s",
-                kernels.ready(args.run, args.backend_options)):
-        check_scales(system, args.t0, args.atol)  # before the kernels' first run, which would fail on them
-        kernels.prepare(system, args.t0, system.undeformed_state(), args.run, args.rtol, args.atol,
-                        args.backend_options)
+                prepare is None or kernels.ready(args.run, args.backend_options)):
+        if prepare is not None:
+            prepare(system, args.t0, system.undeformed_state(), args.run, args.rtol, args.atol,
+                    args.backend_options)
         getattr(sink, "prepare", lambda system: None)(system)
     initial = args.initial
     with _stage(progress, f"solving the initial equilibrium at t = {args.t0:g} s", timings, "equilibrium_s",
                 not (isinstance(initial, str) and initial == "equilibrium")):
-        y0 = _initial_state(system, initial, args.t0)
+        y0 = _initial_state(system, args.kind, initial, args.t0)
     return y0, timings
 
 
@@ -291,10 +290,11 @@ def _stage(progress, text, timings, key, silent=False):
     timings[key] = time.perf_counter() - start
 
 
-def _sink(out, resume, overwrite):
+def _sink(kind, out, resume, overwrite):
+    """The sink of ``out``: None, a sink as given, or the ``kind``'s directory sink."""
     if out is None:
-        if resume:
-            raise ParameterError("`resume=True` needs `out`, the directory of the run to resume")
+        if resume or overwrite:
+            raise ParameterError("`resume` and `overwrite=True` need `out`, the directory of the run")
         return None
     if resume and overwrite:
         raise ParameterError("give either `resume` or `overwrite=True`, not both")
@@ -302,7 +302,7 @@ def _sink(out, resume, overwrite):
         if resume and not hasattr(out, "resume_point"):
             raise ParameterError("`resume=True`: this sink cannot resume (no resume_point)")
         return out
-    return run_sinks.directory_sink(out, resume=bool(resume), overwrite=bool(overwrite))
+    return kind.directory_sink(out, resume=bool(resume), overwrite=bool(overwrite))
 
 
 def _where(sink):
@@ -330,34 +330,30 @@ def _check_plan(plan, asked, t_end, size, sink):
                              "continue on the run's)")
 
 
-def _last_state(result, system):
+def _last_state(result):
     states = getattr(result, "states", None)
     if states is None or len(states) == 0:
-        raise ParameterError("`initial`: this Result holds no states (written by an older rodmol?)")
-    n = system.layout.n_blocks
-    if result.meta.get("n_elements") not in (None, n):
-        raise ParameterError(f"`initial`: the Result has N = {result.meta['n_elements']} elements, "
-                             f"the model {n}")
+        raise ParameterError("`initial`: this result holds no states (written by an older rodmol?)")
     return states[-1]
 
 
-def _initial_state(system, initial, t0):
+def _initial_state(system, kind, initial, t0):
     if isinstance(initial, str):
         if initial == "equilibrium":
             return equilibrium(system, t0)
         if initial == "straight":  # the rest shape: straight unless the rod has rest strains
             return system.undeformed_state()
     y0 = np.array(initial, dtype=float)  # sized by fit, or the resumed run's own state
-    problem = state_problem(system.layout, system.model.ds, t0, y0)
+    problem = kind.state_problem(system, t0, y0)
     if problem:
-        raise ParameterError(f"`initial` is not a state of this rod: {problem}")
+        raise ParameterError(f"`initial` is not a state of this model: {problem}")
     return y0
 
 
-def _state_sized(name, value, layout, positive=False):
-    """A finite float array of the state's size (``layout``'s; a scalar is broadcast if
+def _state_sized(name, value, system, positive=False):
+    """A finite float array of the state's size (``system``'s; a scalar is broadcast if
     ``positive``); the error names the first bad entry, which numpy's summarised repr would hide."""
-    size = layout.size
+    size = system.size
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError, OverflowError):
@@ -373,5 +369,5 @@ def _state_sized(name, value, layout, positive=False):
         i = int(np.flatnonzero(bad)[0])
         need = "finite and > 0" if positive else "finite"
         raise ParameterError(f"`{name}` entries must be {need}, got {float(arr[i])!r} at entry {i} "
-                             f"({layout.entry_name(i)})")
+                             f"({system.entry_name(i)})")
     return arr.copy()

@@ -63,7 +63,7 @@ CHILD = textwrap.dedent("""
                            medium="water", gravity=(0.0, 0.0, -9.81))
     rodmol.simulate(system, 0.02, out=out + "_warm")  # compile or load the kernels, writing's too: not timed
     assembly = Assembly(system)
-    y0 = assembly.initial_state()
+    y0 = assembly.undeformed_state()
     t_out = 0.01 * np.arange(n_chunks * chunk + 1)
     writer = SystemRunWriter(out, chunk_frames=chunk, overwrite=True)
     writer.begin(assembly, t_out)

@@ -95,7 +95,7 @@ class Simulator:
         self.max_wall_time, self._scheme = args.max_wall_time, args.scheme
         self._system = SemiDiscrete(live, args.scheme)
         args = fit(args, self._system)
-        self._sink = _sink(out, False, overwrite)  # after every check: `overwrite` clears the earlier run
+        self._sink = _sink(args.kind, out, False, overwrite)  # after every check: `overwrite` clears the earlier run
         announce = args.progress
         if announce is True:
             from .._progress import Progress

@@ -146,9 +146,13 @@ class Assembly:
 
         return type(base)(lambda t: velocities(t)[:3], lambda t: velocities(t)[3:], base.position, base.rotation)
 
+    #: The rods' inputs are evaluated when their Results are built: a run checks no frame again
+    #: against them (:func:`rodmol.solve.outputs.keep_before_failure`), and a failing one stops it there.
+    inputs_vary = False
+
     # ------------------------------------------------------------------ state
 
-    def initial_state(self):
+    def undeformed_state(self):
         """Every rod at rest in its rest shape at its base, every body at rest at its initial pose."""
         y = np.zeros(self.size)
         for name, sd in self.rods.items():
@@ -157,6 +161,16 @@ class Assembly:
             y[part.fields["x"]] = part.body.position
             y[part.fields["Q"]] = from_matrix(part.body.rotation)
         return y
+
+    def entry_name(self, index):
+        """A readable name of state entry ``index`` (``"rod 'arm' (k[2] of element 7)"``, ``"body 'head' (w)"``)."""
+        for name, part in self.parts.items():
+            if part.start <= index < part.stop:
+                if name in self.rods:
+                    return f"rod {name!r} ({self.rods[name].layout.entry_name(index - part.start)})"
+                field = next(f for f, entries in self.bodies[name].fields.items() if entries.start <= index < entries.stop)
+                return f"body {name!r} ({field})"
+        raise IndexError(f"state entry {index} of a system of {self.size}")
 
     def body_state(self, part, t, y):
         """A body's (x, Q, v, w) at (t, y) (``rigid.FREE_BODY.size``,): its pose and velocities

@@ -287,6 +287,10 @@ class SemiDiscrete:
             self._compiled = True
         return self._args
 
+    def entry_name(self, index):
+        """A readable name of state entry ``index`` (the layout's)."""
+        return self.layout.entry_name(index)
+
     def undeformed_state(self):
         """The unloaded rod at rest in its rest shape, on this system's cells (:func:`undeformed_state`)."""
         return self._undeformed.copy()

@@ -2,10 +2,8 @@
 
 :class:`RunWriter` receives the states at the output times in chunks while
 the run goes (``simulate(..., out=DIR)``; the sink protocol is
-``begin(system, t_out)``, ``frames(t, y)``, ``end(success, message, stats)``
-returning the :class:`rodmol.Result`, ``chunk_frames`` and, optionally,
-``prepare(system)``; see :mod:`rodmol.solve.chunked`), derives the
-Result's arrays for each chunk, and writes
+:mod:`rodmol.solve.chunked`'s), derives the Result's arrays for each chunk,
+and writes
 
 * the chunk's HDF5 file and the index ``result.h5`` (:mod:`rodmol.output.h5result`),
 * the ParaView views ``rod.xdmf``, ``cables.xdmf``, ``markers.xdmf``
@@ -28,7 +26,7 @@ from functools import partial
 
 import numpy as np
 
-from .. import run_sinks
+from .. import _settings, run_sinks
 from .._files import output_directory
 from ..errors import ParameterError
 from ..result import STATIC
@@ -111,7 +109,7 @@ class RunWriter:
             self.t_out = np.asarray(t_out, dtype=float)
         if self.static is None:
             self.static, self.meta = static_arrays(system), dict(run_meta(system), **self.extra_meta)
-        self._plan_views(0 if self.t_out is None else len(self.t_out))
+        self.every = view_step(0 if self.t_out is None else len(self.t_out), self.every)
         first = self.t[-1] if self.t else None if self.t_out is None else self.t_out[0]
         self.record.t_start = None if first is None else float(first)
         if self._dropped:  # list the chunks kept before a chunk of the same name replaces a dropped one
@@ -131,10 +129,13 @@ class RunWriter:
         calls it before :meth:`frames`): the index records the work of each chunk kept."""
         self.record.account(stats)
 
-    def record_settings(self, settings, forced=()):
-        """Record the run's settings (:mod:`rodmol._settings`, from ``simulate``) in the index;
-        ``forced``: what a forced resume changed."""
-        self.record.settings, self.record.forced = dict(settings), list(forced)
+    def record_settings(self, system, force=False, **run):
+        """Record the settings of this run of ``system`` in the index (:func:`rodmol._settings.record`;
+        ``run``: its backend, rtol, atol, backend options and initial state); resuming, refuse other
+        settings than the run's, naming each, unless ``force`` (then recorded as what it changed)."""
+        settings, recorded = _settings.record(system, **run), self.record.settings
+        forced = _settings.check(recorded, settings, force, repr(str(self.directory))) if recorded else []
+        self.record.settings, self.record.forced = settings, forced
 
     @property
     def settings(self):
@@ -262,7 +263,7 @@ class RunWriter:
     def write_result(self, result):
         """Write a finished in-memory :class:`rodmol.Result`, chunk by chunk; returns the path of ``rod.xdmf``."""
         self.t_out = np.asarray(result.t, dtype=float)
-        self._plan_views(len(self.t_out))
+        self.every = view_step(len(self.t_out), self.every)
         self.record.t_start = float(result.t[0]) if len(result.t) else 0.0
         with self._timed():
             for k0 in range(0, len(result.t), self.chunk_frames):
@@ -277,6 +278,11 @@ class RunWriter:
         """(planned output times, index of the restart frame, its state) of the run being resumed:
         the last frame of its last complete chunk (see :meth:`_reopen`)."""
         return self.t_out, self.restart[0], self.restart[2]
+
+    def check(self, system):
+        """Resuming: refuse ``system`` (a ``SemiDiscrete``) on another grid than the run's, before
+        anything is sized by it (:func:`rodmol._settings.check_grid`)."""
+        _settings.check_grid(self.settings or {}, system, repr(str(self.directory)))
 
     # ----------------------------------------------------------------- internals
 
@@ -344,9 +350,6 @@ class RunWriter:
         if self.meta.get("markers"):
             names.append("markers")
         return names
-
-    def _plan_views(self, n_frames):
-        self.every = view_step(n_frames, self.every)
 
     def _shown(self, start, n):
         """Chunk frames shown in the views: global index a multiple of ``every``, and the chunk's

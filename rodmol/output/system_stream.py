@@ -25,7 +25,7 @@ run, and the writer keeps no frames of the chunks before (only their times).
 
 import numpy as np
 
-from .. import run_sinks
+from .. import _settings, run_sinks
 from .._files import output_directory
 from ..errors import ParameterError
 from ..system_result import SystemResult
@@ -139,6 +139,10 @@ class SystemRunWriter:
         return SystemResult(self.assembly, np.array(self.t), read_series(self.directory, dict(chunks=self.chunks),
                                                                          "states"), success, message, dict(stats))
 
+    def resume_point(self):
+        """(planned output times, index of the restart frame, its state) of the run being resumed."""
+        return self.t_out, self.restart[0], self.restart[1]
+
     def check(self, assembly):
         """Resuming: refuse an assembly that is not the one of the run in the directory (other
         rods, or another layout of the state: another grid, a body free or not)."""
@@ -149,10 +153,13 @@ class SystemRunWriter:
                                  f"the rods {list(keys)} with {_layout(assembly)} ({size} states): the states kept "
                                  "are the run's, so its rods' grids and bodies cannot change (start a new run)")
 
-    def record_settings(self, settings, forced=()):
-        """The run's settings (JSON values, :func:`rodmol._settings.record_system`), recorded in the
-        index for a resumed run; ``forced``: what a forced resume changed."""
-        self.settings = dict(settings)
+    def record_settings(self, assembly, force=False, **run):
+        """Record the settings of this run of ``assembly`` in the index (:func:`rodmol._settings.record_system`;
+        ``run``: its backend, rtol, atol, backend options and initial state); resuming, refuse other
+        settings than the run's, naming each (a changed part of the system too), unless ``force``."""
+        settings, recorded = _settings.record_system(assembly, **run), self.settings
+        forced = _settings.check(recorded, settings, force, repr(str(self.directory))) if recorded else []
+        self.settings = settings
         if forced:
             start = float(self.t_out[self.restart[0]]) if self.restart is not None else 0.0
             self.forced = [*self.forced, dict(t_start=start, changed=list(forced))]

@@ -9,7 +9,7 @@ one chunk's states. Any sink with ``chunk_frames``, ``begin(system, t_out)``,
 if it has one, is called before ``end``: where a sink that writes behind the
 run reports a failed write; ``account(stats)``, if it has one, gets the
 solver's statistics of each chunk before its ``frames``; ``prepare(system)``
-and ``record_settings(settings, forced)``, if it has them, are called by
+and ``record_settings(system, force, **run)``, if it has them, are called by
 :func:`rodmol.simulate` before the run)
 (:class:`rodmol.output.stream.RunWriter` is the one rodmol ships).
 """

@@ -110,7 +110,7 @@ def system_rest_state(system, t=0.0, *, scheme=None, tol=1e-10, max_iter=40):
                              f"{system.scheme.name!r} scheme (leave `scheme` out, or pass the System)")
     if system.free or system.rod_joints:  # coupled
         return free_rest_state(system, t, tol, max_iter)
-    y = system.initial_state()
+    y = system.undeformed_state()
     for name, rod in system.rods.items():
         try:
             y[system.parts[name]] = equilibrium(rod, t, tol=tol, max_iter=max_iter)

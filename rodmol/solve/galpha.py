@@ -66,10 +66,12 @@ def coefficients(rho_inf):
 
 
 def auto_dt(system):
-    """The step of ``dt="auto"`` [s]: the first bending period over STEPS_PER_PERIOD."""
+    """The step of ``dt="auto"`` [s]: the first bending period over STEPS_PER_PERIOD; of a
+    system of rods (its ``rods``, :class:`rodmol.solve.system_stepping.SteppedSystem`), the shortest rod's."""
     from ..discretise.system import first_bending_frequency
 
-    return 2.0 * np.pi / first_bending_frequency(system.model) / STEPS_PER_PERIOD
+    rods = getattr(system, "rods", {"": system}).values()
+    return min(2.0 * np.pi / first_bending_frequency(sd.model) / STEPS_PER_PERIOD for sd in rods)
 
 
 def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None,

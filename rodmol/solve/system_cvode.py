@@ -26,8 +26,8 @@ import numpy as np
 
 from ..discretise.system_preconditioner import SystemPreconditioner
 from ..errors import ParameterError
-from .outputs import cause
-from .watch import state_problem
+from .outputs import RawSolution, cause
+from .watch import assembly_state_problem
 
 #: Linear solvers of a system run.
 SYSTEM_LINEAR_SOLVERS = ("sparse", "gmres", "dense")
@@ -63,10 +63,10 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
     ``max_order`` caps the BDF order; ``"auto"`` is 2 when a rod is lightly
     damped (``SemiDiscrete.lightly_damped``), else 5, as for one rod.
 
-    Returns (t (n,), states (n, size), success, message, stats, error): the
-    output frames reached; on failure (CVODE's, a user function's exception,
-    Ctrl-C) ``message`` says after which output time and why, and ``error``
-    holds the exception that stopped it, if any.
+    Returns a :class:`~rodmol.solve.outputs.RawSolution`: the output frames
+    reached; on failure (CVODE's, a user function's exception, Ctrl-C)
+    ``message`` says after which output time and why, and ``error`` holds
+    the exception that stopped it, if any.
     """
     from sksundae.cvode import CVODE, CVODEPrecond
 
@@ -144,7 +144,7 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
         if not r.success:
             message = f"CVODE stopped after t = {reached:.6g} s: {r.message}"
             break
-        broken = _broken(assembly, float(t_k), r.y)
+        broken = assembly_state_problem(assembly, float(t_k), r.y)
         if broken:  # as a single rod's run: the frames before, and where and why
             message = f"CVODE stopped after t = {reached:.6g} s: {broken}"
             break
@@ -164,35 +164,14 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
                  wall_time_s=time.perf_counter() - start)
     if precond is not None:
         stats.update(jac_evals=precond.jac_evals, prec_setups=precond.setups, prec_solves=precond.solves)
-    return t, y, success, message, stats, error
+    return RawSolution(t, y, success, message, stats, error)
 
 
 def _nonfinite(assembly, t, rates):
     """Where the ``rates`` at ``t`` [s] are non-finite: each part (a rod or a body) and its first such entry."""
-    where = []
-    for name, part in assembly.parts.items():
-        bad = np.flatnonzero(~np.isfinite(rates[part]))
-        if not len(bad):
-            continue
-        if name in assembly.rods:
-            where.append(f"rod {name!r} ({assembly.rods[name].layout.entry_name(int(bad[0]))})")
-        else:
-            fields = assembly.bodies[name].fields
-            field = next(f for f, entries in fields.items() if entries.start <= part.start + bad[0] < entries.stop)
-            where.append(f"body {name!r} ({field})")
+    where = [assembly.entry_name(part.start + int(bad[0])) for part in assembly.parts.values()
+             for bad in [np.flatnonzero(~np.isfinite(rates[part]))] if len(bad)]
     return (f"the rates of {', '.join(where)} were non-finite at t = {t:.6g} s (from a finite state; "
             f"{NONFINITE_RATES} non-finite right-hand sides among the {WATCHED_AFTER + NONFINITE_RATES} or more "
             "since the last output frame): no step can be taken "
             "(the model gives no finite motion there: a load, an input or a body's property out of range?)")
-
-
-def _broken(assembly, t, y):
-    """What is wrong with the system's state ``y`` at ``t`` [s] (a rod's part checked as a
-    single rod's state, :func:`rodmol.solve.watch.state_problem`), or None."""
-    for name, sd in assembly.rods.items():
-        problem = state_problem(sd.layout, sd.model.ds, t, y[assembly.parts[name]])
-        if problem:
-            return f"rod {name!r}: {problem}"
-    if not np.all(np.isfinite(y)):
-        return f"the state of a body became non-finite at t = {t:.6g} s: the solution blew up"
-    return None

@@ -114,7 +114,7 @@ class FreeRestEquations:
     def __init__(self, assembly, t):
         self.assembly, self.t = assembly, t
         self.rods = {name: RestEquations(sd, t) for name, sd in assembly.rods.items()}
-        self.y = assembly.initial_state()  # fixed and driven bodies keep their initial poses
+        self.y = assembly.undeformed_state()  # fixed and driven bodies keep their initial poses
         self._gravity = np.asarray(assembly.system.gravity, dtype=float)
         gravity = np.linalg.norm(self._gravity)
         self.scale = (sum(eq.scale for eq in self.rods.values())

@@ -10,29 +10,36 @@ sparse LU on the assembly's Jacobian pattern
 (:class:`rodmol.discretise.system_jacobian.SystemJacobian`): the rods' block
 elimination leaves the coupling out, so it is refused here
 (:meth:`SteppedSystem.preconditioner`); and ``dt="auto"`` is the
-shortest of the rods' (:func:`auto_dt`).
+shortest of the rods' (:func:`rodmol.solve.galpha.auto_dt` of its ``rods``).
 """
+
+import functools
 
 import numpy as np
 
 from ..discretise.system_jacobian import SystemJacobian
-from . import galpha
 from .watch import Watch
 
 
-def auto_dt(assembly):
-    """generalized-alpha's ``dt="auto"`` for a system [s]: the shortest of its rods'."""
-    return min(galpha.auto_dt(sd) for sd in assembly.rods.values())
+def on_assembly(run):
+    """The single rod's backend ``run`` (its options and results) on an assembly, seen through
+    :class:`SteppedSystem`."""
+
+    @functools.wraps(run)
+    def stepped(assembly, y0, t_out, **options):
+        return run(SteppedSystem(assembly), y0, t_out, **options)
+
+    return stepped
 
 
 class SteppedSystem:
     """``assembly`` for the fixed-step and explicit backends: ``size``,
     ``__call__``, ``layout`` (the assembly: it projects the quaternions of
-    every rod and body), ``jacobian``, ``preconditioner`` and ``watch``."""
+    every rod and body), ``rods``, ``jacobian``, ``preconditioner`` and ``watch``."""
 
     def __init__(self, assembly):
         self.assembly = self.layout = assembly
-        self.size = assembly.size
+        self.size, self.rods = assembly.size, assembly.rods
         self.lightly_damped = assembly.lightly_damped
 
     def __call__(self, t, y, out=None):

@@ -22,7 +22,7 @@ Every accepted step (not only the output times) goes through
   stopped (Ctrl-C) between output times too.
 
 The same scan checks the static equilibrium and a user's initial state
-(:func:`state_problem`).
+(:func:`state_problem`; a system's, each rod's part: :func:`assembly_state_problem`).
 """
 
 import math
@@ -91,6 +91,23 @@ def state_problem(layout, ds, t, y):
     code, i, value = scan(y, layout.n_elements, ds, MIN_STRETCH, MAX_STRETCH, MAX_TURN,
                           MAX_QUATERNION_DRIFT)
     return _describe(layout, ds, t, code, i, value)
+
+
+def rod_state_problem(system, t, y):
+    """:func:`state_problem` of a rod's system (a ``SemiDiscrete``)."""
+    return state_problem(system.layout, system.model.ds, t, y)
+
+
+def assembly_state_problem(assembly, t, y):
+    """What is wrong with the state ``y`` at ``t`` [s] of a system of rods and bodies (an
+    ``Assembly``: each rod's part as a single rod's state, the bodies' for finiteness), or None."""
+    for name, sd in assembly.rods.items():
+        problem = rod_state_problem(sd, t, y[assembly.parts[name]])
+        if problem:
+            return f"rod {name!r}: {problem}"
+    if not np.all(np.isfinite(y)):
+        return f"the state of a body became non-finite at t = {t:.6g} s: the solution blew up"
+    return None
 
 
 def _describe(layout, ds, t, code, i, value):

@@ -13,7 +13,7 @@ class NewtonCheck:
     def __init__(self, assembly, seed=5):
         self.assembly, self.scale = assembly, assembly.atol_scale()
         perturbation = np.random.default_rng(seed).standard_normal(assembly.size)
-        self.y = assembly.initial_state() + 1e-2 * perturbation * self.scale
+        self.y = assembly.undeformed_state() + 1e-2 * perturbation * self.scale
         self.fy = assembly(0.0, self.y).copy()
         self.jac = central_columns(lambda z: assembly(0.0, z).copy(), self.y, range(assembly.size),
                                    1e-7 * self.scale)

@@ -46,7 +46,7 @@ def test_parts_tile_the_state_in_order():
 def test_pattern_holds_every_nonzero_of_a_difference_jacobian():
     assembly = Assembly(_system())
     rng = np.random.default_rng(3)
-    y = assembly.initial_state()
+    y = assembly.undeformed_state()
     y += 1e-2 * rng.standard_normal(assembly.size) * assembly.atol_scale()
     f0 = assembly(0.0, y)
     pattern = assembly.pattern().toarray()

@@ -82,7 +82,7 @@ def test_box_sliding_with_friction_decelerates_at_mu_g_and_stops():
     mu, v0 = 0.5, 0.4
     box = _box((_floor(friction=mu),), position=(0.0, 0.0, R - M * G / (4 * K) - H / 2))
     system = _system(box)
-    y0 = Assembly(system).initial_state()
+    y0 = Assembly(system).undeformed_state()
     part = Assembly(system).bodies["body"]
     y0[part.fields["v"]] = (v0, 0.0, 0.0)
     stop = v0 / (mu * G)
@@ -112,7 +112,7 @@ def test_spinning_ball_set_down_rolls_off_at_two_sevenths_of_its_spin():
                             position=(0.0, 0.0, R - M * G / K - H / 2))
     system = _system(ball)
     part = Assembly(system).bodies["body"]
-    y0 = Assembly(system).initial_state()
+    y0 = Assembly(system).undeformed_state()
     y0[part.fields["w"]] = (0.0, w0, 0.0)
     rolling = 2.0 / 7.0 * R * w0
     run = rodmol.simulate(system, 0.2, initial=y0, output_times=np.linspace(0.0, 0.2, 41), rtol=1e-7)

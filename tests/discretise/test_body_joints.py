@@ -135,7 +135,7 @@ def _joined_bodies():
 def test_the_pattern_holds_every_nonzero_the_body_joints_make():
     assembly = _joined_bodies()
     scale = assembly.atol_scale()
-    y = assembly.initial_state() + 1e-2 * np.random.default_rng(3).standard_normal(assembly.size) * scale
+    y = assembly.undeformed_state() + 1e-2 * np.random.default_rng(3).standard_normal(assembly.size) * scale
     f0 = assembly(0.0, y).copy()
     pattern = assembly.pattern().toarray()
     touched = np.zeros_like(pattern)

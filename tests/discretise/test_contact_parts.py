@@ -149,7 +149,7 @@ def test_a_rod_on_a_body_carried_along_with_it_slides_as_at_rest():
         system = rodmol.System({"arm": arm}, {"ball": ball}, contacts=[rodmol.Contact("ball", "arm", shape)],
                                gravity=(0.0, -G, 0.0))
         assembly = Assembly(system)
-        y0, sd = assembly.initial_state(), assembly.rods["arm"]
+        y0, sd = assembly.undeformed_state(), assembly.rods["arm"]
         rod = y0[assembly.parts["arm"]]
         sd.layout.field(rod, "v")[:] = v  # moving with its base from the start (local = global: straight along x)
         y0[assembly.parts["arm"]] = rod
@@ -217,7 +217,7 @@ def test_a_contact_moves_its_rows_in_one_call_as_each_node_alone():
     system = _ball_on_beam()
     assembly = Assembly(system)
     part = assembly.bodies["ball"]
-    y = assembly.initial_state()
+    y = assembly.undeformed_state()
     y[part.fields["x"]] += (0.0, -0.003, 0.001)  # into the beam, moving and turning
     y[part.fields["v"]], y[part.fields["w"]] = (0.02, -0.01, 0.005), (0.3, -0.2, 0.5)
     body = assembly.body_state(part, 0.0, y)

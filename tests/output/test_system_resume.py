@@ -97,7 +97,7 @@ def test_resume_refuses_what_it_cannot_continue(two_arms, tmp_path, killed_syste
     killed_system(partial(run, two_arms()), tmp_path, 1, chunk_frames=CHUNK)
     with pytest.raises(ParameterError, match="ends at 0.1 s"):
         rodmol.simulate(two_arms(), 0.2, out=tmp_path, resume=True)
-    with pytest.raises(ParameterError, match="not the run's"):
+    with pytest.raises(ParameterError, match="initial state: the run 'straight', this call 'equilibrium'"):
         rodmol.simulate(two_arms(), T_END, out=tmp_path, resume=True, initial="equilibrium")
     with pytest.raises(ParameterError, match="output times"):
         rodmol.simulate(two_arms(), T_END, out=tmp_path, resume=True, output_dt=0.02)

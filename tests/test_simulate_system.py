@@ -1,4 +1,4 @@
-"""Runs of systems of rods and rigid bodies (rodmol.system_run) against single-rod
+"""Runs of systems of rods and rigid bodies (rodmol.simulate, what differs in rodmol.run_kinds) against single-rod
 runs, analytic motions and the conservation of momentum."""
 
 import numpy as np
