@@ -46,8 +46,14 @@ def _solver(scheme, backend, rtol, atol, backend_options, initial):
     return dict(scheme=str(scheme.name), backend=str(backend), rtol=float(rtol),
                 atol=None if atol is None else np.asarray(atol, dtype=float).tolist(),
                 backend_options=json.loads(json.dumps(dict(backend_options), default=repr)),
-                initial=initial if isinstance(initial, str) else
-                f"a state vector (fingerprint {fingerprint(np.asarray(initial, dtype=float))[:16]})")
+                initial=described_initial(initial))
+
+
+def described_initial(initial):
+    """How the settings record an initial state: its name, or a state vector's fingerprint."""
+    if isinstance(initial, str):
+        return initial
+    return f"a state vector (fingerprint {fingerprint(np.asarray(initial, dtype=float))[:16]})"
 
 
 def resumed(recorded, scheme, backend, rtol, atol, backend_options):
@@ -88,6 +94,17 @@ def check_grid(recorded, system, where):
         raise ParameterError(f"cannot resume the run in {where}: {NAMES['n_elements']}: the run {run!r}, this "
                              f"call {n_elements!r} (the states kept are on the run's grid: resume with its "
                              "number of elements, or start a new run)")
+
+
+def settle(recorded, settings, force, where):
+    """(settings to record, what a forced resume changed) of a call with ``settings`` that resumes
+    the run in ``where`` (``recorded``: its settings; None or empty: a new run): :func:`check`'s
+    refusal unless ``force``; the initial state recorded stays the run's (a resumed run goes on
+    from its restart point, whatever the call asked)."""
+    if not recorded:
+        return settings, []
+    forced = check(recorded, settings, force, where)
+    return dict(settings, initial=recorded.get("initial", settings["initial"])), forced
 
 
 def check(recorded, current, force, where):

@@ -24,8 +24,10 @@ INITIAL = ("equilibrium", "straight")
 RESUME = (False, True, "force")
 #: Defaults of the settings ``simulate`` leaves as None (a resumed run takes the run's).
 OUTPUT_DT, DEFAULT_BACKEND = 0.01, "cvode"
-#: What an ``initial`` result may be: a run's of any kind.
+#: What an ``initial`` result may be: a run's of any kind (each kind takes its own).
 RESULTS = tuple(kind.results for kind in KINDS)
+#: What a sink needs to resume a run (:mod:`rodmol.solve.chunked`).
+RESUMING = ("resume_point", "check", "record_settings")
 
 
 def default_atol(model, rtol):
@@ -154,8 +156,12 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
     output_dt = _checks.positive("output_dt", OUTPUT_DT if output_dt is None else output_dt, " s")
     system = kind.discretise(model, args.scheme)  # the one system of this run (no compiling): all below reads it
     if resume:  # before anything is sized by it: the states kept fix the grid
-        getattr(sink, "check", lambda system: None)(system)
+        sink.check(system)
     args = fit(args, system)
+    if resume:
+        if np.shape(kept) != (system.size,):
+            raise ParameterError(f"cannot resume the run in {_where(sink)}: its state has {np.size(kept)} entries, "
+                                 f"this model's {system.size}")
     if plan is None:
         t_out = options.output_times(args.t0, t_end, output_dt, output_times, system.size)
     else:  # the run's own output times, from where it stopped
@@ -165,7 +171,8 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         t_out = plan
     if not resume:  # after every check: with `overwrite`, making the sink clears the earlier run
         sink = _sink(kind, out, resume, overwrite)
-    # Resuming, the sink refuses other settings than the run's (unless forced) before it touches anything.
+    # Resuming, the sink refuses other settings than the run's (unless forced) before it touches anything;
+    # the initial state it records stays the run's.
     getattr(sink, "record_settings", lambda system, force, **run: None)(
         system, resume == "force", backend=args.backend, rtol=args.rtol, atol=args.asked_atol,
         backend_options=args.backend_options,  # asked_atol None: the default
@@ -254,9 +261,12 @@ def fit(args, system):
     (:meth:`~rodmol.discretise.system.SemiDiscrete.atol_scale`) times ``rtol``."""
     initial = args.initial
     if isinstance(initial, RESULTS):
-        initial = _last_state(initial)
+        initial = _last_state(initial, args.kind, system)
     if not isinstance(initial, str):
         initial = _state_sized("initial", initial, system)
+        problem = args.kind.state_problem(system, args.t0, initial)
+        if problem:  # before any sink is made (with `overwrite`, making it clears the earlier run)
+            raise ParameterError(f"`initial` is not a state of this model: {problem}")
     atol = None if args.atol is None else _state_sized("atol", args.atol, system, positive=True)
     return replace(args, initial=initial, asked_atol=atol,
                    atol=args.rtol * system.atol_scale() if atol is None else atol)
@@ -276,7 +286,7 @@ def prepare_run(system, args, progress, sink=None):
     initial = args.initial
     with _stage(progress, f"solving the initial equilibrium at t = {args.t0:g} s", timings, "equilibrium_s",
                 not (isinstance(initial, str) and initial == "equilibrium")):
-        y0 = _initial_state(system, args.kind, initial, args.t0)
+        y0 = _initial_state(system, initial, args.t0)
     return y0, timings
 
 
@@ -294,13 +304,16 @@ def _sink(kind, out, resume, overwrite):
     """The sink of ``out``: None, a sink as given, or the ``kind``'s directory sink."""
     if out is None:
         if resume or overwrite:
-            raise ParameterError("`resume` and `overwrite=True` need `out`, the directory of the run")
+            raise ParameterError(f"`{'resume' if resume else 'overwrite=True'}` needs `out`, the directory of the run")
         return None
     if resume and overwrite:
         raise ParameterError("give either `resume` or `overwrite=True`, not both")
     if all(hasattr(out, name) for name in ("begin", "frames", "end", "chunk_frames")):
-        if resume and not hasattr(out, "resume_point"):
-            raise ParameterError("`resume=True`: this sink cannot resume (no resume_point)")
+        missing = [name for name in RESUMING if not hasattr(out, name)]
+        if resume and missing:
+            raise ParameterError(f"`resume=True`: this sink cannot resume (it has no {', '.join(missing)})")
+        if resume and getattr(out, "restart", True) is None:
+            raise ParameterError("`resume=True`: this sink holds no run to resume (make it with resume=True)")
         return out
     return kind.directory_sink(out, resume=bool(resume), overwrite=bool(overwrite))
 
@@ -330,24 +343,27 @@ def _check_plan(plan, asked, t_end, size, sink):
                              "continue on the run's)")
 
 
-def _last_state(result):
+def _last_state(result, kind, system):
+    if not isinstance(result, kind.results):
+        raise ParameterError(f"`initial`: a {type(result).__name__} cannot start a run of a "
+                             f"{kind.model.__name__} (a {kind.results.__name__} can)")
     states = getattr(result, "states", None)
     if states is None or len(states) == 0:
         raise ParameterError("`initial`: this result holds no states (written by an older rodmol?)")
+    if len(states[-1]) != system.size:
+        n = getattr(result, "meta", {}).get("n_elements")
+        raise ParameterError(f"`initial`: the result's states have {len(states[-1])} entries"
+                             f"{'' if n is None else f' (N = {n} elements)'}, this model's {system.size}")
     return states[-1]
 
 
-def _initial_state(system, kind, initial, t0):
+def _initial_state(system, initial, t0):
     if isinstance(initial, str):
         if initial == "equilibrium":
             return equilibrium(system, t0)
         if initial == "straight":  # the rest shape: straight unless the rod has rest strains
             return system.undeformed_state()
-    y0 = np.array(initial, dtype=float)  # sized by fit, or the resumed run's own state
-    problem = kind.state_problem(system, t0, y0)
-    if problem:
-        raise ParameterError(f"`initial` is not a state of this model: {problem}")
-    return y0
+    return np.array(initial, dtype=float)  # checked by fit, or the resumed run's own state
 
 
 def _state_sized(name, value, system, positive=False):

@@ -81,3 +81,41 @@ def test_a_state_sized_argument_is_refused_before_compiling_and_a_system_compile
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, check=False)
     assert out.returncode == 0, out.stderr
     assert out.stdout.split() == ["refused", "1", "1", "0"]
+
+
+def _arm(n):
+    return rodmol.paper_arm(n, markers=())
+
+
+def test_an_initial_result_of_another_grid_or_kind_is_refused_naming_it():
+    earlier = rodmol.simulate(_arm(4), 0.02, initial="straight")
+    with pytest.raises(rodmol.ParameterError, match=r"83 entries \(N = 4 elements\), this model's 121"):
+        rodmol.simulate(_arm(6), 0.04, initial=earlier)
+    with pytest.raises(rodmol.ParameterError, match="a Result cannot start a run of a System"):
+        rodmol.simulate(rodmol.System({"arm": _arm(4)}), 0.04, initial=earlier)
+    with pytest.raises(rodmol.ParameterError, match="`overwrite=True` needs `out`"):
+        rodmol.simulate(_arm(4), 0.02, overwrite=True)
+
+
+def test_a_refused_initial_state_leaves_the_run_overwrite_would_replace(tmp_path):
+    first = rodmol.simulate(_arm(4), 0.02, out=tmp_path, initial="straight")
+    collapsed = np.zeros_like(first.states[-1])
+    with pytest.raises(rodmol.ParameterError, match="not a state of this model: element 0 inverted"):
+        rodmol.simulate(_arm(4), 0.02, out=tmp_path, overwrite=True, initial=collapsed)
+    np.testing.assert_array_equal(rodmol.load_result(tmp_path).states, first.states)
+
+
+def test_a_sink_that_cannot_resume_is_refused_before_any_work(tmp_path):
+    from rodmol.output.stream import RunWriter
+
+    with pytest.raises(rodmol.ParameterError, match="holds no run to resume"):
+        rodmol.simulate(_arm(4), 0.02, out=RunWriter(tmp_path), resume=True)
+
+    class Forgetful:  # streams, but keeps no settings to check a resumed call against
+        chunk_frames = 10
+
+        def __init__(self):
+            self.begin = self.frames = self.end = self.resume_point = lambda *args: None
+
+    with pytest.raises(rodmol.ParameterError, match="cannot resume \\(it has no check, record_settings\\)"):
+        rodmol.simulate(_arm(4), 0.02, out=Forgetful(), resume=True)

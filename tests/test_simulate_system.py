@@ -193,8 +193,8 @@ def test_progress_sees_every_output_and_the_wall_time_budget_stops_the_run():
 
 
 @pytest.mark.parametrize("kwargs, match", [
-    (dict(resume=True), "need `out`"),
-    (dict(resume="force"), "need `out`"),
+    (dict(resume=True), "needs `out`"),
+    (dict(resume="force"), "needs `out`"),
     (dict(backend="rk45"), "unknown `backend` 'rk45'"),
     (dict(linsolver="band"), "linsolver"),
     (dict(krylov_dim=3), "unknown option"),

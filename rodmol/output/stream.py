@@ -134,7 +134,7 @@ class RunWriter:
         ``run``: its backend, rtol, atol, backend options and initial state); resuming, refuse other
         settings than the run's, naming each, unless ``force`` (then recorded as what it changed)."""
         settings, recorded = _settings.record(system, **run), self.record.settings
-        forced = _settings.check(recorded, settings, force, repr(str(self.directory))) if recorded else []
+        settings, forced = _settings.settle(recorded, settings, force, repr(str(self.directory)))
         self.record.settings, self.record.forced = settings, forced
 
     @property

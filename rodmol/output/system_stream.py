@@ -158,7 +158,7 @@ class SystemRunWriter:
         ``run``: its backend, rtol, atol, backend options and initial state); resuming, refuse other
         settings than the run's, naming each (a changed part of the system too), unless ``force``."""
         settings, recorded = _settings.record_system(assembly, **run), self.settings
-        forced = _settings.check(recorded, settings, force, repr(str(self.directory))) if recorded else []
+        settings, forced = _settings.settle(recorded, settings, force, repr(str(self.directory)))
         self.settings = settings
         if forced:
             start = float(self.t_out[self.restart[0]]) if self.restart is not None else 0.0

@@ -10,8 +10,12 @@ if it has one, is called before ``end``: where a sink that writes behind the
 run reports a failed write; ``account(stats)``, if it has one, gets the
 solver's statistics of each chunk before its ``frames``; ``prepare(system)``
 and ``record_settings(system, force, **run)``, if it has them, are called by
-:func:`rodmol.simulate` before the run)
-(:class:`rodmol.output.stream.RunWriter` is the one rodmol ships).
+:func:`rodmol.simulate` before the run, the second recording the run's
+settings and, resuming, refusing others unless ``force``). A sink that
+resumes a run also has ``resume_point()`` -> (planned output times, restart
+frame, its state) and ``check(system)``, which refuses another grid. rodmol
+ships :class:`rodmol.output.stream.RunWriter` (a rod's) and
+:class:`rodmol.output.system_stream.SystemRunWriter` (a System's).
 """
 
 import time

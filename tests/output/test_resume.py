@@ -271,6 +271,8 @@ def test_cli_resume_of_an_edited_scenario_is_refused_unless_forced(tmp_path, cap
     code, _, err = run_cli(capsys, "run", scenario, "--out", out, "--resume-anyway", "--quiet")
     assert code == 0, err
     assert rodmol.load_result(out).success
+    # It went on from its restart point: the initial state recorded stays the run's.
+    assert h5result.read_index(out / "result.h5")["info"]["settings"]["initial"] == "equilibrium"
 
 
 @pytest.mark.parametrize("damage", ["index", "chunk"])
