@@ -100,12 +100,14 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         (:class:`rodmol.output.stream.RunWriter`: ``result.h5`` and ParaView's
         ``rod.xdmf``, see ``docs/paraview.md``; a System's:
         :class:`rodmol.output.system_stream.SystemRunWriter`, ``system.h5``
-        and a folder per rod) or into a sink object with the same protocol; memory then stays bounded by one chunk, the solver
-        restarts at every chunk boundary, and the Result returned reads its
-        arrays from the files. ``result.h5`` records the run's settings
-        (``scheme``, ``backend``, ``rtol``, ``atol``, the backend options, the
-        grid, the initial state and a fingerprint of the model's parameters,
-        a System's of each of its parts, :mod:`rodmol._settings`). A directory holding an earlier run is
+        and a folder per rod) or into a sink object with the same protocol
+        (:mod:`rodmol.solve.chunked`); memory then stays bounded by one
+        chunk, the solver restarts at every chunk boundary, and the result
+        returned reads its arrays from the files. ``result.h5`` records the
+        run's settings (``scheme``, ``backend``, ``rtol``, ``atol``, the
+        backend options, the grid, the initial state and a fingerprint of
+        the model's parameters, a System's of each of its parts,
+        :mod:`rodmol._settings`). A directory holding an earlier run is
         refused unless ``overwrite`` or ``resume``.
     resume : bool or "force"
         With ``out``: continue the unfinished (killed, interrupted or failed)
@@ -158,10 +160,9 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
     if resume:  # before anything is sized by it: the states kept fix the grid
         sink.check(system)
     args = fit(args, system)
-    if resume:
-        if np.shape(kept) != (system.size,):
-            raise ParameterError(f"cannot resume the run in {_where(sink)}: its state has {np.size(kept)} entries, "
-                                 f"this model's {system.size}")
+    if resume and np.shape(kept) != (system.size,):
+        raise ParameterError(f"cannot resume the run in {_where(sink)}: its state has {np.size(kept)} entries, "
+                             f"this model's {system.size}")
     if plan is None:
         t_out = options.output_times(args.t0, t_end, output_dt, output_times, system.size)
     else:  # the run's own output times, from where it stopped

@@ -168,7 +168,8 @@ class Assembly:
             if part.start <= index < part.stop:
                 if name in self.rods:
                     return f"rod {name!r} ({self.rods[name].layout.entry_name(index - part.start)})"
-                field = next(f for f, entries in self.bodies[name].fields.items() if entries.start <= index < entries.stop)
+                fields = self.bodies[name].fields.items()
+                field = next(f for f, entries in fields if entries.start <= index < entries.stop)
                 return f"body {name!r} ({field})"
         raise IndexError(f"state entry {index} of a system of {self.size}")
 
