@@ -215,6 +215,18 @@ def timed_simulate(model, t_end, reps, **options):
     return result, float(np.median(walls))
 
 
+def drift_row(run, wall, gap, reference, reference_wall, against, **fields):
+    """A row of a joint's cost and drift (``gap`` over the frames, a fraction of a length): ``fields``,
+    the run's reach and right-hand sides, its solver wall time ``wall`` [s], each also as a ratio
+    to the ``reference`` run's (columns ``rhs_over_<against>``, ``solver_over_<against>``); printed."""
+    row = dict(fields, success=run.success, t_reached_s=float(run.t[-1]), max_drift_over_L=float(gap.max()),
+               end_drift_over_L=float(gap[-1]), rhs=run.stats["rhs_evals"])
+    row[f"rhs_over_{against}"] = run.stats["rhs_evals"] / reference.stats["rhs_evals"]
+    row.update(solver_s=wall, **{f"solver_over_{against}": wall / reference_wall})
+    print({k: (f"{v:.4g}" if isinstance(v, float) else v) for k, v in row.items()}, flush=True)
+    return row
+
+
 def warm_up(system, y0, **options):
     """Compile (or load) the kernels a configuration uses, outside the timings."""
     t_out = np.array([0.0, 1e-3, 2e-3])

@@ -177,13 +177,8 @@ def main(argv=None):
             system = build(n, factor)
             run, wall = C.timed_simulate(system, t_end, args.reps, linsolver=solver)
             gap = drift(run, system) / system.rods[next(iter(system.rods))].rod.length
-            rows.append(dict(
-                problem=name, N=n, factor=factor, default=factor == HOLD_STIFFNESS_FACTOR, linear_solver=solver,
-                success=run.success, t_reached_s=float(run.t[-1]), max_drift_over_L=float(gap.max()),
-                end_drift_over_L=float(gap[-1]), rhs=run.stats["rhs_evals"],
-                rhs_over_free=run.stats["rhs_evals"] / run_free.stats["rhs_evals"], solver_s=wall,
-                solver_over_free=wall / wall_free))
-            print({k: (f"{v:.4g}" if isinstance(v, float) else v) for k, v in rows[-1].items()}, flush=True)
+            rows.append(C.drift_row(run, wall, gap, run_free, wall_free, "free", problem=name, N=n, factor=factor,
+                                    default=factor == HOLD_STIFFNESS_FACTOR, linear_solver=solver))
 
     formats = dict(factor="g", t_reached_s=".3g", max_drift_over_L=".2e", end_drift_over_L=".2e",
                    rhs_over_free=".2f", solver_s=".3f", solver_over_free=".2f")
