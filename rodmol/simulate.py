@@ -313,8 +313,6 @@ def _sink(kind, out, resume, overwrite):
         missing = [name for name in RESUMING if not hasattr(out, name)]
         if resume and missing:
             raise ParameterError(f"`resume=True`: this sink cannot resume (it has no {', '.join(missing)})")
-        if resume and getattr(out, "restart", True) is None:
-            raise ParameterError("`resume=True`: this sink holds no run to resume (make it with resume=True)")
         return out
     return kind.directory_sink(out, resume=bool(resume), overwrite=bool(overwrite))
 

@@ -108,8 +108,13 @@ def test_a_refused_initial_state_leaves_the_run_overwrite_would_replace(tmp_path
 def test_a_sink_that_cannot_resume_is_refused_before_any_work(tmp_path):
     from rodmol.output.stream import RunWriter
 
+    from rodmol.output.system_stream import SystemRunWriter
+
     with pytest.raises(rodmol.ParameterError, match="holds no run to resume"):
-        rodmol.simulate(_arm(4), 0.02, out=RunWriter(tmp_path), resume=True)
+        rodmol.simulate(_arm(4), 0.02, out=RunWriter(tmp_path / "rod"), resume=True)
+    with pytest.raises(rodmol.ParameterError, match="holds no run to resume"):
+        rodmol.simulate(rodmol.System({"arm": _arm(4)}), 0.02, out=SystemRunWriter(tmp_path / "system"),
+                        resume=True)
 
     class Forgetful:  # streams, but keeps no settings to check a resumed call against
         chunk_frames = 10

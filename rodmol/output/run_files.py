@@ -115,6 +115,13 @@ def refuse_replacing(directory, overwrite, resume_hint, overwrite_hint):
                          f"{resume_hint}, or replace it with {overwrite_hint}")
 
 
+def refuse_resuming_nothing(directory, restart):
+    """Refuse to resume with a writer made without ``resume=True`` (``restart`` None): it holds no run."""
+    if restart is None:
+        raise ParameterError(f"`resume=True`: this writer of {str(directory)!r} holds no run to resume "
+                             "(make it with resume=True)")
+
+
 def cannot_write(path, exc):
     """The message of an output that could not be written (``exc``, an OSError, at ``path``)."""
     reason = exc.strerror or str(exc)

@@ -275,8 +275,8 @@ class RunWriter:
         return h5result.read_result(self.directory / INDEX)
 
     def resume_point(self):
-        """(planned output times, index of the restart frame, its state) of the run being resumed:
-        the last frame of its last complete chunk (see :meth:`_reopen`)."""
+        """(planned output times, restart frame, its state) of the run resumed (:meth:`_reopen`)."""
+        run_files.refuse_resuming_nothing(self.directory, self.restart)
         return self.t_out, self.restart[0], self.restart[2]
 
     def check(self, system):

@@ -141,6 +141,7 @@ class SystemRunWriter:
 
     def resume_point(self):
         """(planned output times, index of the restart frame, its state) of the run being resumed."""
+        run_files.refuse_resuming_nothing(self.directory, self.restart)
         return self.t_out, self.restart[0], self.restart[1]
 
     def check(self, assembly):
