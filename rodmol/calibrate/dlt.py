@@ -172,8 +172,9 @@ def _check_baseline(cameras):
     size = max(np.linalg.norm(c) for c in centres)
     if spread <= 1e-9 * max(size, 1.0):
         names = ", ".join(repr(c.name) for c in cameras)
+        # + 0.0: a rounded -0.0 would print as '-0.0' on some BLAS builds
         raise ParameterError(f"the cameras are degenerate: {names} all have their centre at "
-                             f"{tuple(np.round(centres[0], 6).tolist())} m (one position), so their rays "
+                             f"{tuple((np.round(centres[0], 6) + 0.0).tolist())} m (one position), so their rays "
                              "through a marker coincide and triangulation cannot find its depth; "
                              "use cameras at two different positions")
 
