@@ -147,7 +147,7 @@ class ReachEnv(gymnasium.Env):
     # ----------------------------------------------------------------- gymnasium's API
 
     def reset(self, *, seed=None, options=None):
-        if options is not None and options != {}:  # none is read: refused, not silently ignored
+        if not (options is None or (isinstance(options, dict) and not options)):  # none is read: not ignored
             raise ParameterError(f"`options` {_checks.short(options)}: {type(self).__name__}.reset "
                                  "takes none (None or {})")
         super().reset(seed=seed)

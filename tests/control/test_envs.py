@@ -127,8 +127,9 @@ def test_a_step_before_reset_or_after_the_episode_ended_raises_until_reset():
 
 def test_reset_refuses_options_it_would_ignore(env):
     env.reset(seed=0, options={})
-    with pytest.raises(ParameterError, match="`options`"):
-        env.unwrapped.reset(seed=0, options={"target": (0.2, 0.0, 0.0)})
+    for options in ({"target": (0.2, 0.0, 0.0)}, np.zeros(3), "target"):
+        with pytest.raises(ParameterError, match="`options`"):
+            env.unwrapped.reset(seed=0, options=options)
 
 
 @pytest.mark.parametrize("action", [np.ones(11), "pull", np.ones((2, 12)), None])
