@@ -241,10 +241,8 @@ def check_run(*, initial, t0, scheme, backend, rtol, atol, progress, max_wall_ti
     initial = kind.default_initial if initial is None else initial
     if isinstance(initial, RESULTS):
         t0 = float(initial.t[-1]) if t0 is None else t0
-    elif isinstance(initial, str) and initial not in INITIAL:
-        raise ParameterError(f"unknown `initial` {_checks.short(initial)}"
-                             f"{_checks.did_you_mean(initial, INITIAL)}; use 'equilibrium', "
-                             "'straight' or a state")
+    else:
+        check_word("initial", initial)
     t0 = 0.0 if t0 is None else _checks.non_negative("t0", t0, " s")
     scheme = get_scheme(scheme)
     rtol = options.rtol(scheme.default_rtol if rtol is None else rtol)
@@ -263,14 +261,35 @@ def fit(args, system):
     initial = args.initial
     if isinstance(initial, RESULTS):
         initial = _last_state(initial, args.kind, system)
-    if not isinstance(initial, str):
-        initial = _state_sized("initial", initial, system)
-        problem = args.kind.state_problem(system, args.t0, initial)
-        if problem:  # before any sink is made (with `overwrite`, making it clears the earlier run)
-            raise ParameterError(f"`initial` is not a state of this model: {problem}")
+    if not isinstance(initial, str):  # before any sink is made (`overwrite` then clears the earlier run)
+        initial = check_state("initial", initial, system, args.t0, args.kind)
     atol = None if args.atol is None else _state_sized("atol", args.atol, system, positive=True)
     return replace(args, initial=initial, asked_atol=atol,
                    atol=args.rtol * system.atol_scale() if atol is None else atol)
+
+
+def check_word(name, value):
+    """``value``; a string must be one of :data:`INITIAL` (the states a run can start from
+    by name), else a ParameterError names the parameter ``name``, the value and the words."""
+    if isinstance(value, str) and value not in INITIAL:
+        raise ParameterError(f"unknown `{name}` {_checks.short(value)}{_checks.did_you_mean(value, INITIAL)}"
+                             "; use 'equilibrium', 'straight' or a state")
+    return value
+
+
+def check_state(name, value, system, t=0.0, kind=KINDS[0]):
+    """``value``, the parameter ``name``, as a state vector of ``system`` (a copy), or a
+    ParameterError naming it: the rule for every state a user gives (simulate's and the
+    Simulator's ``initial``, linearize's ``state``). Refused: another size, a non-finite
+    entry (named) and what the ``kind``'s ``state_problem`` at ``t`` [s] finds (an element
+    inverted or torn, an orientation whose quaternion norm is off 1 by more than
+    ``watch.MAX_QUATERNION_DRIFT``, a zero one too); a quaternion within it is taken as it
+    is (the rotations are normalised on the fly), as an integration takes its own."""
+    state = _state_sized(name, value, system)
+    problem = kind.state_problem(system, t, state)
+    if problem:
+        raise ParameterError(f"`{name}` is not a state of this model: {problem}")
+    return state
 
 
 def prepare_run(system, args, progress, sink=None):
@@ -287,7 +306,7 @@ def prepare_run(system, args, progress, sink=None):
     initial = args.initial
     with _stage(progress, f"solving the initial equilibrium at t = {args.t0:g} s", timings, "equilibrium_s",
                 not (isinstance(initial, str) and initial == "equilibrium")):
-        y0 = _initial_state(system, initial, args.t0)
+        y0 = initial_state(system, initial, args.t0)
     return y0, timings
 
 
@@ -356,7 +375,9 @@ def _last_state(result, kind, system):
     return states[-1]
 
 
-def _initial_state(system, initial, t0):
+def initial_state(system, initial, t0):
+    """The state ``initial`` names at ``t0`` [s] (a word of :data:`INITIAL`), or the state
+    vector given (checked by :func:`check_state`) as a new array."""
     if isinstance(initial, str):
         if initial == "equilibrium":
             return equilibrium(system, t0)

@@ -9,6 +9,7 @@ discretisation for model-predictive control.
 
 import numpy as np
 
+from .. import _checks
 from .._differences import central_columns
 from ..discretise import load_entries, stencil
 from ..discretise.schemes import DEFAULT_SCHEME
@@ -16,6 +17,7 @@ from ..discretise.system import SemiDiscrete, tensions_by_hand
 from ..errors import ParameterError
 from ..loads import PointForce, PointMoment
 from ..model import Model
+from ..simulate import check_state, check_word, initial_state
 from .linear_model import LinearModel
 
 #: Step [-] of the central differences of the cables' path lengths in the
@@ -29,8 +31,12 @@ def linearize(model, state, t=0.0, scheme=DEFAULT_SCHEME):
     Parameters
     ----------
     model : Model
-    state : (size,) state vector (e.g. ``rodmol.equilibrium(model, t)``) or
-        ``"equilibrium"`` for the static equilibrium under the loads at ``t``.
+    state : (size,) state vector, ``"equilibrium"`` or ``"straight"``
+        A state (e.g. ``rodmol.equilibrium(model, t)``, ``Result.states[k]``),
+        checked as ``simulate`` checks its ``initial`` (finite, each element
+        neither inverted nor torn, each quaternion's norm within 0.1 of 1);
+        or, by name, the static equilibrium under the loads at ``t`` or the
+        rod at rest in its rest shape.
     t : float
         Time [s] at which the inputs (tensions, base motion, loads) are read.
     scheme : str
@@ -59,18 +65,19 @@ def linearize(model, state, t=0.0, scheme=DEFAULT_SCHEME):
           ``frame="global"``, the section's for ``"local"``): exact as well.
 
         It unpacks as before: ``A, B = linearize(...)``.
+
+    Raises
+    ------
+    ParameterError
+        A bad ``state`` (named, before any work), or rates that are not finite
+        about it (A, B or the tip's C would hold non-finite entries).
     """
     if not isinstance(model, Model):
         raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
+    t = _checks.finite("t", t)
+    check_word("state", state)
     probe = SemiDiscrete(model, scheme)
-    if isinstance(state, str) and state == "equilibrium":
-        from ..solve.equilibrium import equilibrium
-
-        state = equilibrium(probe, t)
-    y = np.asarray(state, dtype=float)
-    layout_size = probe.size
-    if y.shape != (layout_size,) or not np.all(np.isfinite(y)):
-        raise ParameterError(f"`state` must be {layout_size} finite numbers (the state size), got shape {y.shape}")
+    y = initial_state(probe, state, t) if isinstance(state, str) else check_state("state", state, probe, t)
     tensions = model.tensions(t, probe.state_view(t, y) if model.feedback else None)
     system = SemiDiscrete(tensions_by_hand(model), scheme)
 
@@ -98,7 +105,25 @@ def linearize(model, state, t=0.0, scheme=DEFAULT_SCHEME):
         names += [name for name, _ in loads]
         columns.append(np.column_stack([column for _, column in loads]))
     tip = (_tip_rows(system, t, y), ("tip x [m]", "tip y [m]", "tip z [m]"))
-    return LinearModel(a, np.hstack(columns), inputs=tuple(names), state=y, t=t, named_outputs={"tip": tip})
+    columns = np.hstack(columns)
+    entries = [system.entry_name(i) for i in range(system.size)]
+    _refuse_non_finite(t, ("A", a, entries, entries), ("B", columns, entries, names),
+                       ("the tip's C", tip[0], tip[1], entries))
+    return LinearModel(a, columns, inputs=tuple(names), state=y, t=t, named_outputs={"tip": tip})
+
+
+def _refuse_non_finite(t, *matrices):
+    """Raise a ParameterError if one of ``matrices``, (name, matrix, row names, column
+    names), has a non-finite entry: the rates are not finite about this state (a velocity
+    so large that the drag overflows, say), and a controller designed on them would be too."""
+    for name, matrix, rows, columns in matrices:
+        bad = ~np.isfinite(matrix)
+        if bad.any():
+            i, j = np.argwhere(bad)[0]
+            first = f"d {rows[i]} / d {columns[j]} = {float(matrix[i, j])!r}"
+            raise ParameterError(f"linearize: {name} has {int(bad.sum())} non-finite entries about this "
+                                 f"`state` at t = {t:.6g} s (the first: {first}); the model's rates are "
+                                 "not finite there")
 
 
 def _tip_rows(system, t, y):

@@ -13,20 +13,59 @@ rodmol itself never imports this module, so it works without gymnasium.
 """
 
 import functools
+import os
 from pathlib import Path
 
 import gymnasium
 import numpy as np
 from gymnasium import spaces
 
+from .. import _checks
 from ..arm import CABLE_OFFSETS, paper_arm
-from ..errors import IntegrationError
+from ..errors import IntegrationError, ParameterError, RodmolError
 from .simulator import Simulator
 
 REACH_ID = "rodmol/Reach-v0"
 #: Distance of the targets from the base [fraction of L], and largest angle [rad] from the base axis.
 TARGET_REACH = (0.8, 0.97)
 TARGET_CONE = np.radians(45.0)
+
+
+class ResetNeeded(RodmolError, gymnasium.error.ResetNeeded):
+    """``step`` before the first ``reset`` or after the episode ended (terminated or truncated):
+    gymnasium's contract, which its ``OrderEnforcing`` wrapper (``gymnasium.make``) enforces
+    before the first reset only."""
+
+
+def _record(name, value):
+    """A directory to record into (a path, not made yet), or None."""
+    if value is None:
+        return None
+    if not isinstance(value, (str, os.PathLike)) or not str(os.fspath(value)).strip():
+        raise ParameterError(f"`{name}` must be a directory (a path) or None, got {_checks.short(value)}")
+    return Path(value)
+
+
+def _max_tension(name, value):
+    """A tension bound [N] > 0 that the float32 action box holds."""
+    bound = _checks.positive(name, value, " N")
+    if bound > float(np.finfo(np.float32).max):
+        raise ParameterError(f"`{name}` must fit the float32 action box (<= 3.4e38 N), "
+                             f"got {_checks.short(value)}")
+    return bound
+
+
+#: Each option of :class:`ReachEnv` -> its check ``(name, value)`` -> the value, which names the
+#: option and the value it refuses; all run at construction, before any work. ``n_elements`` is
+#: the model's own (:class:`rodmol.Model` checks it).
+OPTIONS = {
+    "period": lambda name, value: _checks.positive(name, value, " s"),
+    "episode_steps": lambda name, value: _checks.integer_at_least(name, value, 1),
+    "max_tension": _max_tension,
+    "effort_weight": lambda name, value: _checks.non_negative(name, value, " m/N^2"),
+    "record": _record,
+    "overwrite": _checks.flag,
+}
 
 
 class ReachEnv(gymnasium.Env):
@@ -51,6 +90,15 @@ class ReachEnv(gymnasium.Env):
     ``-|tip - target| - effort_weight * |T|^2`` per step [m], with T the
     action [N] (``effort_weight`` in m/N^2).
 
+    Actions: a tension outside [0, ``max_tension``] is clipped to it, a NaN
+    is 0 N and an infinite one the bound it points to (``info["non_finite"]``
+    counts them): a policy that diverges does not end a training run. An
+    action of another shape or not numbers raises ParameterError.
+
+    ``step`` before the first ``reset`` or after the episode ended
+    (terminated or truncated) raises :class:`ResetNeeded` (gymnasium's
+    ``ResetNeeded`` too); ``reset`` takes no ``options`` (None or ``{}``).
+
     Targets: points at ``TARGET_REACH`` (0.8-0.97) L from the base within
     ``TARGET_CONE`` (45 degrees) of the base axis, uniform in solid angle
     (the tip at rest, 22 degrees below the axis in water, lies inside; that
@@ -64,13 +112,13 @@ class ReachEnv(gymnasium.Env):
     n_elements : int
         Elements N of the arm (30: faster than real time on one core).
     period : float
-        Control period [s].
+        Control period [s], > 0.
     episode_steps : int
-        Periods per episode.
+        Periods per episode, >= 1.
     max_tension : float
-        Upper bound of each tension [N].
+        Upper bound of each tension [N], > 0 and finite.
     effort_weight : float
-        Weight of the effort in the reward [m/N^2].
+        Weight of the effort in the reward [m/N^2], >= 0.
     record : path, optional
         Stream every episode into ``record/episode_NNNN`` (``result.h5`` and
         ParaView's ``rod.xdmf``), through the Simulator's ``out``.
@@ -82,20 +130,26 @@ class ReachEnv(gymnasium.Env):
 
     def __init__(self, n_elements=30, period=0.02, episode_steps=100, max_tension=4.0,
                  effort_weight=1e-3, record=None, overwrite=False):
-        self.period, self.episode_steps = float(period), int(episode_steps)
-        self.max_tension, self.effort_weight = float(max_tension), float(effort_weight)
+        given = dict(period=period, episode_steps=episode_steps, max_tension=max_tension,
+                     effort_weight=effort_weight, record=record, overwrite=overwrite)
+        options = {name: check(name, given[name]) for name, check in OPTIONS.items()}
+        self.period, self.episode_steps = options["period"], options["episode_steps"]
+        self.max_tension, self.effort_weight = options["max_tension"], options["effort_weight"]
+        self.record, self._overwrite, self._episodes = options["record"], options["overwrite"], 0
         self.model = paper_arm(n_elements, medium="water")
         self.sim = Simulator(self.model)
         self._start, self._y0 = self.sim.copy(), self.sim.y
-        self.record, self._episodes = (None if record is None else Path(record)), 0
-        self._overwrite = bool(overwrite)
         self.action_space = spaces.Box(0.0, self.max_tension, (len(CABLE_OFFSETS),), np.float32)
         self.observation_space = spaces.Box(-np.inf, np.inf, (21,), np.float32)
         self.target, self._steps = self.sim.state.tip.copy(), 0
+        self._ended = "before the first reset()"  # why step must wait for a reset, or None
 
     # ----------------------------------------------------------------- gymnasium's API
 
     def reset(self, *, seed=None, options=None):
+        if not (options is None or (isinstance(options, dict) and not options)):  # none is read: not ignored
+            raise ParameterError(f"`options` {_checks.short(options)}: {type(self).__name__}.reset "
+                                 "takes none (None or {})")
         super().reset(seed=seed)
         self.target = self._draw_target()
         if self.record is not None:
@@ -106,13 +160,15 @@ class ReachEnv(gymnasium.Env):
                                  overwrite=self._overwrite)
         else:
             self.sim.reset(self._start)
-        self._steps = 0
+        self._steps, self._ended = 0, None
         return self._observation(self.sim.state), {"target": self.target.copy()}
 
     def step(self, action):
-        tensions = np.clip(np.asarray(action, dtype=float), 0.0, self.max_tension)
+        if self._ended is not None:
+            raise ResetNeeded(f"step() {self._ended}: call reset() to start an episode")
+        tensions, non_finite = self._tensions(action)
         self._steps += 1
-        info, terminated = {}, False
+        info, terminated = {"non_finite": non_finite}, False
         try:
             self.sim.step(self.period, tensions)
         except IntegrationError as exc:
@@ -122,12 +178,27 @@ class ReachEnv(gymnasium.Env):
         reward = -distance - self.effort_weight * float(tensions @ tensions)
         info["distance"] = distance
         truncated = self._steps >= self.episode_steps and not terminated
+        if terminated or truncated:
+            self._ended = (f"after the episode was {'terminated' if terminated else 'truncated'} "
+                           f"at step {self._steps}")
         return self._observation(state), reward, terminated, truncated, info
 
     def close(self):
         self.sim.close()
 
     # ----------------------------------------------------------------- internals
+
+    def _tensions(self, action):
+        """The tensions [N] ``action`` asks for, within [0, max_tension] (a NaN: 0 N, an
+        infinite one: the bound it points to), and how many of its entries were not finite."""
+        tensions = _checks.floats(action)
+        n = self.action_space.shape[0]
+        if tensions is None or tensions.shape != (n,):
+            raise ParameterError(f"`action` must be {n} numbers, the tensions [N] of cables 1-{n}, "
+                                 f"got {_checks.short(action)}")
+        non_finite = int(np.count_nonzero(~np.isfinite(tensions)))
+        tensions = np.nan_to_num(tensions, nan=0.0, posinf=self.max_tension, neginf=0.0)
+        return np.clip(tensions, 0.0, self.max_tension), non_finite
 
     def _observation(self, state):
         tip_velocity = state.rotations[-1] @ state.v[-1]  # local to global

@@ -6,11 +6,14 @@ import warnings
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 gymnasium = pytest.importorskip("gymnasium")
 envs = pytest.importorskip("rodmol.control.envs")
 
 import rodmol  # noqa: E402
+from rodmol.errors import IntegrationError, ParameterError, RodmolError  # noqa: E402
 
 N = 8  # elements: the tests check the interface, not the physics
 
@@ -76,6 +79,86 @@ def test_records_an_episode_for_paraview(tmp_path):
     assert len(result.t) == 4 and result.success
     np.testing.assert_array_equal(result.tensions[1:], 0.5)
     assert (tmp_path / "episode_0001" / "rod.xdmf").is_file()
+
+
+@pytest.mark.parametrize("option, value", [
+    ("period", -0.02), ("period", float("nan")), ("period", 0.0), ("period", "0.02"),
+    ("episode_steps", 0), ("episode_steps", 2.5), ("episode_steps", "10"),
+    ("max_tension", -1.0), ("max_tension", float("inf")), ("max_tension", float("nan")), ("max_tension", 1e300),
+    ("effort_weight", -1e-3), ("effort_weight", float("nan")),
+    ("record", 3), ("record", " "), ("overwrite", "yes"),
+])
+def test_every_option_is_checked_at_construction_naming_it(monkeypatch, option, value):
+    def no_work(*args, **kwargs):
+        raise AssertionError("the arm was built before the options were checked")
+
+    monkeypatch.setattr(envs, "paper_arm", no_work)
+    with pytest.raises(ParameterError, match=f"`{option}`") as info:
+        envs.ReachEnv(**{option: value})
+    assert repr(value) in str(info.value) or str(value) in str(info.value)
+
+
+def test_gymnasium_make_refuses_a_bad_option_naming_it():
+    with pytest.raises(ParameterError, match="`episode_steps` must be >= 1, got 0"):
+        gymnasium.make("rodmol/Reach-v0", n_elements=N, episode_steps=0)
+
+
+def test_a_step_before_reset_or_after_the_episode_ended_raises_until_reset():
+    env = envs.ReachEnv(n_elements=N, episode_steps=2)
+    action = np.ones(12, dtype=np.float32)
+    with pytest.raises(envs.ResetNeeded, match="before the first reset"):
+        env.step(action)
+    env.reset(seed=0)
+    assert not env.step(action)[3] and env.step(action)[3]  # truncated at the second step
+    with pytest.raises(gymnasium.error.ResetNeeded, match="truncated at step 2") as info:
+        env.step(action)
+    assert isinstance(info.value, RodmolError)
+    env.reset(seed=0)
+    env.step(action)
+
+    def fails(*args, **kwargs):
+        raise IntegrationError("the step failed")
+
+    env.sim.step = fails  # a blow-up: the episode terminates
+    assert env.step(action)[2]
+    with pytest.raises(envs.ResetNeeded, match="terminated at step 2"):
+        env.step(action)
+
+
+def test_reset_refuses_options_it_would_ignore(env):
+    env.reset(seed=0, options={})
+    for options in ({"target": (0.2, 0.0, 0.0)}, np.zeros(3), "target"):
+        with pytest.raises(ParameterError, match="`options`"):
+            env.unwrapped.reset(seed=0, options=options)
+
+
+@pytest.mark.parametrize("action", [np.ones(11), "pull", np.ones((2, 12)), None])
+def test_an_action_of_another_shape_is_refused_naming_it(env, action):
+    env.reset(seed=0)
+    with pytest.raises(ParameterError, match="`action` must be 12 numbers"):
+        env.step(action)
+
+
+def first_step(env, action):
+    env.reset(seed=3)
+    return env.step(action)
+
+
+@settings(max_examples=25, deadline=None, derandomize=True,
+          suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+@given(action=st.lists(st.one_of(st.floats(-10.0, 10.0), st.sampled_from([np.nan, np.inf, -np.inf])),
+                       min_size=12, max_size=12))
+def test_a_non_finite_action_never_raises_and_acts_as_documented(env, action):
+    action = np.array(action, dtype=np.float32)
+    obs, reward, terminated, truncated, info = first_step(env, action)
+    assert np.all(np.isfinite(obs)) and np.isfinite(reward) and not terminated
+    assert info["non_finite"] == np.count_nonzero(~np.isfinite(action))
+    # NaN pulls with 0 N, +-inf with the bound it points to, the rest clipped to [0, max_tension]
+    high = env.unwrapped.max_tension
+    meant = np.clip(np.nan_to_num(action, nan=0.0, posinf=high, neginf=0.0), 0.0, high)
+    again = first_step(env, meant)
+    np.testing.assert_array_equal(obs, again[0])
+    assert reward == again[1]
 
 
 @pytest.mark.subprocess
