@@ -44,6 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError
+from ..meshes import read_surface
 from ..system_result import BodyResult, SystemResult
 from . import h5result, xdmf
 from .run_files import SYSTEM
@@ -63,17 +64,13 @@ RINGS, MERIDIANS = 16, 32
 def body_surface(body):
     """The surface drawing ``body``: (points (n, 3) [m], body frame; triangles (m, 3)).
 
-    Its mesh file if it has one; else the ellipsoid of uniform density with
+    Its mesh file if it has one (:func:`rodmol.meshes.read_surface`); else the ellipsoid of uniform density with
     its mass m and inertia (principal values I_i along the principal axes,
     about the centre of mass): semi-axes a_i = sqrt(5 (I_j + I_k - I_i) / (2 m))
     (a sphere's inertia gives the sphere).
     """
     if body.mesh is not None:
-        import meshio
-
-        mesh = meshio.read(body.mesh)
-        triangles = np.concatenate([block.data for block in mesh.cells if block.type == "triangle"])
-        return np.asarray(mesh.points, dtype=float)[:, :3], triangles.astype(np.int64)
+        return read_surface(body.mesh)  # as RigidBody.from_mesh read it: triangles, outward
     values, axes = np.linalg.eigh(body.inertia)
     semi = np.sqrt(np.maximum(2.5 * (values.sum() - 2.0 * values) / body.mass, 1e-30))
     polar = np.linspace(0.0, np.pi, RINGS + 1)[1:-1]
