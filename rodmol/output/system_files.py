@@ -190,13 +190,13 @@ def read_series(directory, index, name):
 
 
 def read_system(directory):
-    """The :class:`SystemResult` of a system's run directory (its rods and bodies read on first access)."""
+    """The :class:`SystemResult` of a system's run directory (the arrays of its rods and bodies read on
+    first access; every rod's files found first, :func:`_rods`)."""
     directory = Path(directory)
     index = read_info(directory)
     info, t = index["info"], index["t"]
     states = read_series(directory, index, "states")
-    rods = {name: (lambda key=key: h5result.read_result(directory / key / h5result.INDEX))
-            for name, key in info["rods"].items()}
+    rods = {name: (lambda rod=rod: rod) for name, rod in _rods(directory, info["rods"]).items()}
     bodies = {name: (lambda key=key: _body(t, {f: read_series(directory, index, f"bodies/{key}/{f}")
                                                for f in BODY_FIELDS + _stored(directory, index, key)},
                                            index["surfaces"].get(key)))
@@ -207,6 +207,25 @@ def read_system(directory):
                    f"{t[-1] if len(t) else 0.0:.6g} s were kept; resume it with simulate(..., out=DIR, resume=True)")
     return SystemResult(None, t, states, info["success"] and info.get("complete", True), message, info["stats"],
                         saved=(rods, bodies))
+
+
+def _rods(directory, keys):
+    """Each rod's Result ({name: file key} ``keys``; its arrays read on first access), once its
+    files are found: a rod whose folder, index or chunk files are missing or unreadable is a
+    ParameterError naming the rod and the file, before the SystemResult is made."""
+    rods = {}
+    for name, key in keys.items():
+        path = directory / key / h5result.INDEX
+        try:
+            rods[name] = h5result.read_result(path)
+        except FileNotFoundError:
+            raise ParameterError(f"cannot read the rod {name!r} of the system's run {str(directory)!r}: its "
+                                 f"result file {str(path)!r} is missing (the run's {INDEX} lists the rod: a run "
+                                 "directory copied in part?)") from None
+        except ParameterError as exc:
+            raise ParameterError(f"cannot read the rod {name!r} of the system's run {str(directory)!r}: "
+                                 f"{exc}") from exc
+    return rods
 
 
 def _stored(directory, index, key):

@@ -1,5 +1,7 @@
 """A system's run directory: each rod's files as a single rod's, system.h5, bodies.xdmf."""
 
+import shutil
+
 import numpy as np
 import pytest
 
@@ -67,6 +69,27 @@ def test_system_h5_is_an_index_of_chunk_files_written_once(tmp_path, two_arms):
     back = rodmol.load_result(tmp_path)
     assert np.array_equal(back.states, result.states)
     assert np.array_equal(back["head"].quaternion, result["head"].quaternion)
+
+
+def _last_chunk(run, rod):
+    return sorted((run / rod / "frames").glob("chunk_*.h5"))[-1]
+
+
+@pytest.mark.parametrize("damage, words", [
+    (lambda run: shutil.rmtree(run / "right"), "the rod 'right' of the system's run '{run}': its result file "
+                                                "'{run}/right/result.h5' is missing"),
+    (lambda run: (run / "rod_1" / "result.h5").write_bytes(b"garbage" * 10),
+     "the rod 'left arm' of the system's run '{run}': cannot read the result file '{run}/rod_1/result.h5': "
+     "it is not a file rodmol wrote"),
+    (lambda run: _last_chunk(run, "right").unlink(), "the rod 'right' of the system's run '{run}': cannot "
+                                                     "read the result file '{run}/right/frames/chunk_"),
+])
+def test_a_rods_missing_or_damaged_files_are_named_when_the_system_is_loaded(written, tmp_path, damage, words):
+    run = shutil.copytree(written[1], tmp_path / "run")
+    damage(run)
+    with pytest.raises(ParameterError) as caught:
+        rodmol.load_result(run)  # before: loaded, then a raw FileNotFoundError on first access to the rod
+    assert words.format(run=run) in str(caught.value)
 
 
 def test_a_body_without_mesh_is_drawn_as_the_ellipsoid_of_its_mass_and_inertia():
