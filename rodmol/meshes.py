@@ -66,10 +66,7 @@ def solid_properties(points, triangles):
     s = a + b + c) for the second moment. The reference is the vertices' mean,
     so a body far from the origin loses no digits.
     """
-    used = points[np.unique(triangles)]
-    origin = used.mean(axis=0)
-    a, b, c = (points[triangles[:, i]] - origin for i in range(3))
-    det = np.einsum("ij,ij->i", a, np.cross(b, c))
+    origin, (a, b, c), det = _tetrahedra(points, triangles)
     volume = det.sum() / 6.0
     s = a + b + c
     centre = (det[:, None] * s).sum(axis=0) / 24.0 / volume
@@ -77,6 +74,14 @@ def solid_properties(points, triangles):
     second -= volume * np.outer(centre, centre)  # about the centroid
     inertia = np.trace(second) * np.eye(3) - second
     return volume, origin + centre, 0.5 * (inertia + inertia.T)
+
+
+def _tetrahedra(points, triangles):
+    """The tetrahedra spanned by the vertices' mean and each triangle: (the mean (3,),
+    the corners (a, b, c) relative to it, each (m, 3), six times their signed volumes (m,))."""
+    origin = points[np.unique(triangles)].mean(axis=0)
+    a, b, c = (points[triangles[:, i]] - origin for i in range(3))
+    return origin, (a, b, c), np.einsum("ij,ij->i", a, np.cross(b, c))
 
 
 def check_surface(points, faces, source=GIVEN):
@@ -266,9 +271,7 @@ def _outward(points, triangles, owner, pairs, source):
     from scipy.sparse.csgraph import connected_components
 
     n_shells, shell = connected_components(_adjacency(pairs), directed=False)
-    origin = points[np.unique(triangles)].mean(axis=0)
-    a, b, c = (points[triangles[:, i]] - origin for i in range(3))
-    det = np.einsum("ij,ij->i", a, np.cross(b, c))
+    det = _tetrahedra(points, triangles)[2]
     of = shell[owner]  # each triangle's shell
     volumes = np.bincount(of, det, n_shells) / 6.0
     sizes = np.bincount(of, np.abs(det), n_shells) / 6.0

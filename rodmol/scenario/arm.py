@@ -106,7 +106,8 @@ def numbered(data, ctx, kind, table, build, at=(), unique=False):
         name = entry.get("name") if isinstance(entry, dict) and "name" in entry else name["name"]
         if unique and isinstance(name, str):
             named.append((at + (kind, i), kind, name))
-    kept = unique_names(ctx, named, rule=f"{kind} names must be unique")
+    kept = unique_names(ctx, named, rule=f"{kind} names must be unique (one without `name` is '{kind} K', "
+                                         f"the K-th [[{kind}]])")
     return FAILED if failed(*built) or len(kept) < len(named) else built
 
 

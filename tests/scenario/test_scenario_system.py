@@ -350,5 +350,5 @@ def test_two_rods_or_cables_of_one_name_are_reported_at_the_later_naming_the_fir
         # before: reported at the first cable, whose name the Model's message quoted
         (_line(text, 'name = "pull"', 2), "[[rod]] #1 [[cable]] #2"):
             f"the cable name 'pull' is used twice: [[rod]] #1 [[cable]] #1 (line {first_cable}) has it too; "
-            "cable names must be unique",
+            "cable names must be unique (one without `name` is 'cable K', the K-th [[cable]])",
     }
