@@ -102,6 +102,19 @@ def test_a_body_without_mesh_is_drawn_as_the_ellipsoid_of_its_mass_and_inertia()
     assert np.allclose(np.linalg.norm(body_surface(sphere)[0], axis=1), np.sqrt(0.02 / (0.4 * 2.0)))
 
 
+def test_a_meshed_body_is_drawn_as_the_surface_its_mass_came_from(tmp_path):
+    import meshio
+
+    corners = np.array([[x, y, z] for x in (0, 0.3) for y in (0, 0.2) for z in (0, 0.1)], dtype=float)
+    inward = np.array([[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]])[:, ::-1]
+    meshio.write(tmp_path / "box.obj", meshio.Mesh(corners, [("quad", inward)]))  # quads, every one facing in
+    body = rodmol.RigidBody.from_mesh(tmp_path / "box.obj", 500.0)
+    points, triangles = body_surface(body)  # before: no triangles to draw (and no body: "has no triangles")
+    a, b, c = (points[triangles[:, i]] for i in range(3))
+    assert np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0 == pytest.approx(body.volume, rel=1e-12)  # outward
+    assert body.mass == pytest.approx(500.0 * 0.006, rel=1e-12)
+
+
 def test_an_earlier_run_is_kept_and_a_finished_one_is_not_resumed(written, two_arms):
     result, out = written
     with pytest.raises(ParameterError, match="overwrite"):
