@@ -13,6 +13,7 @@ vertices are numbered from 0, in the order meshio reads them from the file.
 
 import numpy as np
 
+from . import _checks
 from .errors import ParameterError
 
 #: What a surface given as arrays is called in messages.
@@ -117,20 +118,22 @@ def _points(points, source):
 def _blocks(faces, n, source):
     """The faces as (m_i, k_i) int64 arrays of k_i >= 3 distinct vertex indices below ``n``;
     a block of faces of several sizes is split by size (the faces' numbers kept)."""
-    blocks = []
+    blocks, first = [], 0
     for given in faces:
         try:
             array = np.asarray(given)
         except ValueError:  # ragged: faces of several sizes
             array = None
-        for block in _by_size(given) if array is None or array.dtype == object else [array]:
-            blocks.append(_indices(block, sum(map(len, blocks)), source))
-    if not sum(map(len, blocks)):
+        for block in _by_size(given, first, source) if array is None or array.dtype == object else [array]:
+            block = _indices(block, first, source)
+            if block.ndim != 2 or block.shape[1] < 3:
+                raise ParameterError(f"{source}: the faces must be rows of 3 or more vertex indices, an (m, k) "
+                                     f"array, got shape {block.shape} from face {first}")
+            blocks.append(block)
+            first += len(block)
+    if not first:
         raise ParameterError(f"{source}: there are no faces")
     for first, block in _numbered(blocks):
-        if block.ndim != 2 or block.shape[1] < 3:
-            raise ParameterError(f"{source}: the faces must be rows of 3 or more vertex indices, an (m, k) "
-                                 f"array, got shape {block.shape} from face {first}")
         outside = np.flatnonzero(np.any((block < 0) | (block >= n), axis=1))
         if len(outside):
             face = block[outside[0]]
@@ -147,11 +150,15 @@ def _blocks(faces, n, source):
     return blocks
 
 
-def _by_size(rows):
-    """Runs of rows of one length, each as an array (the rows' order kept)."""
+def _by_size(rows, first, source):
+    """Runs of rows (faces ``first``, ...) of one length, each as an array (the rows' order kept)."""
     runs = []
-    for row in rows:
-        row = np.asarray(row)
+    for i, row in enumerate(rows):
+        try:
+            row = np.asarray(row)
+        except ValueError:
+            raise ParameterError(f"{source}: the faces must be rows of vertex indices, face {first + i} is "
+                                 f"{_checks.short(row)}") from None
         if runs and runs[-1][-1].shape == row.shape:
             runs[-1].append(row)
         else:
