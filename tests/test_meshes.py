@@ -94,6 +94,8 @@ def test_a_non_finite_vertex_is_refused_naming_it():
     (_CUBE[:, :2], "rows of 3 or more vertex indices"),
     (_CUBE[:0], "there are no faces"),
     (_CUBE.astype(bool), "must be whole vertex indices"),
+    (5, "rows of 3 or more vertex indices, an (m, k) array, got shape ()"),
+    ([[0, 1, 2], [0, [1, 2]]], "the faces must be rows of vertex indices, face 1 is [0, [1, 2]]"),
 ])
 def test_faces_that_are_not_faces_are_refused(faces, words):
     with pytest.raises(rodmol.ParameterError) as caught:
