@@ -1,5 +1,5 @@
 """Rigid bodies of a system: mass properties, fluid loads, motion and their
-mass properties from a closed triangulated surface (a mesh file)."""
+mass properties from a closed surface (a mesh file, :mod:`rodmol.meshes`)."""
 
 from dataclasses import dataclass, field
 
@@ -9,6 +9,8 @@ from . import _checks
 from .base_motion import BaseMotion
 from .errors import ParameterError
 from .loads import SMOOTHING_FRACTION, CapsuleContact, PlaneContact
+from .meshes import mesh_properties  # noqa: F401 (its home before rodmol.meshes)
+from .meshes import read_surface, solid_properties
 
 #: Motions of a body besides a prescribed :class:`BaseMotion`.
 MOTIONS = ("free", "fixed")
@@ -133,28 +135,23 @@ class RigidBody:
 
     @classmethod
     def from_mesh(cls, path, density, **options):
-        """A body of uniform ``density`` [kg/m^3] filling the closed
-        triangulated surface in the file ``path`` (any format meshio reads:
-        STL, OBJ, PLY, VTU, ...; coordinates in metres, the body frame).
-        Volume, centre of mass and inertia come from :func:`mesh_properties`;
-        ``options`` are the other arguments of :class:`RigidBody`."""
-        import meshio
-
+        """A body of uniform ``density`` [kg/m^3] filling the closed surface
+        in the file ``path`` (any format meshio reads: STL, OBJ, PLY, VTU, ...;
+        triangles, quads or polygons; coordinates in metres, the body frame).
+        The surface is checked first (:func:`rodmol.meshes.check_surface`:
+        closed, manifold, consistently oriented, enclosing a volume; one turned
+        wholly inwards is taken turned outwards); volume, centre of mass and
+        inertia come from :func:`rodmol.meshes.solid_properties`; ``options`` are
+        the other arguments of :class:`RigidBody`."""
         density = _checks.positive("density", density, " kg/m^3")
         given = sorted(set(options) & {"mass", "inertia", "volume", "centre_of_mass", "mesh"})
         if given:
             raise ParameterError(f"`{given[0]}` comes from the mesh and its density: leave it out of "
                                  f"RigidBody.from_mesh, got {given[0]}={_checks.short(options[given[0]])}")
-        try:
-            mesh = meshio.read(path)
-        except Exception as exc:  # noqa: BLE001 (any reader failure, named with the file)
-            raise ParameterError(f"cannot read the mesh `path` {str(path)!r}: {exc}") from exc
-        triangles = [block.data for block in mesh.cells if block.type == "triangle"]
-        if not triangles:
-            raise ParameterError(f"the mesh `path` {str(path)!r} has no triangles")
-        volume, centre, inertia = mesh_properties(mesh.points, np.concatenate(triangles))
+        points, triangles = read_surface(path)
+        volume, centre, inertia = solid_properties(points, triangles)
         if isinstance(options.get("contact_points"), str) and options["contact_points"] == "vertices":
-            options["contact_points"] = np.asarray(mesh.points, dtype=float)[:, :3]
+            options["contact_points"] = points
         return cls(density * volume, density * inertia, volume=volume, centre_of_mass=centre,
                    mesh=str(path), **options)
 
@@ -206,36 +203,6 @@ def mass_matrix_about_origin(translational, rotational, point):
     cross_p = np.array([[0.0, -p[2], p[1]], [p[2], 0.0, -p[0]], [-p[1], p[0], 0.0]])
     return np.block([[translational, -translational @ cross_p],
                      [cross_p @ translational, rotational - cross_p @ translational @ cross_p]])
-
-
-def mesh_properties(points, triangles):
-    """Volume [m^3], centroid (3,) [m] and inertia tensor per unit density
-    (3, 3) [m^5] about the centroid of the solid bounded by a closed surface.
-
-    ``points`` (n, 3), ``triangles`` (m, 3) vertex indices, consistently
-    oriented (outward or inward: the sign is fixed from the volume's). By the
-    divergence theorem every integral is a sum over the tetrahedra spanned by
-    the origin and each triangle: det/6 for the volume, det/24 (a + b + c)
-    for the first moment, det/120 (sum of v v^T + s s^T, s = a + b + c) for
-    the second moment.
-    """
-    points = np.asarray(points, dtype=float)[:, :3]
-    tri = np.asarray(triangles, dtype=np.int64)
-    a, b, c = points[tri[:, 0]], points[tri[:, 1]], points[tri[:, 2]]
-    det = np.einsum("ij,ij->i", a, np.cross(b, c))
-    volume = det.sum() / 6.0
-    if not np.isfinite(volume) or abs(volume) <= 1e-300:
-        raise ParameterError("the mesh encloses no volume: is it a closed surface?")
-    s = a + b + c
-    centre = (det[:, None] * s).sum(axis=0) / 24.0 / volume
-    second = np.einsum("t,ti,tj->ij", det, a, a) + np.einsum("t,ti,tj->ij", det, b, b)
-    second += np.einsum("t,ti,tj->ij", det, c, c) + np.einsum("t,ti,tj->ij", det, s, s)
-    second /= 120.0
-    if volume < 0.0:  # inward normals: every integral changed sign
-        volume, second = -volume, -second
-    second -= volume * np.outer(centre, centre)  # about the centroid
-    inertia = np.trace(second) * np.eye(3) - second
-    return volume, centre, inertia
 
 
 def _inertia(value):

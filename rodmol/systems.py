@@ -96,9 +96,12 @@ class System:
         if not rods:
             raise ParameterError("`rods` must hold at least one rod")
         shared = sorted(set(rods) & set(bodies))
-        if shared or "world" in rods or "world" in bodies:
-            clash = shared[0] if shared else "world"
-            raise ParameterError(f"the name {clash!r} is used twice (or is 'world'): names must be unique")
+        if shared:
+            raise ParameterError(f"the name {shared[0]!r} is used twice, by a rod and a body: rods and bodies "
+                                 "share one set of names, each unique")
+        if "world" in rods or "world" in bodies:
+            raise ParameterError(f"`{'rods' if 'world' in rods else 'bodies'}`: the name 'world' is reserved (a "
+                                 "joint's end \"world\" is the fixed frame)")
         self.gravity = _checks.vector3("gravity", gravity)
         probe = next(iter(rods.values())).replace(medium=medium)  # Model checks the medium
         self.medium = probe.medium

@@ -132,8 +132,10 @@ def test_system_graph_checks():
         rodmol.System({"arm": _arm()}, {"wall": fixed}, [rodmol.Joint(("wall", (0, 0, 0)), "world")])
     with pytest.raises(rodmol.ParameterError, match="to itself"):
         rodmol.System({"arm": _arm()}, {"head": head}, [rodmol.Joint(("head", (0, 0, 0)), ("head", (0, 0, 0)))])
-    with pytest.raises(rodmol.ParameterError, match="used twice"):
+    with pytest.raises(rodmol.ParameterError, match="'head' is used twice, by a rod and a body"):
         rodmol.System({"head": _arm()}, {"head": head})
+    with pytest.raises(rodmol.ParameterError, match="`bodies`: the name 'world' is reserved"):
+        rodmol.System({"arm": _arm()}, {"world": head})
     moving = _arm().replace(base=rodmol.BaseMotion(velocity=lambda t: (0, 0, 0)))
     with pytest.raises(rodmol.ParameterError, match="`base` must be the default"):
         rodmol.System({"arm": moving}, {"head": head}, [on_head])

@@ -180,10 +180,14 @@ def frame_state(directory, chunk, row):
 
 
 def read_result(path):
-    """A :class:`rodmol.Result` from an index file; the time series load on first access."""
+    """A :class:`rodmol.Result` from an index file, once the chunk files it lists are found; the
+    time series load on first access."""
     path = Path(path)
     index = read_index(path)
     info, chunks, folder = index["info"], list(index["chunks"]), path.parent
+    for chunk in chunks:  # all there now, not when an array is first read
+        if not (folder / chunk).is_file():
+            raise damaged(folder / chunk, FileNotFoundError(f"no file {chunk!r} in {str(folder)!r}"))
     arrays = {key: index[key] for key in STATIC}
     arrays["t"] = index["t"]
 

@@ -44,6 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ParameterError
+from ..meshes import read_surface
 from ..system_result import BodyResult, SystemResult
 from . import h5result, xdmf
 from .run_files import SYSTEM
@@ -63,17 +64,13 @@ RINGS, MERIDIANS = 16, 32
 def body_surface(body):
     """The surface drawing ``body``: (points (n, 3) [m], body frame; triangles (m, 3)).
 
-    Its mesh file if it has one; else the ellipsoid of uniform density with
+    Its mesh file if it has one (:func:`rodmol.meshes.read_surface`); else the ellipsoid of uniform density with
     its mass m and inertia (principal values I_i along the principal axes,
     about the centre of mass): semi-axes a_i = sqrt(5 (I_j + I_k - I_i) / (2 m))
     (a sphere's inertia gives the sphere).
     """
     if body.mesh is not None:
-        import meshio
-
-        mesh = meshio.read(body.mesh)
-        triangles = np.concatenate([block.data for block in mesh.cells if block.type == "triangle"])
-        return np.asarray(mesh.points, dtype=float)[:, :3], triangles.astype(np.int64)
+        return read_surface(body.mesh)  # as RigidBody.from_mesh read it: triangles, outward
     values, axes = np.linalg.eigh(body.inertia)
     semi = np.sqrt(np.maximum(2.5 * (values.sum() - 2.0 * values) / body.mass, 1e-30))
     polar = np.linspace(0.0, np.pi, RINGS + 1)[1:-1]
@@ -193,13 +190,13 @@ def read_series(directory, index, name):
 
 
 def read_system(directory):
-    """The :class:`SystemResult` of a system's run directory (its rods and bodies read on first access)."""
+    """The :class:`SystemResult` of a system's run directory (the arrays of its rods and bodies read on
+    first access; every rod's files found first, :func:`_rods`)."""
     directory = Path(directory)
     index = read_info(directory)
     info, t = index["info"], index["t"]
     states = read_series(directory, index, "states")
-    rods = {name: (lambda key=key: h5result.read_result(directory / key / h5result.INDEX))
-            for name, key in info["rods"].items()}
+    rods = {name: (lambda rod=rod: rod) for name, rod in _rods(directory, info["rods"]).items()}
     bodies = {name: (lambda key=key: _body(t, {f: read_series(directory, index, f"bodies/{key}/{f}")
                                                for f in BODY_FIELDS + _stored(directory, index, key)},
                                            index["surfaces"].get(key)))
@@ -210,6 +207,25 @@ def read_system(directory):
                    f"{t[-1] if len(t) else 0.0:.6g} s were kept; resume it with simulate(..., out=DIR, resume=True)")
     return SystemResult(None, t, states, info["success"] and info.get("complete", True), message, info["stats"],
                         saved=(rods, bodies))
+
+
+def _rods(directory, keys):
+    """Each rod's Result ({name: file key} ``keys``; its arrays read on first access), once its
+    files are found: a rod whose folder, index or chunk files are missing or unreadable is a
+    ParameterError naming the rod and the file, before the SystemResult is made."""
+    rods = {}
+    for name, key in keys.items():
+        path = directory / key / h5result.INDEX
+        try:
+            rods[name] = h5result.read_result(path)
+        except FileNotFoundError:
+            raise ParameterError(f"cannot read the rod {name!r} of the system's run {str(directory)!r}: its "
+                                 f"result file {str(path)!r} is missing (the run's {INDEX} lists the rod: a run "
+                                 "directory copied in part?)") from None
+        except ParameterError as exc:
+            raise ParameterError(f"cannot read the rod {name!r} of the system's run {str(directory)!r}: "
+                                 f"{exc}") from exc
+    return rods
 
 
 def _stored(directory, index, key):

@@ -18,7 +18,7 @@ from ..markers import Marker
 from ..parameters import MEDIA, Material, Medium
 from ..rod import Rod
 from . import tables
-from .problems import FAILED, failed
+from .problems import FAILED, failed, unique_names
 
 
 def missing_table(data, ctx, key):
@@ -92,22 +92,28 @@ def entries(data, ctx, kind, at=()):
     return found
 
 
-def numbered(data, ctx, kind, table, build, at=()):
+def numbered(data, ctx, kind, table, build, at=(), unique=False):
     """The objects of the ``[[kind]]`` tables (in the table at path ``at``); a
-    nameless one is ``"kind K"``."""
+    nameless one is ``"kind K"``. ``unique``: names may not repeat (a repeat is
+    a problem at the later table's name, naming the earlier)."""
     found = entries(data, ctx, kind, at)
     if found is FAILED:
         return FAILED
-    built = []
+    built, named = [], []
     for i, entry in enumerate(found):
         name = {} if isinstance(entry, dict) and "name" in entry else {"name": f"{kind} {i + 1}"}
         built.append(build_table(entry, ctx, at + (kind, i), table, build, extra=name))
-    return FAILED if failed(*built) else built
+        name = entry.get("name") if isinstance(entry, dict) and "name" in entry else name["name"]
+        if unique and isinstance(name, str):
+            named.append((at + (kind, i), kind, name))
+    kept = unique_names(ctx, named, rule=f"{kind} names must be unique (one without `name` is '{kind} K', "
+                                         f"the K-th [[{kind}]])")
+    return FAILED if failed(*built) or len(kept) < len(named) else built
 
 
 def cables(data, ctx, at=()):
     """The ``[[cable]]`` tables of an arm written out in full."""
-    return numbered(data, ctx, "cable", tables.CABLE, Cable, at)
+    return numbered(data, ctx, "cable", tables.CABLE, Cable, at, unique=True)
 
 
 def markers(data, ctx, at=()):

@@ -43,6 +43,8 @@ class Problem:
 
 #: A value that could not be read; its problem is already recorded.
 FAILED = object()
+#: Where a problem that follows from one already recorded goes: nowhere.
+FOLLOWS = object()
 
 
 def failed(*values):
@@ -67,6 +69,31 @@ def table_label(path):
         entry = f"[[{path[0]}]] #{path[1] + 1}"
         return entry + (" " + table_label(path[2:]) if len(path) > 2 else "")
     return "[" + ".".join(map(str, path)) + "]"
+
+
+def unique_names(ctx, named, reserved=None, rule="names must be unique"):
+    """The paths of the tables of ``named`` — (path, kind, name) each: the ``[[kind]]`` table
+    at ``path`` and its name — whose name no table before it in the file took. Each later
+    use is a problem at that table's ``name`` key naming the table that took it first (and
+    ``rule``); a ``reserved`` name ({name: why}) is one wherever it is."""
+    reserved = reserved or {}
+
+    def line(path):
+        return ctx.lines.find(path + ("name",))
+
+    taken, kept = {}, set()
+    for path, kind, name in sorted(named, key=lambda entry: line(entry[0]) or 0):  # ties keep their order
+        if name in reserved:
+            ctx.add(path + ("name",), f"the {kind} name {name!r} is reserved: {reserved[name]}")
+        elif name in taken:
+            first = taken[name]
+            at = f" (line {line(first)})" if line(first) else ""
+            ctx.add(path + ("name",), f"the {kind} name {name!r} is used twice: {table_label(first)}{at} has it "
+                                      f"too; {rule}")
+        else:
+            taken[name] = path
+            kept.add(path)
+    return kept
 
 
 class Context:
@@ -140,8 +167,8 @@ class Context:
 
     def construct(self, path, build, values, given=None, missing=(), where=None, keys=None):
         """``build(**values)``: the constructor checks the values. Each ParameterError is
-        recorded at the key it names (or at the path ``where(key, message)`` gives); that
-        key then takes a stand-in value (:data:`STAND_INS`, or its default) and ``build``
+        recorded at the key it names (or at the path ``where(key, message)`` gives; nowhere if
+        that is :data:`FOLLOWS`); that key then takes a stand-in value (:data:`STAND_INS`, or its default) and ``build``
         is tried again, so that every bad value is reported at once. ``given``: the
         file's keys (those with a line); ``missing``: required keys already reported
         absent (they take stand-ins); ``keys``: those a message may name (default:
@@ -163,7 +190,8 @@ class Context:
                 key = named_key(message, keys) or quoted_value(message, values, given)
                 if key is None or key not in reported:
                     place = where(key, message) if where else None
-                    self.add(place or path + ((key,) if key in given else ()), message)
+                    if place is not FOLLOWS:
+                        self.add(place or path + ((key,) if key in given else ()), message)
                 if key is None:
                     return FAILED
                 if key not in reported:

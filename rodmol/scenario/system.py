@@ -29,13 +29,15 @@ from . import tables
 from .loads import contacts as contact_tables
 from .loads import loads as load_tables
 from .loads import rod_contacts
-from .problems import FAILED, failed
+from .problems import FAILED, FOLLOWS, failed, unique_names
 
 #: Top-level keys and tables of a single-rod file, and where a system file has them instead.
 SINGLE_ROD_KEYS = {"arm": "a [[rod]] written out in full", "scenario": "Python (rodmol.scenarios)",
                    "material": "[rod.material]", "cable": "[[rod.cable]]", "marker": "[[rod.marker]]",
                    "load": "[[rod.load]]", "base": "[rod.base]", "medium": "[system] medium",
                    "gravity": "[system] gravity"}
+#: Names no rod or body may take, and why.
+RESERVED = {"world": "a joint's end `\"world\"` is the fixed frame"}
 
 
 def is_system(data):
@@ -53,8 +55,8 @@ def system(data, ctx, n_elements):
     settings = ctx.table(data.get("system", {}), ("system",), tables.SYSTEM)
     medium, switches = arm_tables.medium(settings, ctx, "air", at=("system",))
     gravity = arm_tables.values(tables.SYSTEM, ctx, ("system",), settings, keys=("gravity",))
-    rods = _named(data, ctx, "rod", lambda entry, path: _rod(entry, ctx, path, n_elements, switches))
-    bodies = _named(data, ctx, "body", lambda entry, path: _body(entry, ctx, path))
+    rods, bodies, refused = _parts(data, ctx, {"rod": lambda entry, path: _rod(entry, ctx, path, n_elements, switches),
+                                      "body": lambda entry, path: _body(entry, ctx, path)})
     joints = arm_tables.numbered(data, ctx, "joint", tables.JOINT, _joint)
     contacts = rod_contacts(data, ctx)
     if "rod" not in data:
@@ -72,7 +74,7 @@ def system(data, ctx, n_elements):
                                                     medium=None if failed(medium) else medium, **gravity,
                                                     contacts=() if failed(contacts) else contacts),
                           given=gravity, keys=("gravity",),
-                          where=lambda key, message: _system_problem(key, message))
+                          where=lambda key, message: _system_problem(key, message, refused))
     return FAILED if parts_failed or failed(contacts) else built
 
 
@@ -81,27 +83,36 @@ def _joint(name=None, **arguments):
     return Joint(**arguments)
 
 
-def _named(data, ctx, kind, read):
-    """{name: object} of the ``[[kind]]`` tables, each read by ``read(entry, path)``;
-    FAILED if one has a problem (names must be given and unique)."""
-    found = arm_tables.entries(data, ctx, kind)
-    if found is FAILED:
-        return FAILED
+def _parts(data, ctx, read):
+    """The rods and the bodies ({name: object} each) of the ``[[rod]]`` and ``[[body]]``
+    tables, each read by ``read[kind](entry, path)``, and the (kind, name) of the tables
+    whose name was refused as taken or reserved. A table whose name is missing, bad or
+    refused stands under the key FAILED (its problem recorded). Rods and bodies share one
+    set of names, as in a System: each unique, none 'world'."""
+    found, named = {}, []
+    for kind in ("rod", "body"):
+        entries = arm_tables.entries(data, ctx, kind)
+        if entries is not FAILED and not all(isinstance(entry, dict) for entry in entries):
+            ctx.add((kind,), f"`{kind}` must be an array of tables `[[{kind}]]`, got {_checks.short(entries)}")
+            entries = FAILED
+        found[kind] = entries
+        for i, entry in enumerate([] if entries is FAILED else entries):
+            name = ctx.read(entry, (kind, i), "name", _name)
+            if name is None:
+                ctx.add((kind, i), "missing required key `name` (joints name the rods and bodies)")
+            elif not failed(name):
+                named.append(((kind, i), kind, name))
+    kept = unique_names(ctx, named, RESERVED, "rods and bodies share one set of names, each unique")
+    names = {path: name for path, _, name in named if path in kept}
     built = {}
-    for i, entry in enumerate(found):
-        path = (kind, i)
-        if not isinstance(entry, dict):
-            ctx.add((kind,), f"`{kind}` must be an array of tables `[[{kind}]]`, got {_checks.short(entry)}")
-            return FAILED
-        name = ctx.read(entry, path, "name", _name)
-        if name is None:
-            ctx.add(path, "missing required key `name` (joints name the rods and bodies)")
-        elif name in built:
-            ctx.add(path + ("name",), f"the {kind} name {name!r} is used twice: names must be unique")
-        item = read(entry, path)
-        # (one without a usable name, or a second of a name, is left out: its problem is recorded)
-        built.setdefault(FAILED if failed(name) or name is None else name, item)
-    return built
+    for kind, entries in found.items():
+        if entries is FAILED:
+            built[kind] = FAILED
+            continue
+        built[kind] = {}
+        for i, entry in enumerate(entries):  # (every table is read, for its own problems)
+            built[kind].setdefault(names.get((kind, i), FAILED), read[kind](entry, (kind, i)))
+    return built["rod"], built["body"], {(kind, name) for path, kind, name in named if path not in kept}
 
 
 def _name(value):
@@ -192,9 +203,12 @@ def _meshed(mesh, density, **options):
     return RigidBody.from_mesh(mesh, density, **options)
 
 
-def _system_problem(key, message):
+def _system_problem(key, message, refused):
     """Where a System error belongs: its key in [system], the [[joint]] or
-    [[contact]] it numbers, else the top level."""
+    [[contact]] it numbers, else the top level; nowhere if it is about a part
+    left out for its name, ``refused`` ((kind, name) each), whose problem is recorded."""
+    if any(f"names the {kind} {name!r}, which is not in" in message for kind, name in refused):
+        return FOLLOWS
     if key is not None:
         return ("system", key)
     found = re.search(r"(joint|contact)s\[(\d+)\]", message)

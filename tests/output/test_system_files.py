@@ -1,5 +1,7 @@
 """A system's run directory: each rod's files as a single rod's, system.h5, bodies.xdmf."""
 
+import shutil
+
 import numpy as np
 import pytest
 
@@ -69,6 +71,27 @@ def test_system_h5_is_an_index_of_chunk_files_written_once(tmp_path, two_arms):
     assert np.array_equal(back["head"].quaternion, result["head"].quaternion)
 
 
+def _last_chunk(run, rod):
+    return sorted((run / rod / "frames").glob("chunk_*.h5"))[-1]
+
+
+@pytest.mark.parametrize("damage, words", [
+    (lambda run: shutil.rmtree(run / "right"), "the rod 'right' of the system's run '{run}': its result file "
+                                                "'{run}/right/result.h5' is missing"),
+    (lambda run: (run / "rod_1" / "result.h5").write_bytes(b"garbage" * 10),
+     "the rod 'left arm' of the system's run '{run}': cannot read the result file '{run}/rod_1/result.h5': "
+     "it is not a file rodmol wrote"),
+    (lambda run: _last_chunk(run, "right").unlink(), "the rod 'right' of the system's run '{run}': cannot "
+                                                     "read the result file '{run}/right/frames/chunk_"),
+])
+def test_a_rods_missing_or_damaged_files_are_named_when_the_system_is_loaded(written, tmp_path, damage, words):
+    run = shutil.copytree(written[1], tmp_path / "run")
+    damage(run)
+    with pytest.raises(ParameterError) as caught:
+        rodmol.load_result(run)  # before: loaded, then a raw FileNotFoundError on first access to the rod
+    assert words.format(run=run) in str(caught.value)
+
+
 def test_a_body_without_mesh_is_drawn_as_the_ellipsoid_of_its_mass_and_inertia():
     body = rodmol.RigidBody(2.0, np.diag([0.01, 0.02, 0.025]), centre_of_mass=(0.1, -0.2, 0.3))
     points, triangles = body_surface(body)
@@ -77,6 +100,19 @@ def test_a_body_without_mesh_is_drawn_as_the_ellipsoid_of_its_mass_and_inertia()
     assert np.allclose(body.mass / volume * inertia, body.inertia, rtol=0.02)  # a polyhedron, 16 x 32
     sphere = rodmol.RigidBody(2.0, (0.02, 0.02, 0.02))
     assert np.allclose(np.linalg.norm(body_surface(sphere)[0], axis=1), np.sqrt(0.02 / (0.4 * 2.0)))
+
+
+def test_a_meshed_body_is_drawn_as_the_surface_its_mass_came_from(tmp_path):
+    import meshio
+
+    corners = np.array([[x, y, z] for x in (0, 0.3) for y in (0, 0.2) for z in (0, 0.1)], dtype=float)
+    inward = np.array([[0, 1, 3, 2], [4, 6, 7, 5], [0, 4, 5, 1], [2, 3, 7, 6], [0, 2, 6, 4], [1, 5, 7, 3]])[:, ::-1]
+    meshio.write(tmp_path / "box.obj", meshio.Mesh(corners, [("quad", inward)]))  # quads, every one facing in
+    body = rodmol.RigidBody.from_mesh(tmp_path / "box.obj", 500.0)
+    points, triangles = body_surface(body)  # before: no triangles to draw (and no body: "has no triangles")
+    a, b, c = (points[triangles[:, i]] for i in range(3))
+    assert np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0 == pytest.approx(body.volume, rel=1e-12)  # outward
+    assert body.mass == pytest.approx(500.0 * 0.006, rel=1e-12)
 
 
 def test_an_earlier_run_is_kept_and_a_finished_one_is_not_resumed(written, two_arms):

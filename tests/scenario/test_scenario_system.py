@@ -299,3 +299,56 @@ b = "world"
     assert [(j.a, j.b, j.kind) for j in system.body_joints] == [("head", "tail", "pin"), ("tail", None, "clamp")]
     pinned = parse_scenario(text.replace('b = ["right", "base"]', 'b = ["right", "base"]\nkind = "pin"')).model
     assert pinned.base_bodies == {"right": "right.base"} and pinned.clamps["right"][0] == "right.base"
+
+
+def _problems(text):
+    with pytest.raises(ScenarioError) as caught:
+        parse_scenario(text)
+    return caught.value.problems
+
+
+def _line(text, wanted, occurrence=1):
+    """The line number of the ``occurrence``-th line of ``text`` equal to ``wanted``."""
+    return [i for i, line in enumerate(text.splitlines(), start=1) if line == wanted][occurrence - 1]
+
+
+def test_a_rod_and_a_body_of_one_name_are_reported_at_the_later_name_naming_the_first():
+    # The head renamed "left" (and the joints with it): before, one problem at the [system] header.
+    text, left = TWO_ARMS.read_text().replace('"head"', '"left"'), 'name = "left"'
+    (problem,) = _problems(text)  # nothing follows about the joints that name the body "left"
+    assert (problem.line, problem.table) == (_line(text, left, 2), "[[body]] #1")
+    assert problem.message == (f"the body name 'left' is used twice: [[rod]] #2 (line {_line(text, left)}) has "
+                               "it too; rods and bodies share one set of names, each unique")
+    # A body before the rods: the rod, the later, is reported.
+    body = text[text.index("[[body]]"):text.index("[[joint]]")]
+    first = text.replace(body, "").replace("[[rod]]", body + "[[rod]]", 1)
+    (problem,) = _problems(first)
+    assert (problem.line, problem.table) == (_line(first, left, 2), "[[rod]] #2")
+    assert f"[[body]] #1 (line {_line(first, left)}) has it too" in problem.message
+
+
+def test_a_rod_or_body_named_world_is_reported_at_its_name():
+    text = TWO_ARMS.read_text().replace('name = "left"', 'name = "world"').replace('["left", "base"]', '["world"]')
+    found = _problems(text)
+    assert [(p.line, p.table) for p in found][0] == (_line(text, 'name = "world"'), "[[rod]] #2")
+    assert "the rod name 'world' is reserved: a joint's end `\"world\"` is the fixed frame" in found[0].message
+
+
+def test_two_rods_or_cables_of_one_name_are_reported_at_the_later_naming_the_first():
+    text = TWO_ARMS.read_text()
+    rod = text[text.index("[[rod]]"):text.index("[[rod]]", text.index("[[rod]]") + 1)]
+    text = text.replace("[[body]]", rod + "[[body]]")  # a third rod, named "right" too
+    text = text.replace("[[rod.cable]]\n", '[[rod.cable]]\nname = "pull"\n').replace(
+        "tension = [[0.0, 0.0], [0.1, 0.3]]\n", 'tension = [[0.0, 0.0], [0.1, 0.3]]\n[[rod.cable]]\nname = "pull"\n'
+        'offset = [0.0, 0.005]\nanchor = 0.1\n', 1)
+    found = {(p.line, p.table): p.message for p in _problems(text)}
+    first_rod, first_cable = _line(text, 'name = "right"'), _line(text, 'name = "pull"')
+    assert found == {
+        (_line(text, 'name = "right"', 2), "[[rod]] #3"):
+            f"the rod name 'right' is used twice: [[rod]] #1 (line {first_rod}) has it too; rods and bodies share "
+            "one set of names, each unique",
+        # before: reported at the first cable, whose name the Model's message quoted
+        (_line(text, 'name = "pull"', 2), "[[rod]] #1 [[cable]] #2"):
+            f"the cable name 'pull' is used twice: [[rod]] #1 [[cable]] #1 (line {first_cable}) has it too; "
+            "cable names must be unique (one without `name` is 'cable K', the K-th [[cable]])",
+    }
