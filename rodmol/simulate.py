@@ -297,7 +297,7 @@ def prepare_run(system, args, progress, sink=None):
     run: ``RunKind.prepare``) and the initial state, each stage announced through
     ``progress``: returns (y0, timings [s])."""
     timings, prepare = {}, args.kind.prepare
-    with _stage(progress, "preparing the compiled kernels", timings, "prepare_s",
+    with _stage(progress, kernels.stage_text(), timings, "prepare_s",
                 prepare is None or kernels.ready(args.run, args.backend_options)):
         if prepare is not None:
             prepare(system, args.t0, system.undeformed_state(), args.run, args.rtol, args.atol,

@@ -10,6 +10,7 @@ its code can read, so any change to them recompiles every kernel once.
 """
 
 import hashlib
+import pickle
 from pathlib import Path
 
 from numba.core import caching
@@ -59,3 +60,13 @@ def install():
     locators = getattr(getattr(caching, "CacheImpl", None), "_locator_classes", None)
     if isinstance(locators, list) and InTreeLocator not in locators:
         locators[:0] = [InTreeLocator, UserWideLocator]
+
+
+def cached(dispatcher):
+    """True if numba's disk cache holds machine code of ``dispatcher`` stamped for today's
+    sources (a run will load it), False if not (a run will compile it), None if this numba
+    does not say (its cache's internals differ)."""
+    try:
+        return bool(dispatcher._cache._cache_file._load_index())
+    except (AttributeError, OSError, EOFError, ValueError, pickle.UnpicklingError):
+        return None

@@ -14,6 +14,8 @@ import contextlib
 
 import numpy as np
 
+from ..discretise import stencil
+from ..discretise.kernel_cache import cached
 from ..result import ARRAYS, from_states
 
 #: Span [s] of the preparing run.
@@ -28,6 +30,16 @@ def _key(run, options):
 def ready(run, options):
     """True once :func:`prepare` has run for this backend and options in this process."""
     return _key(run, options) in _prepared
+
+
+def stage_text():
+    """What the preparing stage does, for the progress line: compiling (the first run after
+    installing rodmol or editing its kernels' sources; once, its machine code is cached) or
+    loading the kernels from the disk cache."""
+    if cached(stencil.rhs) is False:
+        return ("compiling the kernels (right-hand side, Jacobian, preconditioner, post-processing) "
+                "once: later runs load them from the cache")
+    return "preparing the compiled kernels"
 
 
 def prepare(system, t, y, run, rtol, atol, options):

@@ -38,3 +38,26 @@ def test_changing_any_kernel_source_changes_the_digest(tmp_path):
     loads = next(c for c in copies if c.name == "loads.py")
     loads.write_text(loads.read_text().replace("code", "code ", 1))  # e.g. a load kind's code edited
     assert kernel_cache.sources_digest(copies) != kernel_cache.DIGEST
+
+
+def test_cached_tells_whether_a_run_compiles_or_loads(tmp_path, monkeypatch):
+    """kernel_cache.cached reads numba's index: False before a kernel's first compilation,
+    True once its machine code is on disk; the progress line says which."""
+    import importlib.util
+
+    from rodmol.solve import kernels
+
+    script = tmp_path / "kernel_module.py"
+    script.write_text("import numba\n\n@numba.njit(cache=True)\ndef twice(x):\n    return 2.0 * x\n")
+    spec = importlib.util.spec_from_file_location("kernel_module", script)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    assert kernel_cache.cached(module.twice) is False
+    assert module.twice(1.5) == 3.0
+    assert kernel_cache.cached(module.twice) is True
+    assert kernel_cache.cached(lambda: None) is None  # not a numba kernel: no answer
+
+    monkeypatch.setattr(kernels, "cached", lambda dispatcher: False)
+    assert kernels.stage_text().startswith("compiling the kernels") and "once" in kernels.stage_text()
+    monkeypatch.setattr(kernels, "cached", lambda dispatcher: True)
+    assert kernels.stage_text() == "preparing the compiled kernels"
