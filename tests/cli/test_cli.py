@@ -162,7 +162,8 @@ def test_ctrl_c_while_writing_stops_between_frames(tmp_path, monkeypatch):
 
     result = rodmol.simulate(rodmol.scenarios.get("bending").model(6), 0.05, output_dt=0.01)
     interrupts = DeferredSignals()
-    interrupts.signal, interrupts.count, interrupts.forcing = signal.SIGINT, 1, False  # one stopped the solver
+    # one Ctrl-C stopped the solver already
+    interrupts.signal, interrupts.count, interrupts.forcing = signal.SIGINT, 1, False
     original = writers.SeriesWriter.write
 
     def write(self, result, k):

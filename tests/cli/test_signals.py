@@ -87,8 +87,8 @@ def resume(scenario, out, whole):
 def signalled(scenario, out, sig, after=None):
     """``rodmol run scenario --out out`` in a subprocess, sent ``sig`` once its first chunk file
     is written (``after``: that many seconds after it says it began); returns (exit code, stderr)."""
-    process = subprocess.Popen([sys.executable, "-u", "-m", "rodmol", "run", str(scenario), "--out", str(out)],
-                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    command = [sys.executable, "-u", "-m", "rodmol", "run", str(scenario), "--out", str(out)]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         if after is None:
             first, deadline = out / h5result.chunk_name(0), time.monotonic() + 120
@@ -119,8 +119,8 @@ def test_a_signal_stops_the_run_resumably_and_resume_ends_as_the_uninterrupted_r
 
 
 @pytest.mark.parametrize("kind", ["rod", "system"])
-def test_a_signal_inside_a_chunk_write_lets_it_finish_and_stops_after(scenarios, tmp_path, monkeypatch, capsys,
-                                                                       kind):
+def test_a_signal_inside_a_chunk_write_lets_it_finish_and_stops_after(scenarios, tmp_path, monkeypatch,
+                                                                       capsys, kind):
     """Where Python's own handler would raise: the chunk is written whole, the run stops at its next step."""
     scenario, whole = scenarios[kind]
     write_chunk, calls = h5result.write_chunk, []
@@ -128,7 +128,7 @@ def test_a_signal_inside_a_chunk_write_lets_it_finish_and_stops_after(scenarios,
     def signalled_write(*args, **kwargs):
         calls.append(args[1])
         if len(calls) == 3:
-            signal.raise_signal(signal.SIGINT)  # a system's own chunk: in the main thread, where the handler runs
+            signal.raise_signal(signal.SIGINT)  # a system's own chunk: in the main thread, the handler's
         return write_chunk(*args, **kwargs)
 
     monkeypatch.setattr(h5result, "write_chunk", signalled_write)
