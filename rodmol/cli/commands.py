@@ -140,8 +140,8 @@ def stopped(signum, out, result, streamed):
     if result is not None and result.success:
         return f"{what} after the run had finished: {out} holds the whole run"
     if not streamed:
-        return (f"{what}: the frames done are written to {out} (`--format vtp` cannot be resumed; "
-                "`--format xdmf` can)")
+        return (f"{what}: the frames written are in {out} (a run written as `--format vtp` cannot be "
+                "resumed; as `--format xdmf` it can)")
     if not any((Path(out) / index).is_file() for index in (h5result.INDEX, SYSTEM_INDEX)):
         return f"{what} before its first frame was written: nothing to resume, run it again"
     reached = "" if result is None or not len(result.t) else f" to t = {float(result.t[-1]):g} s"
@@ -152,7 +152,7 @@ def stopped(signum, out, result, streamed):
 def _run_system(args, spec, out, signals):
     """``rodmol run`` of a system file: the run, its files streamed while it goes (``--resume``
     continues a killed one with its recorded settings, ``--resume-anyway`` with the file's);
-    returns (exit code, result)."""
+    returns (exit code, result). ``signals`` is not needed: all its files are written while it goes."""
     if (args.format or spec.output.format) != "xdmf":
         raise ParameterError("a system's run is written as `--format xdmf` only")
     say = (lambda *a, **k: None) if args.quiet else print
