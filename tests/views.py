@@ -23,8 +23,9 @@ def view_grids(path):
     return grids
 
 
-def assert_valid_views(directory):
-    """Every view's grids point at existing frames of existing chunk files; returns the rod's times."""
+def assert_valid_views(directory, timed="rod.xdmf"):
+    """Every view's grids point at existing frames of existing chunk files; returns the times of
+    the view ``timed`` (the rod's; a system's directory: ``bodies.xdmf``)."""
     directory = Path(directory)
     times = None
     for view in sorted(directory.glob("*.xdmf")):
@@ -41,7 +42,7 @@ def assert_valid_views(directory):
                     if match:
                         assert list(dataset.shape) == [int(d) for d in match["dims"].split()], text
                         assert int(match["start"]) < dataset.shape[0], text
-        if view.name == "rod.xdmf":
+        if view.name == timed:
             times = [float(g.find("Time").get("Value")) for g in grids]
-    assert times is not None, "no rod.xdmf"
+    assert times is not None, f"no {timed}"
     return times

@@ -14,7 +14,9 @@ the settings it recorded (:mod:`rodmol._settings`).
 Exit codes: 0 done, 1 the solver failed, 2 bad scenario or arguments (or the
 output directory is in use by another run), 3 outputs could not be written
 (what was written is valid), 130 interrupted (Ctrl-C), 143 terminated
-(SIGTERM); an interrupted or terminated run keeps the frames done.
+(SIGTERM). A signal stops a run, a rod's or a system's alike, at the end of
+its current step (a second Ctrl-C stops it at once); the run keeps the
+frames done and, streamed, continues with ``--resume``.
 """
 
 import argparse
@@ -33,14 +35,18 @@ from ..output import h5result
 from ..output.formats import FORMATS, get_format
 from ..output.lock import OutputLock
 from ..output.run_files import cannot_write
+from ..output.system_files import INDEX as SYSTEM_INDEX
 from ..output.system_stream import SystemRunWriter
+from ..solve.interrupts import DeferredSignals
 from ..systems import System
 from .options import EXAMPLES, add_run_options, load_spec
 
 EXIT_FAILED, EXIT_USAGE, EXIT_OUTPUT, EXIT_INTERRUPTED = 1, 2, 3, 130
 #: Exit code of a run stopped by each signal (128 + the signal's number, as a shell reports it).
 EXIT_SIGNAL = {signal.SIGINT: 130, signal.SIGTERM: 143}
-__all__ = ["Progress", "main", "summary"]
+#: Said at the first signal: the run goes on to its next safe point (a step's end), then stops.
+STOPPING = "rodmol: stopping after the solver's current step (Ctrl-C again to stop at once)"
+__all__ = ["Progress", "main", "stopped", "summary"]
 
 
 def main(argv=None):
@@ -107,51 +113,79 @@ def _run(args):
     spec = load_spec(args)
     out = args.out or spec.output.directory or Path("out") / spec.name
     output_directory(out, "--out")  # before the run, so a directory that cannot be made does not waste it
-    with OutputLock(out):  # one run per output directory
-        if isinstance(spec.model, System):
-            return _run_system(args, spec, out)
-        return _run_locked(args, spec, out)
+    args.resume = "force" if args.resume_anyway else bool(args.resume)
+    if args.resume and args.overwrite:
+        raise ParameterError("give either `--resume` or `--overwrite`, not both")
+    system = isinstance(spec.model, System)
+    streamed = system or get_format(args.format or spec.output.format).sink is not None
+    # One signal path for a rod's run and a system's: a signal asks the run to stop at its next
+    # safe point (rodmol.solve.interrupts), which leaves its files whole and resumable.
+    with OutputLock(out), DeferredSignals(EXIT_SIGNAL, notice=STOPPING) as signals:  # one run per directory
+        try:
+            code, result = (_run_system if system else _run_rod)(args, spec, out, signals)
+        except KeyboardInterrupt:  # a second signal: stopped at once, the files as a kill leaves them
+            if signals.signal is None:
+                raise
+            code, result = None, None
+    if signals.signal is None:
+        return code
+    print(stopped(signals.signal, out, result, streamed), file=sys.stderr)
+    return EXIT_SIGNAL[signals.signal]
 
 
-def _run_system(args, spec, out):
+def stopped(signum, out, result, streamed):
+    """What a run stopped by the signal ``signum`` left in ``out``: whether and how it continues.
+    ``result``: the run's (None: stopped at once, by a second signal)."""
+    what = f"rodmol: {'interrupted' if signum == signal.SIGINT else 'terminated'} ({signum.name})"
+    if result is not None and result.success:
+        return f"{what} after the run had finished: {out} holds the whole run"
+    if not streamed:
+        return (f"{what}: the frames written are in {out} (a run written as `--format vtp` cannot be "
+                "resumed; as `--format xdmf` it can)")
+    if not any((Path(out) / index).is_file() for index in (h5result.INDEX, SYSTEM_INDEX)):
+        return f"{what} before its first frame was written: nothing to resume, run it again"
+    reached = "" if result is None or not len(result.t) else f" to t = {float(result.t[-1]):g} s"
+    return (f"{what}: the run in {out} is kept{reached} and can be resumed: run the same command with "
+            "`--resume` to continue it from its last complete chunk")
+
+
+def _run_system(args, spec, out, signals):
     """``rodmol run`` of a system file: the run, its files streamed while it goes (``--resume``
-    continues a killed one with its recorded settings, ``--resume-anyway`` with the file's)."""
+    continues a killed one with its recorded settings, ``--resume-anyway`` with the file's);
+    returns (exit code, result). ``signals`` is not needed: all its files are written while it goes."""
     if (args.format or spec.output.format) != "xdmf":
         raise ParameterError("a system's run is written as `--format xdmf` only")
     say = (lambda *a, **k: None) if args.quiet else print
     system = spec.model
     say(f"rodmol: {spec.name}: {len(system.rods)} rods, {len(system.bodies)} bodies, t_end = {spec.t_end:g} s, "
         f"{spec.solver['scheme']} scheme -> {out}")
-    resume, sink = "force" if args.resume_anyway else bool(args.resume), out
-    if resume and args.overwrite:
-        raise ParameterError("give either `--resume` or `--overwrite`, not both")
-    if not resume:  # the file's chunks and views (a resumed run keeps its own)
+    sink = out
+    if not args.resume:  # the file's chunks and views (a resumed run keeps its own)
         chunk_frames = spec.output.chunk_frames if args.chunk_frames is None else args.chunk_frames
         sink = SystemRunWriter(out, chunk_frames=chunk_frames, every=spec.output.every, overwrite=args.overwrite)
     progress = None if args.quiet else Progress(stream=sys.stdout)
     started = time.perf_counter()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # the summary gives the message
-        result = spec.simulate(progress=progress, out=sink, resume=resume)
+        result = spec.simulate(progress=progress, out=sink, resume=args.resume)
     if progress:
         progress.close()
-    state = "finished" if result.success else f"failed: {result.message}"
-    summary = (f"rodmol: {spec.name}: {state}; {len(result.t)} output frames to t = {result.t[-1]:g} s in "
+    state = "finished" if result.success else f"stopped: {result.message}"
+    reached = f" to t = {result.t[-1]:g} s" if len(result.t) else ""
+    summary = (f"rodmol: {spec.name}: {state}; {len(result.t)} output frames{reached} in "
                f"{time.perf_counter() - started:.3g} s, written to {out} (open bodies.xdmf and NAME/rod.xdmf)")
     if result.success:
         say(summary)  # --quiet: nothing but errors
     else:
         print(summary, file=sys.stderr)
-    return 0 if result.success else EXIT_FAILED
+    return (0 if result.success else EXIT_FAILED), result
 
 
-def _run_locked(args, spec, out):
+def _run_rod(args, spec, out, signals):
+    """``rodmol run`` of a single rod's file; returns (exit code, result)."""
     from ..output.run_files import refuse_replacing
 
     say = (lambda *a, **k: None) if args.quiet else print
-    args.resume = "force" if args.resume_anyway else args.resume
-    if args.resume and args.overwrite:
-        raise ParameterError("give either `--resume` or `--overwrite`, not both")
     if not args.resume:
         refuse_replacing(out, args.overwrite, "`--resume`", "`--overwrite`")
     model = spec.model
@@ -162,9 +196,6 @@ def _run_locked(args, spec, out):
         frame, t_restart, _ = writer.restart
         say(f"rodmol: resuming the run in {out} at t = {t_restart:g} s (frame {frame} of {len(writer.t_out) - 1}, "
             "its last complete chunk)")
-
-    interrupts = _Interrupts()
-    previous = {signum: signal.signal(signum, interrupts) for signum in EXIT_SIGNAL}
     try:
         progress = None if args.quiet else Progress(stream=sys.stdout)
         started = time.perf_counter()
@@ -175,7 +206,7 @@ def _run_locked(args, spec, out):
         wall = time.perf_counter() - started
         if progress:
             progress.close()
-        interrupts.raising = False  # from here, Ctrl-C stops writing between frames
+        signals.forcing = False  # from here, a signal stops writing between frames
         if writer is not None:  # written while the run went
             wall -= writer.seconds
             written = _streamed(writer, result)
@@ -183,45 +214,21 @@ def _run_locked(args, spec, out):
             result.meta.update(scenario=spec.source, name=spec.name)
             say(f"rodmol: writing {len(result.t)} frames to {out} (Ctrl-C stops between frames) ...")
             options = replace(spec.output, format=args.format or spec.output.format)
-            written = _write_outputs(result, options, out, interrupts)
+            written = _write_outputs(result, options, out, signals)
             written["seconds"] = time.perf_counter() - started - wall
     except OSError as exc:  # the streamed index could not be replaced: the previous one is valid
         if writer is None:
             raise
         print(f"rodmol: {cannot_write(out / h5result.INDEX, exc)}", file=sys.stderr)
-        return EXIT_OUTPUT
-    except KeyboardInterrupt:
-        print("\nrodmol: interrupted before the first frame; nothing written", file=sys.stderr)
-        return EXIT_SIGNAL.get(interrupts.signal, EXIT_INTERRUPTED)
-    finally:
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
+        return EXIT_OUTPUT, None
     if not args.quiet:
         print(summary(spec, result, wall, written))
     elif not result.success:
         print(f"rodmol: {spec.name}: {result.message}", file=sys.stderr)
     if "error" in written:
         print(f"rodmol: {written['error']}", file=sys.stderr)
-    if interrupts.count:
-        return EXIT_SIGNAL.get(interrupts.signal, EXIT_INTERRUPTED)
-    if "error" in written:
-        return EXIT_OUTPUT
-    return 0 if result.success else EXIT_FAILED
-
-
-class _Interrupts:
-    """SIGINT and SIGTERM handler (schedulers, ``timeout`` and ``docker stop``
-    send SIGTERM): raises KeyboardInterrupt (``raising``) or only counts.
-    Either way the frames done are kept."""
-
-    def __init__(self):
-        self.count, self.raising, self.signal = 0, True, None
-
-    def __call__(self, signum, frame):
-        self.count += 1
-        self.signal = signal.Signals(signum)
-        if self.raising:
-            raise KeyboardInterrupt
+        return EXIT_OUTPUT, result
+    return (0 if result.success else EXIT_FAILED), result
 
 
 def _stream_writer(args, spec, out):
@@ -250,10 +257,11 @@ def _streamed(writer, result):
     return written
 
 
-def _write_outputs(result, options, out, interrupts):
-    """Write the outputs of ``options.format`` after the run; stop between frames on a new Ctrl-C."""
-    before = interrupts.count
-    return get_format(options.format).write_run(result, options, out, lambda: interrupts.count > before)
+def _write_outputs(result, options, out, signals):
+    """Write the outputs of ``options.format`` after the run; stop between frames on a new signal
+    (``signals``: the run's :class:`~rodmol.solve.interrupts.DeferredSignals`)."""
+    before = signals.count
+    return get_format(options.format).write_run(result, options, out, lambda: signals.count > before)
 
 
 def summary(spec, result, wall, written):

@@ -122,6 +122,19 @@ def refuse_resuming_nothing(directory, restart):
                              "(make it with resume=True)")
 
 
+def chunks_kept(chunks, point):
+    """The chunks (name -> frames, in the run's order) that a run resumed from its restart frame
+    ``point`` keeps: those ending at or before it. A first chunk cut short after its first frame
+    ends at frame 0 but is not kept (none is, at ``point`` 0): the run is redone from the initial
+    state it holds, that first frame included, which keeping it would store twice."""
+    kept, frames = {}, 0
+    for name, n in chunks.items():
+        if frames + n - 1 > point or point == 0:
+            break
+        kept[name], frames = n, frames + n
+    return kept
+
+
 def cannot_write(path, exc):
     """The message of an output that could not be written (``exc``, an OSError, at ``path``)."""
     reason = exc.strerror or str(exc)

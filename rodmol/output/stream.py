@@ -327,11 +327,7 @@ class RunWriter:
         ``chunk_frames``; None: the last one); ``restart``: (its index, time, state)."""
         last = len(self.t) - 1
         point = last - last % self.chunk_frames if point is None else point
-        kept, frames = {}, 0
-        for name, n in self.chunks.items():
-            if frames + n - 1 > point:
-                break
-            kept[name], frames = n, frames + n
+        kept = run_files.chunks_kept(self.chunks, point)
         # The first chunk cut short: its first frame, the run's initial state, is the restart point.
         chunk, row = (list(kept)[-1], -1) if kept else (list(self.chunks)[0], 0)
         with damaged(self.directory / chunk):
@@ -339,7 +335,7 @@ class RunWriter:
         dropped = [name for name in self.chunks if name not in kept]
         self._dropped += dropped
         self.record.drop(dropped)
-        self.chunks, self.t = kept, self.t[:frames]
+        self.chunks, self.t = kept, self.t[:sum(kept.values())]
         self.restart = (point, t, state)
 
     def view_names(self):

@@ -256,11 +256,8 @@ class SystemRunWriter:
         self.forced, self._layout = list(info.get("forced") or []), info.get("parts")
         last = len(t) - 1
         point = last - last % self.chunk_frames
-        kept, frames = {}, 0
-        for name, n in index["chunks"].items():
-            if frames + n - 1 > point:
-                break
-            kept[name], frames = n, frames + n
+        kept = run_files.chunks_kept(index["chunks"], point)
+        frames = sum(kept.values())
         # The first chunk cut short: its first frame, the run's initial state, is the restart point.
         chunk, row = (list(kept)[-1], -1) if kept else (list(index["chunks"])[0], 0)
         with damaged(self.directory / chunk):

@@ -26,6 +26,7 @@ import numpy as np
 
 from ..discretise.system_preconditioner import SystemPreconditioner
 from ..errors import ParameterError
+from .interrupts import stop_reason
 from .outputs import RawSolution, cause
 from .watch import assembly_state_problem
 
@@ -52,13 +53,19 @@ class _NonFinite(Exception):
     """Raised inside the right-hand side when its rates were non-finite too often (its message says where)."""
 
 
+class _Interrupted(Exception):
+    """Raised inside the right-hand side, before its work, when a signal asked the run to stop
+    (:func:`rodmol.solve.interrupts.stop_reason`, its message): CVODE's step is left there."""
+
+
 def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, linsolver=None,
                  max_step=0.0, max_order="auto"):
     """Integrate ``assembly`` from ``y0`` at ``t_out[0]`` through the output
     times ``t_out`` [s].
 
     ``progress(t, t_end)`` is called at each output time; ``max_wall_time``
-    [s] is checked at every right-hand side, and ends the run when used up.
+    [s] is checked at every right-hand side, and ends the run when used up, as
+    does a stop asked by a signal (:mod:`rodmol.solve.interrupts`).
 
     ``max_order`` caps the BDF order; ``"auto"`` is 2 when a rod is lightly
     damped (``SemiDiscrete.lightly_damped``), else 5, as for one rod.
@@ -83,9 +90,15 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
     # (a segmentation fault, found by review): there the right-hand side keeps it, returns NaN
     # rates, which fail CVODE's step at once, and the step's caller raises it.
     kept = [None]
+    # There a signal's stop waits for the step to the next output: NaN rates would have CVODE
+    # retry and print its failure before the step's caller stops.
+    stop_inside = linsolver != "sparse"
 
     def rates(t, y, yp):
         evals[0] += 1
+        asked = stop_inside and stop_reason()
+        if asked:
+            raise _Interrupted(asked)
         if max_wall_time is not None and time.perf_counter() - start > max_wall_time:
             raise _OutOfTime
         assembly(t, y, yp)
@@ -123,9 +136,13 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
     if progress is not None:
         progress(float(t_out[0]), float(t_out[-1]))
     frames, message, error, jac_evals = [np.array(y0, dtype=float)], "", None, 0
-    solver = CVODE(kept_rates if linsolver == "sparse" else rates, **options)
-    solver.init_step(float(t_out[0]), frames[0])
-    for t_k in t_out[1:]:
+    asked = stop_reason()  # before the run: no solver made (a sparse one freed unstepped crashes)
+    if asked:
+        message = f"CVODE stopped after t = {float(t_out[0]):.6g} s: {asked}"
+    else:
+        solver = CVODE(kept_rates if linsolver == "sparse" else rates, **options)
+        solver.init_step(float(t_out[0]), frames[0])
+    for t_k in [] if asked else t_out[1:]:
         reached = float(t_out[len(frames) - 1])
         try:
             r = step(float(t_k))
@@ -135,7 +152,7 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
         except _OutOfTime:
             message = f"CVODE stopped after t = {reached:.6g} s: the wall-time budget max_wall_time = {max_wall_time:g} s is used up"
             break
-        except _NonFinite as exc:
+        except (_NonFinite, _Interrupted) as exc:
             message = f"CVODE stopped after t = {reached:.6g} s: {exc}"
             break
         except Exception as exc:  # noqa: BLE001 (a user function's: reported with the frames before)
@@ -157,6 +174,10 @@ def cvode_system(assembly, y0, t_out, *, rtol, atol, progress=None, max_wall_tim
             except Exception as exc:  # noqa: BLE001 (the user's callable, guarded: a UserFunctionError)
                 message, error = f"CVODE stopped at t = {float(t_k):.6g} s: {cause(exc)}", exc
                 break
+        asked = stop_reason()
+        if asked and len(frames) < len(t_out):  # between two steps (inside one: `rates`)
+            message = f"CVODE stopped after t = {float(t_k):.6g} s: {asked}"
+            break
     t, y = t_out[:len(frames)], np.array(frames)
     assembly.project_quaternions(y)
     success = len(t) == len(t_out)

@@ -19,7 +19,10 @@ Every accepted step (not only the output times) goes through
 * the wall-time budget ``max_wall_time`` (optional);
 * ``progress(t, t_end)`` is called when :data:`PROGRESS_INTERVAL` seconds of
   wall time passed since the last report, so a stall is seen and can be
-  stopped (Ctrl-C) between output times too.
+  stopped (Ctrl-C) between output times too;
+* a stop asked by a signal (:func:`rodmol.solve.interrupts.stop_reason`,
+  the command line's Ctrl-C and SIGTERM): the step is where the run stops
+  safely.
 
 The same scan checks the static equilibrium and a user's initial state
 (:func:`state_problem`; a system's, each rod's part: :func:`assembly_state_problem`).
@@ -32,6 +35,7 @@ import numba
 import numpy as np
 
 from ..discretise.layout import BLOCK, HEADER, QUAT, K, Q
+from .interrupts import stop_reason
 
 #: Axial stretch q1 at or below which an element counts as inverted or collapsed.
 MIN_STRETCH = 0.05
@@ -189,7 +193,11 @@ class Watch:
                 f"(tip strain q1 = {q1:.3g}): the load is beyond what the rod can carry")
 
     def pace(self, t, y):
-        """After the outputs of a step: the stall test, the wall-time budget, progress."""
+        """After the outputs of a step: a stop asked by a signal, the stall test, the wall-time
+        budget, progress."""
+        asked = stop_reason()
+        if asked:
+            return asked
         if self.steps and self.steps % STALL_WINDOW == 0 and self.steps != self._checked:
             self._checked = self.steps
             covered, self._window_start = t - self._window_start, t

@@ -20,6 +20,7 @@ from cli_helpers import (
 from views import assert_valid_views
 
 import rodmol
+from rodmol.solve.interrupts import DeferredSignals
 
 
 @pytest.mark.subprocess
@@ -160,8 +161,9 @@ def test_ctrl_c_while_writing_stops_between_frames(tmp_path, monkeypatch):
     from rodmol.output.options import OutputOptions
 
     result = rodmol.simulate(rodmol.scenarios.get("bending").model(6), 0.05, output_dt=0.01)
-    interrupts = cli._Interrupts()
-    interrupts.count, interrupts.raising = 1, False  # one Ctrl-C already stopped the solver
+    interrupts = DeferredSignals()
+    # one Ctrl-C stopped the solver already
+    interrupts.signal, interrupts.count, interrupts.forcing = signal.SIGINT, 1, False
     original = writers.SeriesWriter.write
 
     def write(self, result, k):

@@ -152,9 +152,12 @@ def test_resume_after_ctrl_c_redoes_the_chunk_cut_short(model, whole, tmp_path):
     assert first["steps"] + second["steps"] > resumed.stats["steps"]  # the chunk cut short was redone
 
 
-def test_resume_after_ctrl_c_in_the_first_chunk_starts_from_the_initial_state(model, whole, tmp_path):
+@pytest.mark.parametrize("at", [0.05, -1.0], ids=["in-the-first-chunk", "after-the-first-frame"])
+def test_resume_after_ctrl_c_in_the_first_chunk_starts_from_the_initial_state(model, whole, tmp_path, at):
+    """A first chunk cut short after its first frame was kept, and the resumed run stored that frame twice."""
     with pytest.warns(RuntimeWarning, match="interrupted"):
-        rodmol.simulate(model, 0.5, rtol=RTOL, out=RunWriter(tmp_path, chunk_frames=20), progress=Interrupt(0.05))
+        cut = rodmol.simulate(model, 0.5, rtol=RTOL, out=RunWriter(tmp_path, chunk_frames=20), progress=Interrupt(at))
+    assert (len(cut.t) == 1) == (at < 0)
     resumed = rodmol.simulate(model, 0.5, out=tmp_path, resume=True)
     reference = rodmol.simulate(model, 0.5, rtol=RTOL, out=RunWriter(tmp_path / "whole", chunk_frames=20))
     assert resumed.stats["resumed_at"] == 0.0

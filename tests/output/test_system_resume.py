@@ -69,10 +69,12 @@ def test_a_killed_run_resumes_to_the_uninterrupted_one(two_arms, whole, tmp_path
     assert resumed.stats["rhs_evals"] < whole.stats["rhs_evals"]  # frames 4-10 only
 
 
-@pytest.mark.parametrize("at, frames", [(0.065, (5, 7)), (0.015, (2, 3))])  # in the second chunk, the first
+# In the second chunk, the first, after the first frame.
+@pytest.mark.parametrize("at, frames", [(0.065, (5, 7)), (0.015, (2, 3)), (-1.0, (1, 1))])
 def test_an_interrupted_run_keeps_its_frames_and_resumes(two_arms, whole, tmp_path, monkeypatch, at, frames):
     """Cut inside the first chunk, the rods' reopening rolled back to frame 0 already, and the
-    system's roll-back to it raised an IndexError after emptying system.h5 (found by review)."""
+    system's roll-back to it raised an IndexError after emptying system.h5 (found by review);
+    cut after its first frame, the chunk holding only that frame was kept, and stored twice."""
     rates = Assembly.__call__
 
     def ctrl_c(self, t, y, out=None):  # Ctrl-C inside CVODE's step
