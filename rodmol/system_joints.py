@@ -9,9 +9,11 @@ import numpy as np
 
 from . import _checks
 from .errors import ParameterError
+from .load_kinds import HOLD_KINDS
 
-#: Joint kinds: "clamp" holds the position and the orientation, "pin" the position only (a ball joint).
-JOINT_KINDS = ("clamp", "pin")
+#: Joint kinds: a joint is held by the Hold law ("clamp" holds the position and
+#: the orientation, "pin" the position only: a ball joint), so its kinds are the holds'.
+JOINT_KINDS = HOLD_KINDS
 #: Named ends of a rod a joint may hold (else an arc length s [m], a velocity node).
 ROD_ENDS = ("base", "tip")
 

@@ -64,7 +64,7 @@ def joint_law(joint, parts, omega):
     a, b = parts
     turn = np.eye(3) if b is None else a.body.rotation.T @ b.body.rotation
     g = mobility(a, joint.point_a) + mobility(b, joint.point_b, turn)
-    clamp = joint.kind == "clamp"
+    clamp = KERNELS[joint.kind].holds_turning
     k = omega**2 / np.linalg.eigvalsh(g[:3, :3])[-1] if joint.stiffness is None else joint.stiffness
     k_r = k * np.linalg.eigvalsh(g[:3, :3])[-1] / np.linalg.eigvalsh(g[3:, 3:])[-1] if clamp else 0.0
     size = 6 if clamp else 3
