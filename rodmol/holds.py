@@ -16,8 +16,22 @@ from .errors import ParameterError
 from .load_kinds import HOLD_KINDS, KERNELS
 
 #: Default hold stiffness, as a multiple of the held element's axial
-#: stiffness E A / ds (docs/model.md: the measured drift and cost).
+#: stiffness E A / ds times the rod's length over ds (:func:`default_stiffness`;
+#: docs/model.md: the measured drift and cost).
 HOLD_STIFFNESS_FACTOR = 100.0
+
+
+def default_stiffness(axial_stiffness, ds, length):
+    """The default stiffness [N/m] of a hold at a node whose element has the
+    axial stiffness E A / ds ``axial_stiffness`` [N/m], on a rod of ``length``
+    [m] and elements ``ds`` [m]: HOLD_STIFFNESS_FACTOR E A L / ds^2.
+
+    Its compliance is ds / (HOLD_STIFFNESS_FACTOR L) of an element's, O(ds^2)
+    against the whole rod's, as the scheme's own error: joints at the rods'
+    ends converge at second order (with E A / ds alone their compliance, ds /
+    100 of an element's, was a first-order term; docs/systems.md, "Joints at
+    rods' ends")."""
+    return HOLD_STIFFNESS_FACTOR * axial_stiffness * length / ds
 
 
 @dataclass(frozen=True)
@@ -40,7 +54,8 @@ class Hold:
     rotation : (3, 3) rotation matrix (its columns the section's axes, global)
         held by a clamp; default: the section's orientation at rest.
     stiffness : penalty stiffness [N/m]; default ``HOLD_STIFFNESS_FACTOR``
-        times the held element's axial stiffness E A / ds.
+        times the held element's axial stiffness E A / ds times L / ds
+        (:func:`default_stiffness`: its compliance O(ds^2) against the rod's).
     damping : penalty damping [N s/m]; default critical for the node's own
         mass, 2 sqrt(stiffness m) with m = rho A ds (added mass left out).
     name : used in messages and in the result's ``meta["loads"]``.
