@@ -48,9 +48,10 @@ class Joint:
         Of a penalty joint (any node but the base): as for
         :class:`rodmol.Hold` [N/m, N s/m], whose law and defaults it takes.
         Of a joint between bodies (or a pinned base) the defaults put the
-        joint's fastest mode at the frequency of a rod node on its default
-        Hold (the system's fastest) and damp every mode of the joint at
-        least critically (:func:`rodmol.discretise.body_joints.joint_law`;
+        joint's fastest mode at the frequency of a rod element on 100 E A /
+        ds (the system's fastest; at a pinned, joined or branched base, of
+        its rod's node on its default Hold) and damp every mode of the joint
+        at least critically (:func:`rodmol.discretise.body_joints.joint_law`;
         docs/systems.md, "Joints of bodies"); a given stiffness [N/m] is the
         translational one, the turning one scaled with it.
     """
