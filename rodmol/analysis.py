@@ -46,7 +46,7 @@ def _hold_energy(g, u, states, layout):
     """Penalty energy [J] of the held points (rodmol.Hold) in every frame, at the
     integrated positions ``u`` (n_t, N, 3) and the states' quaternions."""
     out = np.zeros(len(u))
-    held = np.flatnonzero(np.isin(g.kind, (external.PIN, external.CLAMP)))
+    held = np.flatnonzero(np.isin(g.kind, external.HOLDS))
     if held.size:
         quat = layout.field(np.asarray(states), "Q")
     for e in held:
@@ -61,7 +61,7 @@ def _contact_energy(g, u, lengths):
     (n_t, N, 3) of the velocity nodes (those the contact law sees); ``g``
     the system's loads on the grid."""
     out = np.zeros(len(u))
-    for e in np.flatnonzero(np.isin(g.kind, (external.PLANE, external.CAPSULE))):
+    for e in np.flatnonzero(np.isin(g.kind, external.CONTACTS)):
         node, params = int(g.node[e]) - 1, g.params[e]
         weight = g.weight[e] * lengths[node]
         for i in range(len(u)):

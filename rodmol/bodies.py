@@ -8,7 +8,7 @@ import numpy as np
 from . import _checks
 from .base_motion import BaseMotion
 from .errors import ParameterError
-from .loads import SMOOTHING_FRACTION, CapsuleContact, PlaneContact
+from .loads import CONTACT_NAMES, CONTACT_SHAPES, SMOOTHING_FRACTION
 from .meshes import mesh_properties  # noqa: F401 (its home before rodmol.meshes)
 from .meshes import read_surface, solid_properties
 
@@ -160,8 +160,7 @@ def _contact_geometry(body):
     """Check and set a body's ``contacts`` (a tuple), ``contact_points`` ((n, 3) [m], body frame),
     ``contact_radius`` ((n,) [m]) and ``contact_smoothing``, the default smoothing depth [m]."""
     put = object.__setattr__
-    contacts = _checks.items("contacts", body.contacts, (PlaneContact, CapsuleContact),
-                             "a rodmol.PlaneContact, CapsuleContact or SphereContact")
+    contacts = _checks.items("contacts", body.contacts, CONTACT_SHAPES, f"a {CONTACT_NAMES}")
     put(body, "contacts", contacts)
     points = np.zeros((0, 3)) if body.contact_points is None else _checks.floats(body.contact_points)
     if points is None or points.ndim != 2 or points.shape[1] != 3 or not np.all(np.isfinite(points)):

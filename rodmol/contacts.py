@@ -1,21 +1,19 @@
 """Rods touching rigid bodies: :class:`Contact`, a body's shape that chosen
 rods of a :class:`rodmol.System` touch (an arm grasping a payload).
 
-The shape is a contact load of the rods (:class:`rodmol.PlaneContact`,
-:class:`rodmol.CapsuleContact`, :func:`rodmol.SphereContact`: the same
+The shape is a contact load of the rods (one of
+:data:`rodmol.loads.CONTACT_SHAPES`: :class:`rodmol.PlaneContact`,
+:class:`rodmol.CapsuleContact`, :func:`rodmol.SphereContact`, the same
 penalty law with friction) given in the body's frame: the body carries it
-and feels the rods' contact forces with the opposite sign
+(the shape's ``placed``) and feels the rods' contact forces with the opposite sign
 (:mod:`rodmol.discretise.contact_parts`).
 """
 
-import dataclasses
 from dataclasses import dataclass
-
-import numpy as np
 
 from . import _checks
 from .errors import ParameterError
-from .loads import CapsuleContact, PlaneContact
+from .loads import CONTACT_NAMES, CONTACT_SHAPES
 
 
 @dataclass(frozen=True)
@@ -49,9 +47,9 @@ class Contact:
         if not rods:
             raise ParameterError("Contact `rods` must name at least one rod")
         object.__setattr__(self, "rods", rods)
-        if not isinstance(self.shape, (PlaneContact, CapsuleContact)):
-            raise ParameterError("Contact `shape` must be a rodmol.PlaneContact, CapsuleContact or "
-                                 f"SphereContact (in the body frame), got {_checks.short(self.shape)}")
+        if not isinstance(self.shape, CONTACT_SHAPES):
+            raise ParameterError(f"Contact `shape` must be a {CONTACT_NAMES} (in the body frame), got "
+                                 f"{_checks.short(self.shape)}")
 
 
 @dataclass(frozen=True)
@@ -66,13 +64,6 @@ class RodContact:
     body: str
     shape: object
 
-    def geometry(self):
-        """The shape's (6,) points and direction, body frame: a capsule's start
-        and end [m], a plane's point [m] and normal."""
-        if isinstance(self.shape, PlaneContact):
-            return np.concatenate([self.shape.point, self.shape.normal])
-        return np.concatenate([self.shape.start, self.shape.end])
-
 
 def attach(contacts, rods, bodies):
     """The rods (a dict of name to Model) with each contact's shape added to
@@ -84,12 +75,7 @@ def attach(contacts, rods, bodies):
             raise ParameterError(f"`contacts[{i}]` names the body {contact.body!r}, which is not in `bodies`"
                                  f"{_checks.did_you_mean(contact.body, bodies)}")
         body, shape = bodies[contact.body], contact.shape
-        if isinstance(shape, PlaneContact):
-            placed = dataclasses.replace(shape, point=body.position + body.rotation @ shape.point,
-                                         normal=body.rotation @ shape.normal, name=f"contacts[{i}]")
-        else:
-            placed = dataclasses.replace(shape, start=body.position + body.rotation @ shape.start,
-                                         end=body.position + body.rotation @ shape.end, name=f"contacts[{i}]")
+        placed = shape.placed(body.position, body.rotation, f"contacts[{i}]")
         for rod in contact.rods:
             if rod not in rods:
                 raise ParameterError(f"`contacts[{i}]` names the rod {rod!r}, which is not in `rods`"

@@ -1,7 +1,8 @@
 """Points of the rod held to the world: :class:`Hold`, a pin or a clamp.
 
-A load kind of :mod:`rodmol.loads` (its records ``"pin"`` and ``"clamp"`` in
-``KERNELS``, its ``[[load]] type = "hold"`` in ``SCENARIO_TYPES``); the grid
+A load kind of :mod:`rodmol.loads` (its kinds, ``"pin"`` and ``"clamp"``,
+are the records of quantity ``"hold"`` in :data:`rodmol.load_kinds.KERNELS`;
+its ``[[load]] type = "hold"`` in ``SCENARIO_TYPES``); the grid
 places it on its node (:mod:`rodmol.discretise.load_entries`) and the
 compiled law is :func:`rodmol.discretise.external.hold`. With the base clamp,
 a hold at the tip gives a rod held at both ends (docs/model.md, "Held points").
@@ -12,11 +13,25 @@ from typing import Any
 
 from . import _checks
 from .errors import ParameterError
+from .load_kinds import HOLD_KINDS, KERNELS
 
 #: Default hold stiffness, as a multiple of the held element's axial
-#: stiffness E A / ds (docs/model.md: the measured drift and cost).
+#: stiffness E A / ds times the rod's length over ds (:func:`default_stiffness`;
+#: docs/model.md: the measured drift and cost).
 HOLD_STIFFNESS_FACTOR = 100.0
-HOLD_KINDS = ("pin", "clamp")
+
+
+def default_stiffness(axial_stiffness, ds, length):
+    """The default stiffness [N/m] of a hold at a node whose element has the
+    axial stiffness E A / ds ``axial_stiffness`` [N/m], on a rod of ``length``
+    [m] and elements ``ds`` [m]: HOLD_STIFFNESS_FACTOR E A L / ds^2.
+
+    Its compliance is ds / (HOLD_STIFFNESS_FACTOR L) of an element's, O(ds^2)
+    against the whole rod's, as the scheme's own error: joints at the rods'
+    ends converge at second order (with E A / ds alone their compliance, ds /
+    100 of an element's, was a first-order term; docs/systems.md, "Joints at
+    rods' ends")."""
+    return HOLD_STIFFNESS_FACTOR * axial_stiffness * length / ds
 
 
 @dataclass(frozen=True)
@@ -39,7 +54,8 @@ class Hold:
     rotation : (3, 3) rotation matrix (its columns the section's axes, global)
         held by a clamp; default: the section's orientation at rest.
     stiffness : penalty stiffness [N/m]; default ``HOLD_STIFFNESS_FACTOR``
-        times the held element's axial stiffness E A / ds.
+        times the held element's axial stiffness E A / ds times L / ds
+        (:func:`default_stiffness`: its compliance O(ds^2) against the rod's).
     damping : penalty damping [N s/m]; default critical for the node's own
         mass, 2 sqrt(stiffness m) with m = rho A ds (added mass left out).
     name : used in messages and in the result's ``meta["loads"]``.
@@ -64,9 +80,10 @@ class Hold:
         if self.position is not None:
             object.__setattr__(self, "position", _checks.vector3(f"{name} position", self.position))
         if self.rotation is not None:
-            if self.kind != "clamp":
-                raise ParameterError(f"{name}: `rotation` is held by kind='clamp' only (a pin turns "
-                                     f"freely), got kind={self.kind!r}")
+            if not KERNELS[self.kind].holds_turning:
+                turning = [kind for kind in HOLD_KINDS if KERNELS[kind].holds_turning]
+                raise ParameterError(f"{name}: `rotation` is held by kind={' or '.join(map(repr, turning))} only "
+                                     f"(a {self.kind} leaves the section free to turn), got kind={self.kind!r}")
             object.__setattr__(self, "rotation", _checks.rotation(f"{name} rotation", self.rotation))
         if self.stiffness is not None:
             object.__setattr__(self, "stiffness", _checks.positive(f"{name} stiffness", self.stiffness,

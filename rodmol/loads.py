@@ -20,6 +20,8 @@ around s, linearly (a share that falls on the clamped base goes into the
 clamp); distributed and contact loads act at every node but the base.
 """
 
+import dataclasses
+import typing
 from dataclasses import dataclass
 from typing import Any
 
@@ -29,38 +31,12 @@ from . import _checks
 from .errors import ParameterError, RodmolError
 from .holds import Hold
 from .inputs import as_time_input
+from .load_kinds import KERNELS, Kernel  # noqa: F401 (the records, read through rodmol.loads too)
 
 FRAMES = ("global", "local")
 #: Default contact smoothing depth, as a fraction of the section radius.
 SMOOTHING_FRACTION = 0.01
 
-
-@dataclass(frozen=True)
-class Kernel:
-    """One branch of the compiled load kernel (:func:`rodmol.discretise.external.load`).
-
-    ``code`` is its number in the kernel; ``depends`` the state fields of its
-    own element block it reads (the Jacobian's pattern, colouring and
-    preconditioner are derived from them); ``quantity`` is ``"force"``,
-    ``"moment"`` (what the load scale adds up) or ``"contact"``.
-    """
-
-    code: int
-    depends: tuple
-    quantity: str
-
-
-#: The kernel's branches, by name; a load names its branch in ``kernel``.
-KERNELS = {
-    "follower_force": Kernel(0, (), "force"),
-    "dead_force": Kernel(1, ("Q",), "force"),
-    "follower_moment": Kernel(2, (), "moment"),
-    "dead_moment": Kernel(3, ("Q",), "moment"),
-    "plane": Kernel(4, ("u", "Q", "v", "w"), "contact"),
-    "capsule": Kernel(5, ("u", "Q", "v", "w"), "contact"),
-    "pin": Kernel(6, ("u", "Q", "v"), "hold"),
-    "clamp": Kernel(7, ("u", "Q", "v", "w"), "hold"),
-}
 
 # The parameter row a load hands its kernel at each node (``params``): the
 # contact kinds' geometry (plane: point, normal; capsule: start, end,
@@ -278,8 +254,31 @@ class _Contact(_Load):
             object.__setattr__(self, "smoothing_depth", _checks.positive(
                 f"{name} smoothing_depth", self.smoothing_depth, " m"))
 
+    #: The fields holding the shape's 3-vectors, in the order of its record's
+    #: ``geometry`` roles (:data:`rodmol.load_kinds.KERNELS`), then those of its
+    #: scalars: together they open its parameter row.
+    vectors, scalars = (), ()
+
     def _law(self):
         return [self.stiffness, self.damping, self.friction, self.slip_speed]
+
+    def _geometry(self):
+        row = [float(x) for f in self.vectors for x in getattr(self, f)] + [float(getattr(self, f))
+                                                                          for f in self.scalars]
+        return row + [0.0] * (P_STIFFNESS - len(row))
+
+    def shape_vectors(self):
+        """(n, 3) the shape's 3-vectors [m or -], in its own frame (a body's, for a rodmol.Contact)."""
+        return np.array([getattr(self, f) for f in self.vectors], dtype=float)
+
+    def placed(self, position, rotation, name):
+        """This shape, given in a body's frame, where the body's pose (``position``
+        [m], ``rotation``, global) puts it, named ``name``: its points moved and
+        turned with the body, its directions turned (the roles of its record's ``geometry``)."""
+        roles = KERNELS[self.kernel].geometry
+        moved = {f: rotation @ getattr(self, f) + (position if role == "point" else 0.0)
+                 for f, role in zip(self.vectors, roles)}
+        return dataclasses.replace(self, name=name, **moved)
 
     def params(self, radius):
         """The kernel's parameter rows at nodes of section radius ``radius`` [m]."""
@@ -317,7 +316,7 @@ class PlaneContact(_Contact):
     slip_speed: float = 1e-4
     smoothing_depth: float | None = None
     name: str = "plane contact"
-    kernel = "plane"
+    kernel, vectors = "plane", ("point", "normal")
 
     def __post_init__(self):
         object.__setattr__(self, "point", _checks.vector3(f"{self.name} point", self.point))
@@ -326,9 +325,6 @@ class PlaneContact(_Contact):
             raise ParameterError(f"{self.name}: `normal` must not be zero, got {self.normal!r}")
         object.__setattr__(self, "normal", n / np.linalg.norm(n))
         self._check_common()
-
-    def _geometry(self):
-        return [*self.point, *self.normal, 0.0]
 
 
 @dataclass(frozen=True)
@@ -345,7 +341,7 @@ class CapsuleContact(_Contact):
     slip_speed: float = 1e-4
     smoothing_depth: float | None = None
     name: str = "capsule contact"
-    kernel = "capsule"
+    kernel, vectors, scalars = "capsule", ("start", "end"), ("radius",)
 
     def __post_init__(self):
         object.__setattr__(self, "start", _checks.vector3(f"{self.name} start", self.start))
@@ -353,12 +349,9 @@ class CapsuleContact(_Contact):
         object.__setattr__(self, "radius", _checks.positive(f"{self.name} radius", self.radius, " m"))
         self._check_common()
 
-    def _geometry(self):
-        return [*self.start, *self.end, self.radius]
-
 
 def SphereContact(centre, radius, stiffness, damping=0.0, friction=0.0, slip_speed=1e-4,  # noqa: N802
-                  smoothing_depth=None, name="sphere contact"):
+                  smoothing_depth=None, name="sphere contact") -> CapsuleContact:
     """Contact with a sphere of ``radius`` [m] around ``centre`` [m] (global):
     a :class:`CapsuleContact` whose segment is a point."""
     return CapsuleContact(centre, centre, radius, stiffness, damping, friction, slip_speed,
@@ -387,6 +380,17 @@ SCENARIO_TYPES = {
     "hold": (Hold, {"s": "m", "position": "m", "rotation": "-", "stiffness": "N/m",
                     "damping": "N s/m", "kind": "-"}),
 }
+
+
+def _builds(build):
+    """The class a scenario type's constructor makes (a function's: its return annotation)."""
+    return build if isinstance(build, type) else typing.get_type_hints(build)["return"]
+
+
+#: The contact shapes (a rodmol.Contact's and a rigid body's ``contacts`` take them).
+CONTACT_SHAPES = tuple(kind for kind in LOAD_TYPES if issubclass(kind, _Contact))
 #: The contact types of :data:`SCENARIO_TYPES` (a rigid body's ``[[body.contact]]`` takes them too).
-CONTACT_TYPES = tuple(kind for kind, (build, _) in SCENARIO_TYPES.items()
-                      if build in (PlaneContact, CapsuleContact, SphereContact))
+CONTACT_TYPES = tuple(kind for kind, (build, _) in SCENARIO_TYPES.items() if issubclass(_builds(build), _Contact))
+_constructors = [SCENARIO_TYPES[kind][0].__name__ for kind in CONTACT_TYPES]
+#: How messages name the contact shapes: "rodmol.PlaneContact, SphereContact or CapsuleContact".
+CONTACT_NAMES = f"rodmol.{', '.join(_constructors[:-1])} or {_constructors[-1]}"

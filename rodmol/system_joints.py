@@ -9,9 +9,11 @@ import numpy as np
 
 from . import _checks
 from .errors import ParameterError
+from .load_kinds import HOLD_KINDS
 
-#: Joint kinds: "clamp" holds the position and the orientation, "pin" the position only (a ball joint).
-JOINT_KINDS = ("clamp", "pin")
+#: Joint kinds: a joint is held by the Hold law ("clamp" holds the position and
+#: the orientation, "pin" the position only: a ball joint), so its kinds are the holds'.
+JOINT_KINDS = HOLD_KINDS
 #: Named ends of a rod a joint may hold (else an arc length s [m], a velocity node).
 ROD_ENDS = ("base", "tip")
 
@@ -46,9 +48,10 @@ class Joint:
         Of a penalty joint (any node but the base): as for
         :class:`rodmol.Hold` [N/m, N s/m], whose law and defaults it takes.
         Of a joint between bodies (or a pinned base) the defaults put the
-        joint's fastest mode at the frequency of a rod node on its default
-        Hold (the system's fastest) and damp every mode of the joint at
-        least critically (:func:`rodmol.discretise.body_joints.joint_law`;
+        joint's fastest mode at the frequency of a rod element on 100 E A /
+        ds (the system's fastest; at a pinned, joined or branched base, of
+        its rod's node on its default Hold) and damp every mode of the joint
+        at least critically (:func:`rodmol.discretise.body_joints.joint_law`;
         docs/systems.md, "Joints of bodies"); a given stiffness [N/m] is the
         translational one, the turning one scaled with it.
     """

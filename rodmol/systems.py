@@ -32,6 +32,7 @@ from .bodies import RigidBody
 from .contacts import Contact, attach
 from .errors import ParameterError
 from .holds import Hold
+from .load_kinds import KERNELS
 from .model import Model
 from .parameters import Medium
 from .system_joints import BodyJoint, Joint, PenaltyJoint
@@ -146,7 +147,7 @@ class System:
                 if rod in clamps:
                     raise ParameterError(f"`joints[{i}]`: the base of rod {rod!r} is already jointed; hold a "
                                          "rod's other nodes by joints at its tip or at an arc length s")
-                if joint.kind == "pin":
+                if not KERNELS[joint.kind].holds_turning:  # only a clamp's base is eliminated
                     clamps[rod] = self._pinned_base(i, joint, rod, other)
                     continue
                 if joint.stiffness is not None or joint.damping is not None:
@@ -256,7 +257,7 @@ class System:
                                      f"at {tuple(map(float, point_b))}, but at rest the two points are {gap:.3g} m apart: "
                                      "place the bodies (their `position`, `rotation`) so that they meet")
             turn_gap = float(np.linalg.norm(body_b.rotation @ turn_b - frame))
-            if joint.kind == "clamp" and turn_gap > 1e-9:
+            if KERNELS[joint.kind].holds_turning and turn_gap > 1e-9:
                 raise ParameterError(f"`joints[{i}]` clamps bodies {name_a!r} and {name_b!r} with joint frames "
                                      f"that differ at rest (by {turn_gap:.3g}): give one rotation or matching ones")
         if not free:

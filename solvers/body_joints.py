@@ -10,8 +10,9 @@
   tip pinned (a Hold), settling under its weight for 0.3 s.
 
 For stiffnesses k = factor times the default (the joint's reduced mass
-times the squared frequency of a rod node on its default Hold, damping
-critical: docs/systems.md, "Joints of bodies"), each system runs through
+times a squared frequency: between bodies a rod element's on 100 E A / ds,
+at the pinned base its rod's node on its default Hold; damping critical:
+docs/systems.md, "Joints of bodies"), each system runs through
 ``rodmol.simulate`` (CVODE, default tolerances) with GMRES and the block
 preconditioner (the free bodies with joints between them, and the pinned
 bases with their rods, in its Schur complement) and with the sparse direct
@@ -130,7 +131,8 @@ def main(argv=None):
                    rhs_over_reference=".2f", solver_s=".3f", solver_over_reference=".2f")
     C.write_results(args, "body_joints", "Joints of bodies and pinned bases: drift and cost against the stiffness",
                     header, rows, [
-                        ("k = factor times the default (reduced mass times a held rod node's squared frequency), "
+                        ("k = factor times the default (reduced mass times a held rod node's squared frequency: "
+                         "docs/systems.md), "
                          "damping critical; drift over the pendulum's arm (0.1 m) or the beam's length; ratios to "
                          "the reference of the module docstring, same run, same linear solver",
                          C.markdown_table(rows, formats=formats))])

@@ -15,8 +15,9 @@ error it makes, the rest tip reaction against that of a pin of factor 1e4
 the round-off floor of the residual grows with k); CVODE's steps, right-hand
 sides, the solver's wall time and the whole call's (with the initial
 equilibrium and the Result), each as a ratio to the same rod with its tip
-free (measured in the same run, median of --reps). The default factor
-(``rodmol.holds.HOLD_STIFFNESS_FACTOR``) is marked.
+free (measured in the same run, median of --reps). The default
+(``rodmol.holds.default_stiffness``: factor HOLD_STIFFNESS_FACTOR L / ds,
+4000 at N = 40) is added and marked.
 
     python solvers/holds.py [--quick | --smoke] [--out DIR] [--reps K]
 """
@@ -89,7 +90,8 @@ def main(argv=None):
         res_free, wall_free, solver_free = timed(free, start, t_end, args.reps)
         stiff = build(n, hold_for(free, REFERENCE_FACTOR))
         reference = tip_reaction(stiff, rodmol.equilibrium(stiff, loaded))
-        for factor in factors:
+        default = HOLD_STIFFNESS_FACTOR * free.rod.length / free.ds
+        for factor in sorted({*factors, default}):
             model = build(n, hold_for(free, factor))
             rest = rodmol.equilibrium(model, loaded)
             held = model.loads[-1]
@@ -98,7 +100,7 @@ def main(argv=None):
             drift = np.linalg.norm(res.integrated_positions[:, -1] - p, axis=1)
             length = model.rod.length
             rows.append(dict(
-                problem=name, N=n, factor=factor, default=factor == HOLD_STIFFNESS_FACTOR,
+                problem=name, N=n, factor=factor, default=factor == default,
                 stiffness_N_per_m=held.stiffness, success=res.success,
                 rest_drift_over_L=float(np.linalg.norm(rodmol.StateLayout(n).field(rest, "u")[-1] - p) / length),
                 max_drift_over_L=float(np.max(drift) / length),

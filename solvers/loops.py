@@ -23,7 +23,8 @@ Two systems whose loops close through penalty joints:
   50 ms), no gravity.
 
 For penalty stiffnesses k = factor E A / ds of the tip element (damping
-2 sqrt(k m), m = rho A ds, the Hold's default law), each system runs through
+2 sqrt(k m), m = rho A ds, the Hold's default law), and the default
+stiffness (the Hold's, 100 E A L / ds^2: factor 100 L / ds, marked), each system runs through
 ``rodmol.simulate`` (CVODE, default tolerances) with the sparse direct
 solver and with GMRES and the block preconditioner (the free bodies with
 penalty joints eliminated by their Schur complement). The table gives the drift |u - x - R p| of
@@ -32,7 +33,7 @@ rods, the nodes' distance), CVODE's
 right-hand sides and the solver's wall time, each also as a ratio to the same
 rods with free tips and no body (the joints' cost), measured in the same
 run, medians of --reps. A second table takes the systems of joints between
-rods at the default stiffness through N = 8, 32, 100 per rod: right-hand
+rods at the default stiffness (None: the Hold's law) through N = 8, 32, 100 per rod: right-hand
 sides and wall times of GMRES (the rod-rod joints' blocks in its
 preconditioner, :mod:`rodmol.discretise.rod_joint_coupling`) and of the
 sparse solver, their ratios, and the largest distance between the two
@@ -53,8 +54,16 @@ UP = np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]])  # a leg's x
 
 
 def _stiffness(model, factor):
+    """factor E A / ds of the tip element [N/m]; None for the default (the Hold's law)."""
+    if factor is None:
+        return None
     rod = model.rod
     return factor * rod.material.E * float(rod.area(rod.length)) / model.ds
+
+
+def default_factor(model):
+    """The default stiffness's factor on E A / ds: HOLD_STIFFNESS_FACTOR L / ds (rodmol.holds.default_stiffness)."""
+    return HOLD_STIFFNESS_FACTOR * model.rod.length / model.ds
 
 
 def payload(n, factor, joined=True):
@@ -170,23 +179,26 @@ def main(argv=None):
         t_end, n = C.pick(args, *t_ends), C.pick(args, *sizes)
         free = build(n, None, joined=False)
         for solver in ("gmres", "sparse"):  # compile, warm
-            rodmol.simulate(build(n, HOLD_STIFFNESS_FACTOR), t_end / 10, linsolver=solver)
+            rodmol.simulate(build(n, None), t_end / 10, linsolver=solver)
         run_free, wall_free = C.timed_simulate(free, t_end, args.reps)
-        cases = [(f, solver) for f in factors for solver in ("gmres", "sparse")]
+        cases = [(f, solver) for f in (*factors, None) for solver in ("gmres", "sparse")]
         for factor, solver in cases:
             system = build(n, factor)
             run, wall = C.timed_simulate(system, t_end, args.reps, linsolver=solver)
-            gap = drift(run, system) / system.rods[next(iter(system.rods))].rod.length
-            rows.append(C.drift_row(run, wall, gap, run_free, wall_free, "free", problem=name, N=n, factor=factor,
-                                    default=factor == HOLD_STIFFNESS_FACTOR, linear_solver=solver))
+            first = system.rods[next(iter(system.rods))]
+            gap = drift(run, system) / first.rod.length
+            rows.append(C.drift_row(run, wall, gap, run_free, wall_free, "free", problem=name, N=n,
+                                    factor=default_factor(first) if factor is None else factor,
+                                    default=factor is None, linear_solver=solver))
 
     formats = dict(factor="g", t_reached_s=".3g", max_drift_over_L=".2e", end_drift_over_L=".2e",
                    rhs_over_free=".2f", solver_s=".3f", solver_over_free=".2f")
     sizes = solvers_by_size(args)
     C.write_results(args, "loops", "Penalty joints of systems: drift and cost against the penalty stiffness",
                     header, rows, [
-                        ("k = factor E A / ds, damping 2 sqrt(k m); ratios to the same rods with free tips "
-                         "and no body, same run, same linear solver default", C.markdown_table(rows, formats=formats)),
+                        ("k = factor E A / ds, damping 2 sqrt(k m), the default (True) 100 E A L / ds^2; ratios to "
+                         "the same rods with free tips and no body, same run, same linear solver",
+                         C.markdown_table(rows, formats=formats)),
                         ("Joints between rods, default stiffness: GMRES against the sparse solver by N per rod "
                          "(wall times and their ratio medians of --reps, the two "
                          "solvers interleaved; the runs' largest node distance over L)", C.markdown_table(sizes, formats=dict(
@@ -202,7 +214,7 @@ def solvers_by_size(args):
         build, t_ends, _ = PROBLEMS[name]
         t_end = C.pick(args, *t_ends)
         for n in C.pick(args, *SIZES):
-            system = build(n, HOLD_STIFFNESS_FACTOR)
+            system = build(n, None)
             walls = []
             for _ in range(args.reps):  # interleaved: the machine's load moves both alike
                 gmres, gmres_s = C.timed_simulate(system, t_end, 1, linsolver="gmres")

@@ -14,7 +14,7 @@ import pytest
 import rodmol
 from rodmol import loads as loads_module
 from rodmol.discretise import external, load_entries
-from rodmol.holds import HOLD_STIFFNESS_FACTOR
+from rodmol.holds import HOLD_STIFFNESS_FACTOR, default_stiffness
 
 G_ACC = 9.81
 # A short stiff rod: small deflections, so the beam formulas hold.
@@ -118,7 +118,7 @@ def test_propped_cantilever_settles_with_cvode_onto_the_equilibrium():
     np.testing.assert_allclose(settled, rest, atol=1e-3 * np.max(np.abs(rest[:, 2])))
     w, ea, _, _ = _section(**BEAM)
     drift = np.linalg.norm(settled[-1] - (length, 0.0, 0.0))
-    assert drift < 3 * w * length / 8 / (HOLD_STIFFNESS_FACTOR * ea / model.ds) * 1.01
+    assert drift < 3 * w * length / 8 / default_stiffness(ea / model.ds, model.ds, length) * 1.01
 
 
 # --------------------------------------------------------------------------- slack rod, catenary
@@ -195,7 +195,7 @@ def test_a_clamped_tip_keeps_its_orientation_under_a_tip_moment():
     y = rodmol.equilibrium(model)
     tip = _rotation(rodmol.StateLayout(20).field(y, "Q")[-1])
     angle = np.arctan2(tip[1, 0], tip[0, 0])
-    k_turn = HOLD_STIFFNESS_FACTOR * ea / model.ds * BEAM["radius"] ** 2 / 4
+    k_turn = default_stiffness(ea / model.ds, model.ds, length) * BEAM["radius"] ** 2 / 4
     np.testing.assert_allclose(angle, moment / (k_turn + 4 * ei / length), rtol=2e-2)
     assert 0.0 < angle < moment / k_turn
     np.testing.assert_allclose(_positions(model, y)[-1], (length, 0.0, 0.0), atol=1e-9)
@@ -217,7 +217,7 @@ def test_a_clamp_turns_the_tip_to_its_held_rotation():
     tip = _rotation(rodmol.StateLayout(20).field(y, "Q")[-1])
     mismatch = np.arccos(np.clip((np.trace(held.T @ tip) - 1) / 2, -1.0, 1.0))
     _, ea, _, ei = _section(**BEAM)
-    k_turn = HOLD_STIFFNESS_FACTOR * ea / model.ds * BEAM["radius"] ** 2 / 4
+    k_turn = default_stiffness(ea / model.ds, model.ds, length) * BEAM["radius"] ** 2 / 4
     np.testing.assert_allclose(mismatch, 4 * ei / length * angle / k_turn, rtol=5e-2)
 
 
@@ -246,13 +246,17 @@ def test_a_hold_between_nodes_or_beyond_the_tip_is_refused_before_any_work():
 
 
 def test_default_law_is_the_documented_multiple_of_the_element_and_critical():
-    """k = HOLD_STIFFNESS_FACTOR E A / ds; c = 2 sqrt(k m), m = rho A ds."""
+    """k = HOLD_STIFFNESS_FACTOR E A / ds L / ds (a compliance O(ds^2) against the rod's);
+    c = 2 sqrt(k m), m = rho A ds."""
     model = _model(_rod(**BEAM), 10, [rodmol.Hold(0.25, kind="clamp")])
     grid = load_entries.of_model(model)
     _, ea, _, _ = _section(**BEAM)
-    k = HOLD_STIFFNESS_FACTOR * ea / model.ds
+    k = HOLD_STIFFNESS_FACTOR * ea / model.ds * BEAM["length"] / model.ds
     mass = BEAM["rho"] * np.pi * BEAM["radius"] ** 2 * model.ds
-    law = load_entries.hold_law(model.loads[0], ea / model.ds, mass, BEAM["radius"])
+    law = load_entries.hold_law(model.loads[0], ea / model.ds, mass, BEAM["radius"], model.ds, BEAM["length"])
+    columns = [loads_module.P_STIFFNESS, loads_module.P_DAMPING, loads_module.P_TURN_STIFFNESS,
+               loads_module.P_TURN_DAMPING]
+    np.testing.assert_allclose(grid.params[0, columns], law, rtol=1e-12)
     np.testing.assert_allclose(law, (k, 2 * np.sqrt(k * mass), k * BEAM["radius"] ** 2 / 4,
                                      2 * np.sqrt(k * mass) * BEAM["radius"] ** 2 / 4), rtol=1e-12)
     assert list(grid.node) == [5]

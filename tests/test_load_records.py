@@ -14,7 +14,7 @@ from rodmol.arm import paper_rod
 from rodmol.discretise import external, load_entries
 from rodmol.scenario import tables
 
-NOUNS = ("rod", "parameters", "cables", "cable_routing", "loads", "holds", "markers", "base_motion", "inputs",
+NOUNS = ("rod", "parameters", "cables", "cable_routing", "load_kinds", "loads", "holds", "markers", "base_motion", "inputs",
          "model")
 
 

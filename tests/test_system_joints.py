@@ -289,7 +289,7 @@ def test_two_half_beams_joined_at_their_tips_fall_as_one_clamped_clamped_beam():
     np.testing.assert_allclose(run["right"].integrated_positions[:, -1], middle, atol=1e-5)  # the joint's gap
     # GMRES (the joint's blocks in its preconditioner) and the sparse direct solver: the same
     # trajectories to the time integration's error, which falls with the tolerance.
-    for rtol, atol in ((1e-6, 2e-6), (1e-9, 1e-9)):  # measured 4.2e-7 and 2.2e-10 m
+    for rtol, atol in ((1e-6, 2e-6), (1e-9, 3e-9)):  # measured 4.2e-7 and 1.4e-9 m (2.2e-10 m at 8x softer joints)
         runs = [rodmol.simulate(system, 0.3, output_dt=0.02, rtol=rtol, linsolver=lin) for lin in ("gmres", "sparse")]
         assert all(r.success for r in runs)
         for rod in ("left", "right"):

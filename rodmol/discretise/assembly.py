@@ -60,7 +60,7 @@ the segments' at their clamps) and quadratic drag.
 import numpy as np
 from scipy import sparse
 
-from .body_joints import BodyJointPart, joint_frequency
+from .body_joints import BodyJointPart, body_joint_frequency
 from .body_part import BodyPart, clamp_velocities, cross, first_element
 from .contact_parts import contact_parts
 from .joints import JOINT_COLUMNS, JOINT_ROWS, JointPart, RecordedJoints, RodJointPart
@@ -121,9 +121,8 @@ class Assembly:
             elif joint.partner is not None:
                 self.rod_joints.append(RodJointPart(joint, *rod, self.rods[joint.partner],
                                                     self.parts[joint.partner].start))
-        omega = joint_frequency(system.rods.values())
-        self.body_joints = [BodyJointPart(j, self.bodies[j.a], None if j.b is None else self.bodies[j.b], omega)
-                            for j in system.body_joints]
+        self.body_joints = [BodyJointPart(j, self.bodies[j.a], None if j.b is None else self.bodies[j.b],
+                                          body_joint_frequency(system, j)) for j in system.body_joints]
         for joint in self.body_joints:
             for part in joint.parts:
                 part.body_joints.append(joint)

@@ -9,19 +9,22 @@ moment M act on a, -F and -M on b, the force at a's point on both (equal
 and opposite with one line of action: momentum and angular momentum are
 kept). The damping acts on a's velocities relative to b's point.
 
-Default law (:func:`joint_law`): the joint's fastest modes at about the
-frequency omega of a rod node on its default Hold, the system's fastest
-(``HOLD_STIFFNESS_FACTOR`` E A / ds on rho A ds: omega^2 =
-HOLD_STIFFNESS_FACTOR E / (rho ds^2)), so no faster than the rods' held
-nodes, and every mode of the joint at least critically damped; a fixed or
-driven body or the world counts as infinitely heavy. Its drift is the
+Default law (:func:`joint_law`): the joint's fastest modes at about a
+frequency omega (:func:`body_joint_frequency`), and every mode of the joint
+at least critically damped; a fixed or driven body or the world counts as
+infinitely heavy. Between bodies omega is that of a rod element on
+``HOLD_STIFFNESS_FACTOR`` E A / ds, the system's fastest (omega^2 =
+HOLD_STIFFNESS_FACTOR E / (rho ds^2)); at a rod's end (a joint of a base
+body: a pinned, joined or branched base) it is the rod's node on its
+default Hold (:func:`hold_frequency`), whose compliance is O(ds^2) against
+the rod's, so that the rod converges at second order. Its drift is the
 joint's load over a stiffness of the order of the reduced mass times
 omega^2 (docs/systems.md, "Joints of bodies").
 """
 
 import numpy as np
 
-from ..holds import HOLD_STIFFNESS_FACTOR
+from ..holds import HOLD_STIFFNESS_FACTOR, default_stiffness
 from ..loads import KERNELS, N_PARAMS, P_DAMPING, P_STIFFNESS, P_TURN_DAMPING, P_TURN_STIFFNESS
 from .external import hold
 from .physics import add, cross, jit, quaternion_product, rotation, scale, to_global, to_local
@@ -30,9 +33,28 @@ from .rotations import from_matrix
 
 
 def joint_frequency(models):
-    """omega [rad/s] of a body joint's default law: the fastest of the
-    models' nodes on their default Hold (HOLD_STIFFNESS_FACTOR E / (rho ds^2))."""
+    """omega [rad/s] of the default law of a joint between bodies: the fastest
+    of the models' elements on HOLD_STIFFNESS_FACTOR E A / ds (omega^2 =
+    HOLD_STIFFNESS_FACTOR E / (rho ds^2))."""
     return max(np.sqrt(HOLD_STIFFNESS_FACTOR * m.rod.material.E / m.rod.material.rho) / m.ds for m in models)
+
+
+def hold_frequency(model):
+    """omega [rad/s] of a node of ``model`` on its default Hold (its stiffness
+    :func:`rodmol.holds.default_stiffness` on the node's mass rho A ds:
+    omega^2 = HOLD_STIFFNESS_FACTOR E L / (rho ds^3))."""
+    material = model.rod.material
+    return np.sqrt(default_stiffness(material.E / model.ds, model.ds, model.rod.length) / (material.rho * model.ds))
+
+
+def body_joint_frequency(system, joint):
+    """omega [rad/s] of ``joint``'s default law (a :class:`rodmol.systems.BodyJoint`
+    of ``system``): at a rod's end (a base body's joint) the fastest of its
+    rods' nodes on their default Hold, so that its compliance is O(ds^2)
+    against theirs as a Hold's; between other bodies :func:`joint_frequency`."""
+    rod_of = {body: rod for rod, body in system.base_bodies.items()}
+    ends = [system.rods[rod_of[body]] for body in (joint.a, joint.b) if body in rod_of]
+    return max(map(hold_frequency, ends)) if ends else joint_frequency(system.rods.values())
 
 
 def mobility(part, point, turn=None):
@@ -64,7 +86,7 @@ def joint_law(joint, parts, omega):
     a, b = parts
     turn = np.eye(3) if b is None else a.body.rotation.T @ b.body.rotation
     g = mobility(a, joint.point_a) + mobility(b, joint.point_b, turn)
-    clamp = joint.kind == "clamp"
+    clamp = KERNELS[joint.kind].holds_turning
     k = omega**2 / np.linalg.eigvalsh(g[:3, :3])[-1] if joint.stiffness is None else joint.stiffness
     k_r = k * np.linalg.eigvalsh(g[:3, :3])[-1] / np.linalg.eigvalsh(g[3:, 3:])[-1] if clamp else 0.0
     size = 6 if clamp else 3
@@ -101,7 +123,8 @@ def pair_wrench(kind, row, value, a, point_a, turn_a, b, point_b, turn_b):
 class BodyJointPart:
     """A :class:`rodmol.systems.BodyJoint` between the body parts ``a`` and
     ``b`` (:class:`rodmol.discretise.body_part.BodyPart`; b None for the
-    world), its law from :func:`joint_law` at the frequency ``omega``."""
+    world), its law from :func:`joint_law` at the frequency ``omega``
+    (:func:`body_joint_frequency`)."""
 
     def __init__(self, joint, a, b, omega):
         self.joint, self.a, self.b = joint, a, b

@@ -1,6 +1,7 @@
 """Rods touching rigid bodies (:class:`rodmol.Contact`): the body's shape is
-one of the rod's contact loads (:class:`rodmol.PlaneContact`,
-:class:`rodmol.CapsuleContact`) whose geometry the body moves.
+one of the rod's contact loads (a contact shape of
+:data:`rodmol.loads.CONTACT_SHAPES`) whose geometry the body moves (its
+points moved and turned, its directions turned: its record's ``geometry``).
 
 As a penalty joint's hold (:mod:`rodmol.discretise.joints`), every velocity
 node's entry of that load is one part of the system: before each
@@ -18,8 +19,9 @@ complement, the equilibrium and the rebuilt Results take them as joints.
 
 import numpy as np
 
-from ..loads import KERNELS, P_OBSTACLE_SPIN, P_OBSTACLE_VELOCITY, P_RADIUS
-from .external import PLANE, contact, contact_depth
+from ..load_kinds import KERNELS
+from ..loads import P_OBSTACLE_SPIN, P_OBSTACLE_VELOCITY, P_RADIUS
+from .external import contact, contact_depth
 from .layout import QUAT, U, V, W
 from .load_entries import count
 from .physics import add, cross, jit, rotation, scale, sub, to_global, to_local
@@ -30,29 +32,29 @@ NOTHING = ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
 
 
 @jit
-def contact_reaction(kind, row, y, node, body, shape, length):
+def contact_reaction(kind, row, y, node, body, shape, moves, length):
     """Move a contact entry's obstacle with a body and return its reaction.
 
-    Writes into ``row`` (the entry's parameter row) the shape ``shape``
-    (6,), body frame (a capsule's start and end [m], a plane's point [m]
-    and normal), placed by the body in the state ``body`` (x, Q, v, w:
-    origin [m], quaternion, global; velocities [m/s, rad/s], body frame),
-    and the obstacle's motion (global). Returns the force and moment [N,
-    N m] about the body's origin, body frame, on the body: the opposite of
-    the force on the rod node whose element block starts at ``y[node]``
-    (its density times the node's ``length`` [m]), acting at the contact
-    point."""
+    Writes into ``row`` (the entry's parameter row) the shape's 3-vectors
+    ``shape`` (n, 3), body frame, placed by the body in the state ``body``
+    (x, Q, v, w: origin [m], quaternion, global; velocities [m/s, rad/s],
+    body frame): each turned with the body and, where ``moves`` (n,) is 1
+    (a point, not a direction), moved with its origin; and the obstacle's
+    motion (global) at the first vector, a point. Returns the force and
+    moment [N, N m] about the body's origin, body frame, on the body: the
+    opposite of the force on the rod node whose element block starts at
+    ``y[node]`` (its density times the node's ``length`` [m]), acting at
+    the contact point."""
     x_b = _row3(body, BX)
     r_b = rotation((body[BQ], body[BQ + 1], body[BQ + 2], body[BQ + 3]))
     v_b, w_b = _row3(body, BV), _row3(body, BW)
-    first = _row3(shape, 0)
-    start = add(x_b, to_global(r_b, first))
-    second = to_global(r_b, _row3(shape, 3))
-    if kind != PLANE:
-        second = add(x_b, second)
+    for k in range(shape.shape[0]):
+        placed = add(scale(moves[k], x_b), to_global(r_b, _row3(shape[k], 0)))
+        for i in range(3):
+            row[3 * k + i] = placed[i]
+    first = _row3(shape[0], 0)
     velocity, spin = to_global(r_b, add(v_b, cross(w_b, first))), to_global(r_b, w_b)
     for i in range(3):
-        row[i], row[3 + i] = start[i], second[i]
         row[P_OBSTACLE_VELOCITY + i], row[P_OBSTACLE_SPIN + i] = velocity[i], spin[i]
     u = _row3(y, node + U)
     r = rotation((y[node + QUAT], y[node + QUAT + 1], y[node + QUAT + 2], y[node + QUAT + 3]))
@@ -64,13 +66,13 @@ def contact_reaction(kind, row, y, node, body, shape, length):
 
 
 @jit
-def group_reaction(kind, rows, y, nodes, body, shape, lengths):
+def group_reaction(kind, rows, y, nodes, body, shape, moves, lengths):
     """:func:`contact_reaction` of the entries ``rows`` (n, N_PARAMS) at the
     element blocks starting at ``y[nodes]`` (n,) of nodes of ``lengths``
     (n,) [m], all moved by one body: their total force and moment on it."""
     force, moment = (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
     for i in range(nodes.shape[0]):
-        f, m = contact_reaction(kind, rows[i], y, nodes[i], body, shape, lengths[i])
+        f, m = contact_reaction(kind, rows[i], y, nodes[i], body, shape, moves, lengths[i])
         force, moment = add(force, f), add(moment, m)
     return force, moment
 
@@ -91,7 +93,9 @@ class ContactPart:
         self.row, self.value = sd.entry_params[self.entry], sd.entry_values[self.entry]
         self.node = rod_start + sd.layout.header + sd.layout.block * block
         self.length = float(sd.grid_loads.weight[self.entry] * sd.node_lengths[block])
-        self.shape = np.ascontiguousarray(record.geometry(), dtype=float)
+        self.shape = np.ascontiguousarray(record.shape.shape_vectors())
+        roles = KERNELS[record.shape.kernel].geometry
+        self.moves = np.array([1.0 if role == "point" else 0.0 for role in roles])
         if self.leader:  # the group's arrays, filled by the others as they are made
             self.rows = sd.entry_params[self.entry:self.entry]
             self.nodes, self.lengths = np.zeros(0, dtype=np.int64), np.zeros(0)
@@ -109,10 +113,10 @@ class ContactPart:
         (their rows are written); given another row (scratch, or a frame's
         replay), each part its own node."""
         if row is not self.row:
-            return contact_reaction(self.kind, row, y, self.node, body, self.shape, self.length)
+            return contact_reaction(self.kind, row, y, self.node, body, self.shape, self.moves, self.length)
         if not self.leader:
             return NOTHING
-        return group_reaction(self.kind, self.rows, y, self.nodes, body, self.shape, self.lengths)
+        return group_reaction(self.kind, self.rows, y, self.nodes, body, self.shape, self.moves, self.lengths)
 
 
 def contact_parts(assembly):

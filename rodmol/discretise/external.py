@@ -5,18 +5,23 @@ A model's external loads (:mod:`rodmol.loads`) become *entries*: (kind,
 velocity node, weight, parameter row, value). Every entry adds ``weight`` times
 its force and moment densities to its node's balance laws, in the local frame.
 
-To add a kind: give it a record in :data:`rodmol.loads.KERNELS` (its code,
-the state fields it reads and what it adds up as) and a branch in
-:func:`load`; its loads tell the grid how they spread and what parameter row
-they hand the kernel (:mod:`rodmol.discretise.load_entries`). The Jacobian's
-pattern, colouring and preconditioner are derived from the records, and the
-Jacobian test covers every code in :data:`DEPENDS`.
+To add a kind: give it a record in :data:`rodmol.load_kinds.KERNELS` (its
+code, the state fields it reads, what it adds up as and, for a hold or a
+contact shape, its turning and geometry) and a branch here: a hold kind in
+:func:`hold` and :func:`hold_energy`, a contact shape in
+:func:`contact_depth` (its law, energy and motion with a body are shared),
+another in :func:`load`. Its loads tell the grid how they spread and what
+parameter row they hand the kernel (:mod:`rodmol.discretise.load_entries`).
+The Jacobian's pattern, colouring and preconditioner are derived from the
+records; ``tests/test_load_records.py`` walks every record and names what a
+half-added kind lacks (docs/systems.md, "Adding a joint kind or a contact
+shape").
 """
 
 import numpy as np
 
+from ..load_kinds import KERNELS, codes
 from ..loads import (
-    KERNELS,
     N_PARAMS,  # noqa: F401 (the row width, read here by the system)
     P_DAMPING,
     P_FRICTION,
@@ -33,11 +38,15 @@ from ..loads import (
 )
 from .physics import add, cross, dot, jit, quaternion_product, rotation, scale, sub, to_local
 
-# The codes as module constants: the compiled branches read them as such.
+# The codes as module constants: the compiled branches read them as such (numba
+# freezes them at compile time; the kernel cache's digest holds load_kinds.py).
 FOLLOWER_FORCE, DEAD_FORCE = KERNELS["follower_force"].code, KERNELS["dead_force"].code
 FOLLOWER_MOMENT, DEAD_MOMENT = KERNELS["follower_moment"].code, KERNELS["dead_moment"].code
 PLANE, CAPSULE = KERNELS["plane"].code, KERNELS["capsule"].code
 PIN, CLAMP = KERNELS["pin"].code, KERNELS["clamp"].code
+#: The codes of the holds (rodmol.Hold, a system's joints), of those that hold the
+#: section's turning too, and of the contact shapes: from the records' fields.
+HOLDS, TURNING_HOLDS, CONTACTS = codes("hold"), codes("hold", holds_turning=True), codes("contact")
 
 #: Which fields of its own element block each kind reads (force rows "v" and
 #: moment rows "w" of that block are the ones written).
@@ -142,7 +151,7 @@ def hold(kind, p, value, u, quat, r, v, w):
     gap = sub(u, add((p[0], p[1], p[2]), value))
     held_v = (p[P_HELD_VELOCITY], p[P_HELD_VELOCITY + 1], p[P_HELD_VELOCITY + 2])
     f = pin_force(to_local(r, gap), sub(v, to_local(r, held_v)), p[P_STIFFNESS], p[P_DAMPING])
-    if kind != CLAMP:
+    if kind not in TURNING_HOLDS:
         return f, (0.0, 0.0, 0.0)
     held_w = (p[P_HELD_SPIN], p[P_HELD_SPIN + 1], p[P_HELD_SPIN + 2])
     return f, clamp_moment(quat, (p[3], p[4], p[5], p[6]), sub(w, to_local(r, held_w)), p[P_TURN_STIFFNESS],
@@ -163,7 +172,7 @@ def load(kind, p, value, u, quat, v, w):
         return to_local(r, value), zero
     if kind == DEAD_MOMENT:
         return zero, to_local(r, value)
-    if kind in (PIN, CLAMP):
+    if kind in HOLDS:
         return hold(kind, p, value, u, quat, r, v, w)
     return contact(kind, p, u, r, v, w)
 
@@ -172,7 +181,7 @@ def load(kind, p, value, u, quat, v, w):
 def contact_energy(kind, p, u):
     """Elastic energy density [J/m] of the contact penalty at u (the integral
     of the penalty force over the depth)."""
-    if kind != PLANE and kind != CAPSULE:
+    if kind not in CONTACTS:
         return 0.0
     depth, _ = contact_depth(kind, p, u)
     h = p[P_SMOOTHING]
@@ -189,11 +198,11 @@ def hold_energy(kind, p, value, u, quat):
     stiffness |u - p|^2 / 2, plus for a clamp turning stiffness (1 - cos
     theta), the potential of :func:`clamp_moment` (1 - cos theta = 2 sin^2(theta / 2),
     from e = conj(quat) held: its vector part's squared norm over its own)."""
-    if kind != PIN and kind != CLAMP:
+    if kind not in HOLDS:
         return 0.0
     gap = sub(u, add((p[0], p[1], p[2]), value))
     energy = 0.5 * p[P_STIFFNESS] * dot(gap, gap)
-    if kind == CLAMP:
+    if kind in TURNING_HOLDS:
         a, b, c, d = quaternion_product((quat[0], -quat[1], -quat[2], -quat[3]), (p[3], p[4], p[5], p[6]))
         energy += p[P_TURN_STIFFNESS] * 2.0 * (b * b + c * c + d * d) / (a * a + b * b + c * c + d * d)
     return energy

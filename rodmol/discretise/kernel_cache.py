@@ -2,7 +2,7 @@
 
 Numba keys a cached function on its own file's time stamp only, but rodmol's
 kernels inline functions and freeze constants from other modules (the load
-kinds' codes and parameter columns of :mod:`rodmol.loads`, the layout's
+kinds' codes of :mod:`rodmol.load_kinds`, the parameter columns of :mod:`rodmol.loads`, the layout's
 offsets, the compiled physics): after an edit or an upgrade that changed
 only those, the old machine code was loaded and ran silently wrong physics.
 Here every rodmol kernel's stamp also carries one digest of all the sources
@@ -18,7 +18,7 @@ from numba.core import caching
 PACKAGE = Path(__file__).resolve().parents[1]
 #: The sources whose code or constants a compiled kernel can read.
 SOURCES = (*sorted((PACKAGE / "discretise").glob("*.py")), *sorted((PACKAGE / "solve").glob("*.py")),
-           PACKAGE / "loads.py", PACKAGE / "holds.py")
+           PACKAGE / "load_kinds.py", PACKAGE / "loads.py", PACKAGE / "holds.py")
 
 
 def sources_digest(paths=SOURCES):

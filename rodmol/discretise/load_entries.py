@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..holds import HOLD_STIFFNESS_FACTOR
+from ..holds import default_stiffness
 from ..loads import (
     KERNELS,
     N_PARAMS,
@@ -66,13 +66,15 @@ def node_shares(s, s_nodes):
     return np.array(nodes, dtype=int), np.array(weights)
 
 
-def hold_law(hold, axial_stiffness, mass, radius):
+def hold_law(hold, axial_stiffness, mass, radius, ds, length):
     """(stiffness [N/m], damping [N s/m], turning stiffness [N m], turning
     damping [N m s]) of ``hold`` (a :class:`rodmol.Hold`) at a node whose
     element has the axial stiffness E A / ds ``axial_stiffness`` [N/m], of
-    ``mass`` [kg] and section ``radius`` [m]: the defaults where the hold
-    gives none, and the turning law the section's I / A = r^2 / 4 times it."""
-    k = HOLD_STIFFNESS_FACTOR * axial_stiffness if hold.stiffness is None else hold.stiffness
+    ``mass`` [kg] and section ``radius`` [m], on a rod of ``length`` [m]
+    and elements ``ds`` [m]: the defaults where the hold gives none
+    (:func:`rodmol.holds.default_stiffness`, critical damping), and the
+    turning law the section's I / A = r^2 / 4 times it."""
+    k = default_stiffness(axial_stiffness, ds, length) if hold.stiffness is None else hold.stiffness
     c = 2.0 * np.sqrt(k * mass) if hold.damping is None else hold.damping
     arm2 = 0.25 * radius * radius
     return k, c, k * arm2, c * arm2
@@ -90,7 +92,8 @@ def _held_entries(load, s_nodes, rest):
     if load.rotation is not None:
         quat = from_matrix(load.rotation)
     row[0, :3], row[0, 3:7] = position, quat
-    law = hold_law(load, rest["axial_stiffness"][node], rest["mass"][node], rest["radius"][node])
+    law = hold_law(load, rest["axial_stiffness"][node], rest["mass"][node], rest["radius"][node], ds,
+                   s_nodes[-1] - s_nodes[0])
     row[0, [P_STIFFNESS, P_DAMPING, P_TURN_STIFFNESS, P_TURN_DAMPING]] = law
     shift = np.zeros((1, 3)) if load.position is None else (load.position - position)[None, :]
     return np.array([node]), np.array([1.0 / ds]), row, lambda t: shift

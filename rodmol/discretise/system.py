@@ -196,7 +196,7 @@ class SemiDiscrete:
         self._entry_weights = np.ascontiguousarray(entries.weight * stretch, dtype=float)
         self._entry_params = np.ascontiguousarray(entries.params, dtype=float).reshape(-1, external.N_PARAMS)
         self.entry_values = np.ascontiguousarray(entries.initial, dtype=float).reshape(-1, 3)
-        self._hold_entries = np.isin(self._kinds, (external.PIN, external.CLAMP))  # rodmol.Hold
+        self._hold_entries = np.isin(self._kinds, external.HOLDS)  # rodmol.Hold
         self.grid_loads = entries
 
     @property

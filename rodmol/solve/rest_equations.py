@@ -87,7 +87,7 @@ class RestEquations:
         self.scale = load_scale(model, t, tensions, system.grid_loads)
         self.unloaded = self.scale == 0.0 and not model.loads
         grid = system.grid_loads
-        moved = np.isin(grid.kind, (external.PIN, external.CLAMP)) & np.any(grid.initial != 0.0, axis=1)
+        moved = np.isin(grid.kind, external.HOLDS) & np.any(grid.initial != 0.0, axis=1)
         self.holds_moved = bool(np.any(moved))
         self._force_scale = (self.scale or 1.0) / model.rod.length  # contact alone: forces of about 1 N
 
@@ -101,7 +101,7 @@ class RestEquations:
         floor = 10 * np.finfo(float).eps / self._force_scale
         elastic = max(tol, floor * np.max(self.system.sampled.kl) / model.ds)
         out = self.static.blocks(np.full(self.static.size, elastic))
-        for e in np.flatnonzero(np.isin(grid.kind, (external.PIN, external.CLAMP))):
+        for e in np.flatnonzero(np.isin(grid.kind, external.HOLDS)):
             hold_density = grid.params[e, P_STIFFNESS] * grid.weight[e]
             out[grid.node[e] - 1, self._sl["q"]] = max(elastic, floor * hold_density * model.rod.length)
         return out.ravel()

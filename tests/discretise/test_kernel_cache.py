@@ -12,10 +12,10 @@ def test_rodmol_kernels_are_stamped_with_the_digest_of_every_kernel_source():
     locator = kernel_cache.InTreeLocator.from_function(external.load.py_func, external.__file__)
     own, digest = locator.get_source_stamp()
     assert digest == kernel_cache.DIGEST == kernel_cache.sources_digest()
-    # The stamp numba would use alone: the kernel's own file, blind to loads.py's codes.
+    # The stamp numba would use alone: the kernel's own file, blind to load_kinds.py's codes.
     assert own == caching.InTreeCacheLocator.from_function(external.load.py_func, external.__file__).get_source_stamp()
     names = {path.name for path in kernel_cache.SOURCES}
-    assert {"loads.py", "holds.py", "layout.py", "stencil.py", "physics.py", "newton_matrix.py"} <= names
+    assert {"load_kinds.py", "loads.py", "holds.py", "layout.py", "stencil.py", "physics.py", "newton_matrix.py"} <= names
 
 
 def test_a_function_outside_the_package_keeps_numbas_own_locator(tmp_path):
@@ -35,8 +35,8 @@ def test_changing_any_kernel_source_changes_the_digest(tmp_path):
         shutil.copy(path, copy)
         copies.append(copy)
     assert kernel_cache.sources_digest(copies) == kernel_cache.DIGEST
-    loads = next(c for c in copies if c.name == "loads.py")
-    loads.write_text(loads.read_text().replace("code", "code ", 1))  # e.g. a load kind's code edited
+    kinds = next(c for c in copies if c.name == "load_kinds.py")
+    kinds.write_text(kinds.read_text().replace("Kernel(4,", "Kernel(5,", 1))  # e.g. a load kind's code edited
     assert kernel_cache.sources_digest(copies) != kernel_cache.DIGEST
 
 
