@@ -1,14 +1,15 @@
 """gymnasium environments of the paper's arm (``pip install rodmol[rl]``).
 
-Importing this module registers ``"rodmol/Reach-v0"`` (:class:`ReachEnv`)::
+``import rodmol`` registers ``"rodmol/Reach-v0"`` (:class:`ReachEnv`) with
+gymnasium (:mod:`rodmol.control.registration`), whose ``make`` imports this
+module::
 
     import gymnasium
-    import rodmol.control.envs  # noqa: F401  (registers the environments)
+    import rodmol
 
     env = gymnasium.make("rodmol/Reach-v0")
-    envs = rodmol.control.envs.vector_env(4)  # in parallel processes
+    envs = rodmol.control.envs.vector_env(4)  # in parallel processes (after importing it)
 
-``gymnasium.make("rodmol.control.envs:rodmol/Reach-v0")`` imports it too.
 rodmol itself never imports this module, so it works without gymnasium.
 """
 
@@ -25,7 +26,7 @@ from ..arm import CABLE_OFFSETS, paper_arm
 from ..errors import IntegrationError, ParameterError, RodmolError
 from .simulator import Simulator
 
-REACH_ID = "rodmol/Reach-v0"
+REACH_ID = "rodmol/Reach-v0"  # registered by rodmol.control.registration
 #: Distance of the targets from the base [fraction of L], and largest angle [rad] from the base axis.
 TARGET_REACH = (0.8, 0.97)
 TARGET_CONE = np.radians(45.0)
@@ -221,7 +222,3 @@ def vector_env(num_envs, **kwargs):
     """``num_envs`` :class:`ReachEnv` (keyword arguments ``kwargs``), each in its own process
     (``gymnasium.vector.AsyncVectorEnv``)."""
     return gymnasium.vector.AsyncVectorEnv([functools.partial(ReachEnv, **kwargs)] * int(num_envs))
-
-
-if REACH_ID not in gymnasium.registry:
-    gymnasium.register(REACH_ID, entry_point=ReachEnv)

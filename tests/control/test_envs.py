@@ -181,8 +181,19 @@ def test_vectorised_in_parallel_processes():
 
 
 @pytest.mark.subprocess
+def test_import_rodmol_alone_registers_the_environments():
+    """In a fresh interpreter: ``import rodmol`` registers rodmol/Reach-v0, and its module is
+    imported by gymnasium.make only."""
+    code = ("import sys, rodmol, gymnasium; assert 'rodmol.control.envs' not in sys.modules; "
+            "env = gymnasium.make('rodmol/Reach-v0', n_elements=4, episode_steps=2); "
+            "observation, _ = env.reset(seed=0); print(type(env.unwrapped).__name__, observation.shape)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0 and "ReachEnv (21,)" in out.stdout, out.stderr[-2000:]
+
+
+@pytest.mark.subprocess
 def test_rodmol_imports_without_gymnasium():
     code = ("import sys; sys.modules['gymnasium'] = None; import rodmol, rodmol.control; "
-            "print(rodmol.Simulator.__name__)")
+            "assert not rodmol.control.register_environments(); print(rodmol.Simulator.__name__)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0 and "Simulator" in out.stdout, out.stderr
