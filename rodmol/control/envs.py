@@ -108,6 +108,11 @@ class ReachEnv(gymnasium.Env):
     (``reset(seed=...)``), and a reset restores the start state bitwise, so
     episodes are reproducible.
 
+    Model-based control: :attr:`state` (the whole state vector), :attr:`t`
+    and :attr:`held` (the tensions held now) are the operating point, and
+    ``rodmol.linearize(env.held_model(), env.state, env.t)`` the linear model
+    about it (read them on ``env.unwrapped``).
+
     Parameters
     ----------
     n_elements : int
@@ -144,6 +149,31 @@ class ReachEnv(gymnasium.Env):
         self.observation_space = spaces.Box(-np.inf, np.inf, (21,), np.float32)
         self.target, self._steps = self.sim.state.tip.copy(), 0
         self._ended = "before the first reset()"  # why step must wait for a reset, or None
+
+    # ----------------------------------------------------------------- for model-based control
+
+    @property
+    def state(self):
+        """The arm's whole state vector now (``rodmol.StateLayout``), a copy: the observation
+        is a part of it."""
+        return self.sim.y
+
+    @property
+    def t(self):
+        """The simulated time now [s] (0 at a reset)."""
+        return self.sim.t
+
+    @property
+    def held(self):
+        """The tensions [N] of cables 1-12 held now (those of the last action, as clipped;
+        0 N after a reset), float64."""
+        tensions = self.sim.held["tensions"]
+        return np.array([tensions[f"cable {k}"] for k in sorted(CABLE_OFFSETS)])
+
+    def held_model(self):
+        """The arm with the tensions held now as constants: ``rodmol.linearize(env.held_model(),
+        env.state, env.t)`` is the linear model about the present state and inputs."""
+        return self.sim.held_model()
 
     # ----------------------------------------------------------------- gymnasium's API
 

@@ -18,7 +18,7 @@ import numpy as np
 from .. import _checks
 from ..cables import Tension
 from ..errors import ParameterError
-from ..inputs import TimeInput
+from ..inputs import Constant, TimeInput
 from ..loads import PointForce, PointMoment
 
 #: The point loads whose vector a simulator holds.
@@ -123,6 +123,12 @@ class HeldInputs:
             else:
                 loads[i] = dataclasses.replace(loads[i], **{loads[i]._what: signal})
         return m.replace(cables=cables, loads=loads)
+
+    def constant(self, row):
+        """The model holding ``row`` for all time (constant inputs), as ``rodmol.linearize``
+        and ``rodmol.equilibrium`` take it."""
+        return self.model_with([Constant(np.atleast_1d(value), 3 if kind == "load" else 1)
+                                for kind, value in zip(self.kinds, row)])
 
     def live(self, row):
         """(model, its :class:`Held` inputs) holding ``row``."""

@@ -146,6 +146,12 @@ class Simulator:
             out[f"{kind}s"][pool[i].name] = value.copy() if kind == "load" else value
         return out
 
+    def held_model(self):
+        """The model with the inputs held now as constants (a tension schedule of the model
+        replaced by its held value): with :attr:`y` and :attr:`t`, the operating point a
+        model-based controller linearises about, ``rodmol.linearize(sim.held_model(), sim.y, sim.t)``."""
+        return self._inputs.constant(self._row)
+
     def step(self, dt, tensions=None, *, displacements=None, loads=None):
         """Advance by ``dt`` [s] with the inputs held; returns the new :attr:`state`.
 
