@@ -150,7 +150,7 @@ def main(argv=None):
                             f"distance_{end:g}s_median_mm": float(1e3 * np.median(at_end)),
                             f"distance_{end:g}s_max_mm": float(1e3 * at_end.max()),
                             f"within_0.5mm_at_{end:g}s": f"{int(np.sum(at_end <= WITHIN))}/{episodes}"},
-                         wall_s_per_episode=float(walls.mean()), per_episode_mm=" ".join(
+                         wall_s_per_episode=float(walls.mean()), per_episode=" ".join(
                              f"{1e3 * d:.3g}/{1e3 * e:.3g}" for d, e in zip(at_scored, at_end))))
         print(rows[-1], flush=True)
     env.close()
@@ -161,7 +161,7 @@ def main(argv=None):
         ("Reading", f"Episodes seeded 0-{episodes - 1}: the same targets for every policy. mean_return: the "
                     f"environment's return over its default episode ({SCORED} periods, {scored:g} s), the sum "
                     "of -|tip - target| - 1e-3 |T|^2 [m]; the episodes go on to "
-                    f"{end:g} s for the distances at the end. per_episode_mm: each episode's distance "
+                    f"{end:g} s for the distances at the end. per_episode: each episode's distance [mm] "
                     f"at {scored:g} s / at {end:g} s.\n")])
 
 
