@@ -151,6 +151,10 @@ def test_point_loads_and_displacements_are_held():
     sim = Simulator(model)
     for k in range(4):
         sim.step(DT, displacements={"motor": -0.005 * k}, loads={"push": (0.0, -0.02 * k, 0.0)})
+    # the operating point a model-based controller takes: the model holding these inputs
+    lin = rodmol.linearize(sim.held_model(), sim.y, sim.t)
+    np.testing.assert_array_equal(lin.u0[1:], [-0.015, 0.0, -0.06, 0.0])  # the held z, the force
+    np.testing.assert_allclose(lin.f0, rodmol.SemiDiscrete(sim.held_model())(sim.t, sim.y))
     result = sim.result
     z = result.actuator_positions[:, 0]
     np.testing.assert_array_equal(z, [0.0, 0.0, -0.005, -0.01, -0.015])
