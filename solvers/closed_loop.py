@@ -113,9 +113,7 @@ def held_rows(args, n):
 def env_speed(n, steps):
     """Wall time [s] per simulated second of rodmol/Reach-v0 under random actions, or None."""
     try:
-        import gymnasium
-
-        import rodmol.control.envs  # noqa: F401  (registers rodmol/Reach-v0)
+        import gymnasium  # import rodmol registered rodmol/Reach-v0
     except ImportError:
         return None
     env = gymnasium.make("rodmol/Reach-v0", n_elements=n)
