@@ -14,6 +14,11 @@ once per period. Timed in one run, each the median of --reps:
 
 the three interleaved in each repetition, their ratios to the replay taken
 within a repetition (median and range over them); and the Simulator's tip against the replay's (the same equations to rtol).
+Then held inputs: the arm from rest pulled by cables 11 and 5 at constant
+tensions, stepped at 50 Hz by the Simulator against one ``simulate`` with
+those tensions (its ``stats`` wall time), interleaved, the ratio within a
+repetition, with CVODE's steps and right-hand sides of each: held inputs
+must not cut CVODE's steps at every period.
 The learning environment's steps (``rodmol/Reach-v0``, N = 30, 20 ms
 periods, random actions) against real time close the table when gymnasium
 is installed.
@@ -65,12 +70,50 @@ def per_period(n, steps):
     return np.array(tips), time.perf_counter() - start
 
 
+HELD_PERIOD = 0.02  # s, 50 Hz
+HELD_TENSIONS = {11: 1.0, 5: 0.5}  # N, constant from t = 0
+
+
+def held(n, t_end, rest):
+    """Held tensions: (Simulator's loop wall time [s], its stats, simulate's Result) from the
+    state ``rest``."""
+    sim = rodmol.Simulator(rodmol.paper_arm(n), initial=rest)
+    commands = {f"cable {k}": value for k, value in HELD_TENSIONS.items()}
+    start = time.perf_counter()
+    for _ in range(int(round(t_end / HELD_PERIOD))):
+        sim.step(HELD_PERIOD, commands)
+    wall = time.perf_counter() - start
+    one = rodmol.simulate(rodmol.paper_arm(n, tensions=HELD_TENSIONS), t_end, initial=rest,
+                          output_dt=HELD_PERIOD)
+    gap = float(np.max(np.linalg.norm(sim.result.tip - one.tip, axis=1)))
+    return wall, dict(sim.stats, tip_gap_m=gap), one
+
+
+def held_rows(args, n):
+    """The held-inputs table: the Simulator at 50 Hz against one simulate, ratios within a repetition."""
+    t_end = C.pick(args, 6.0, 2.0, 0.4)
+    rest = rodmol.Simulator(rodmol.paper_arm(n)).y  # at rest without tension
+    held(n, 2 * HELD_PERIOD, rest)  # warm
+    ratios, walls, ones = [], [], []
+    for _ in range(max(args.reps, 5)):
+        wall, stats, one = held(n, t_end, rest)
+        walls.append(wall)
+        ones.append(one.stats["wall_time_s"])
+        ratios.append(wall / one.stats["wall_time_s"])
+    ratios = np.array(ratios)
+    common = dict(N=n, t_end_s=t_end, periods=int(round(t_end / HELD_PERIOD)))
+    return [dict(method="Simulator, held tensions (50 Hz)", **common, wall_s=float(np.median(walls)),
+                 ratio_to_simulate=float(np.median(ratios)), ratio_range=f"{ratios.min():.2f}-{ratios.max():.2f}",
+                 steps=stats["steps"], rhs_evals=stats["rhs_evals"], restarts=stats["restarts"],
+                 tip_gap_m=stats["tip_gap_m"]),
+            dict(method="simulate, the same tensions", **common, wall_s=float(np.median(ones)),
+                 ratio_to_simulate=1.0, steps=one.stats["steps"], rhs_evals=one.stats["rhs_evals"])]
+
+
 def env_speed(n, steps):
     """Wall time [s] per simulated second of rodmol/Reach-v0 under random actions, or None."""
     try:
-        import gymnasium
-
-        import rodmol.control.envs  # noqa: F401  (registers rodmol/Reach-v0)
+        import gymnasium  # import rodmol registered rodmol/Reach-v0
     except ImportError:
         return None
     env = gymnasium.make("rodmol/Reach-v0", n_elements=n)
@@ -126,10 +169,17 @@ def main(argv=None):
              f"{stats['rhs_evals']} right-hand sides; the replay: {replay.stats['steps']} steps, "
              f"{replay.stats['rhs_evals']} right-hand sides. Tension range "
              f"{result.tensions[:, 10].min():.3g}-{result.tensions[:, 10].max():.3g} N.")
-    fmt = {"wall_s": ".3g", "s_per_simulated_s": ".3g", "ratio_to_replay": ".2f"}
-    C.write_results(args, "closed_loop", "A 100 Hz controller outside the right-hand side", header, rows, [
-        ("Results", C.markdown_table(rows, None, fmt)),
-        ("Agreement and work", facts + "\n")])
+    held_table = held_rows(args, n)
+    for row in held_table:
+        print(row, flush=True)
+    fmt = {"wall_s": ".3g", "s_per_simulated_s": ".3g", "ratio_to_replay": ".2f", "ratio_to_simulate": ".2f",
+           "tip_gap_m": ".2g"}
+    C.write_results(args, "closed_loop", "A 100 Hz controller outside the right-hand side", header,
+                    rows + held_table, [
+                        ("Results", C.markdown_table(rows, None, fmt)),
+                        ("Agreement and work", facts + "\n"),
+                        ("Held tensions: the Simulator at 50 Hz against one simulate",
+                         C.markdown_table(held_table, None, fmt))])
 
 
 if __name__ == "__main__":

@@ -144,6 +144,9 @@ def _closed_loop(out):
     table = {row["method"]: row for row in rows(out / "closed_loop.csv")}
     # the kept-alive stepper costs about the replay of the same table; the per-period workaround rebuilds it all
     assert table["Simulator"]["ratio_to_replay"] < table["per-period simulate"]["ratio_to_replay"]
+    # held tensions: CVODE's steps are not cut at each period's end (counts, not times)
+    held, one = table["Simulator, held tensions (50 Hz)"], table["simulate, the same tensions"]
+    assert held["steps"] <= 1.2 * one["steps"] and held["restarts"] == 1 and held["tip_gap_m"] < 1e-4
 
 
 def _inverse_statics(out):
@@ -247,6 +250,14 @@ def _rod_contact(out):
     assert all(abs(row["force_over_weight"] - 1.0) < 5e-3 for row in table), table
 
 
+def _reach_scores(out):
+    table = {row["policy"]: row for row in rows(out / "reach_scores.csv")}
+    assert set(table) == {"random", "proportional", "inverse statics, open loop", "linear MPC"}
+    for row in table.values():  # a distance [m] of the reach, at most the arm's length from the target
+        distances = [value for key, value in row.items() if key.endswith("_mm")]
+        assert all(0.0 <= d < 1e3 for d in distances) and math.isfinite(row["mean_return"]), row
+
+
 SCRIPTS = {
     "scaling.py": (["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"], _scaling),
     "temporal.py": (["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv", "temporal_options.csv"],
@@ -267,6 +278,7 @@ SCRIPTS = {
     "closed_loop.py": (["closed_loop.csv", "closed_loop.md"], _closed_loop),
     "inverse_statics.py": (["inverse_statics.csv", "inverse_statics.md"], _inverse_statics),
     "linear_mpc.py": (["linear_mpc.csv", "linear_mpc.md"], _linear_mpc),
+    "reach_scores.py": (["reach_scores.csv", "reach_scores.md"], _reach_scores),
     "quaternion_norm.py": (["quaternion_norm.csv", "quaternion_norm.md"], _quaternion_norm),
     "octopus.py": (["octopus.csv", "octopus.md"], _octopus),
     "octopus_stats.py": (["octopus_stats.csv", "octopus_stats.md"], _octopus_stats),
@@ -294,6 +306,8 @@ def test_script_smoke_run(script, tmp_path):
     if script == "rest_strains_speed.py" and subprocess.run(
             ["git", "-C", ROOT, "merge-base", "HEAD", "main"], capture_output=True).returncode != 0:
         pytest.skip("needs a git checkout with a main branch (the base it measures against)")
+    if script == "reach_scores.py":
+        pytest.importorskip("gymnasium")
     if script == "view_open.py" and shutil.which("pvpython") is None:
         pytest.skip("needs ParaView's pvpython")
     proc = subprocess.run([sys.executable, os.path.join(ROOT, "solvers", script), "--smoke",

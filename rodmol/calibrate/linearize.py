@@ -1,4 +1,4 @@
-"""Linearisation for control design: dy/dt ~ A dy + B du about a state.
+"""Linearisation for control design: dy/dt ~ A dy + B du + f0 about a state.
 
 The inputs u are the cable tensions, the actuator positions of
 displacement-controlled cables and the components of point loads; the
@@ -64,7 +64,12 @@ def linearize(model, state, t=0.0, scheme=DEFAULT_SCHEME):
           force or moment, the components in the load's own frame (global for
           ``frame="global"``, the section's for ``"local"``): exact as well.
 
-        It unpacks as before: ``A, B = linearize(...)``.
+        It unpacks as before: ``A, B = linearize(...)``. It carries its operating
+        point: ``state``, ``t``, the inputs' values ``u0`` there (the tensions,
+        actuator positions and load components, in the order of ``inputs``), the
+        tip there (``output("tip").y0``), the inputs' ``bounds`` (tensions >= 0 N)
+        and the drift ``f0``, the rates at ``state`` (zero at an equilibrium), so
+        dy/dt ~ A dy + B du + f0 holds about a state in motion too.
 
     Raises
     ------
@@ -95,21 +100,22 @@ def linearize(model, state, t=0.0, scheme=DEFAULT_SCHEME):
     for j, unit in enumerate(np.eye(len(model.cables))):
         b[:, j] = 0.5 * (rates(y, tensions + unit) - rates(y, tensions - unit))
     names = [f"{c.name} tension [N]" for c in model.cables]
-    columns = [b]
-    motors = _tendons(model, system, t, y, a, b)
-    if motors:
-        names += [name for name, _ in motors]
-        columns.append(np.column_stack([column for _, column in motors]))
-    loads = _point_loads(model, system, t, y, tensions)
-    if loads:
-        names += [name for name, _ in loads]
-        columns.append(np.column_stack([column for _, column in loads]))
-    tip = (_tip_rows(system, t, y), ("tip x [m]", "tip y [m]", "tip z [m]"))
+    columns, values = [b], [np.asarray(tensions, dtype=float)]
+    bounds = [np.tile([0.0, np.inf], (len(model.cables), 1))]  # cables only pull
+    for found in (_tendons(model, system, t, y, a, b), _point_loads(model, system, t, y, tensions)):
+        if found:
+            names += [name for name, _, _ in found]
+            columns.append(np.column_stack([column for _, column, _ in found]))
+            values.append(np.array([value for _, _, value in found]))
+            bounds.append(np.tile([-np.inf, np.inf], (len(found), 1)))
+    tip = (_tip_rows(system, t, y), ("tip x [m]", "tip y [m]", "tip z [m]"), probe.state_view(t, y).tip)
     columns = np.hstack(columns)
+    drift = probe(t, y)  # the model's own rates at the operating point
     entries = [system.entry_name(i) for i in range(system.size)]
     _refuse_non_finite(t, ("A", a, entries, entries), ("B", columns, entries, names),
-                       ("the tip's C", tip[0], tip[1], entries))
-    return LinearModel(a, columns, inputs=tuple(names), state=y, t=t, named_outputs={"tip": tip})
+                       ("the tip's C", tip[0], tip[1], entries), ("f0", drift[:, None], entries, ["t"]))
+    return LinearModel(a, columns, inputs=tuple(names), state=y, t=t, named_outputs={"tip": tip},
+                       u0=np.concatenate(values), f0=drift, bounds=np.vstack(bounds))
 
 
 def _refuse_non_finite(t, *matrices):
@@ -141,7 +147,7 @@ def _tip_rows(system, t, y):
 
 def _tendons(model, system, t, y, a, b):
     """The displacement-controlled cables: their tendon law's dependence on the
-    path length is added to ``a`` in place; returns their (name, d f / d z) columns."""
+    path length is added to ``a`` in place; returns their (name, d f / d z, z [m]) columns."""
     motors = [(j, c) for j, c in enumerate(model.cables) if c.actuated]
     if not motors:
         return []
@@ -164,7 +170,7 @@ def _tendons(model, system, t, y, a, b):
     for j, cable in motors:
         stiffness, gain = cable.tension.slopes(t, lengths[j])
         a[:, rows] += np.outer(b[:, j], stiffness * d_length[:, j])
-        out.append((f"{cable.name} displacement [m]", b[:, j] * gain))
+        out.append((f"{cable.name} displacement [m]", b[:, j] * gain, float(cable.displacement.value(t))))
     return out
 
 
@@ -174,8 +180,8 @@ def _field_rows(layout, name):
 
 
 def _point_loads(model, system, t, y, tensions):
-    """(name, d f / d component) of the point forces and moments: the kernel's
-    load values moved by one unit, central (the right-hand side is affine in them)."""
+    """(name, d f / d component, the component's value) of the point forces and moments: the
+    kernel's load values moved by one unit, central (the right-hand side is affine in them)."""
     out, start = [], 0
     system.update_inputs(t, y, tensions)
     values = system.entry_values
@@ -188,10 +194,11 @@ def _point_loads(model, system, t, y, tensions):
         if not isinstance(load, (PointForce, PointMoment)):
             continue
         unit = "N" if isinstance(load, PointForce) else "N m"
+        vector = np.asarray(getattr(load, load._what).value(t), dtype=float)  # in the load's frame
         for c, axis in enumerate("xyz"):
             for side, sign in enumerate((1.0, -1.0)):
                 values[rows, c] = held[rows, c] + sign
                 stencil.rhs(y, rates[side], *system.kernel_arguments())
                 values[rows, c] = held[rows, c]
-            out.append((f"{load.name} {axis} [{unit}]", 0.5 * (rates[0] - rates[1])))
+            out.append((f"{load.name} {axis} [{unit}]", 0.5 * (rates[0] - rates[1]), float(vector[c])))
     return out

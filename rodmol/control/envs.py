@@ -1,14 +1,15 @@
 """gymnasium environments of the paper's arm (``pip install rodmol[rl]``).
 
-Importing this module registers ``"rodmol/Reach-v0"`` (:class:`ReachEnv`)::
+``import rodmol`` registers ``"rodmol/Reach-v0"`` (:class:`ReachEnv`) with
+gymnasium (:mod:`rodmol.control.registration`), whose ``make`` imports this
+module::
 
     import gymnasium
-    import rodmol.control.envs  # noqa: F401  (registers the environments)
+    import rodmol
 
     env = gymnasium.make("rodmol/Reach-v0")
-    envs = rodmol.control.envs.vector_env(4)  # in parallel processes
+    envs = rodmol.control.envs.vector_env(4)  # in parallel processes (after importing it)
 
-``gymnasium.make("rodmol.control.envs:rodmol/Reach-v0")`` imports it too.
 rodmol itself never imports this module, so it works without gymnasium.
 """
 
@@ -25,7 +26,7 @@ from ..arm import CABLE_OFFSETS, paper_arm
 from ..errors import IntegrationError, ParameterError, RodmolError
 from .simulator import Simulator
 
-REACH_ID = "rodmol/Reach-v0"
+REACH_ID = "rodmol/Reach-v0"  # registered by rodmol.control.registration
 #: Distance of the targets from the base [fraction of L], and largest angle [rad] from the base axis.
 TARGET_REACH = (0.8, 0.97)
 TARGET_CONE = np.radians(45.0)
@@ -107,6 +108,11 @@ class ReachEnv(gymnasium.Env):
     (``reset(seed=...)``), and a reset restores the start state bitwise, so
     episodes are reproducible.
 
+    Model-based control: :attr:`state` (the whole state vector), :attr:`t`
+    and :attr:`held` (the tensions held now) are the operating point, and
+    ``rodmol.linearize(env.held_model(), env.state, env.t)`` the linear model
+    about it (read them on ``env.unwrapped``).
+
     Parameters
     ----------
     n_elements : int
@@ -143,6 +149,31 @@ class ReachEnv(gymnasium.Env):
         self.observation_space = spaces.Box(-np.inf, np.inf, (21,), np.float32)
         self.target, self._steps = self.sim.state.tip.copy(), 0
         self._ended = "before the first reset()"  # why step must wait for a reset, or None
+
+    # ----------------------------------------------------------------- for model-based control
+
+    @property
+    def state(self):
+        """The arm's whole state vector now (``rodmol.StateLayout``), a copy: the observation
+        is a part of it."""
+        return self.sim.y
+
+    @property
+    def t(self):
+        """The simulated time now [s] (0 at a reset)."""
+        return self.sim.t
+
+    @property
+    def held(self):
+        """The tensions [N] of cables 1-12 held now (those of the last action, as clipped;
+        0 N after a reset), float64."""
+        tensions = self.sim.held["tensions"]
+        return np.array([tensions[f"cable {k}"] for k in sorted(CABLE_OFFSETS)])
+
+    def held_model(self):
+        """The arm with the tensions held now as constants: ``rodmol.linearize(env.held_model(),
+        env.state, env.t)`` is the linear model about the present state and inputs."""
+        return self.sim.held_model()
 
     # ----------------------------------------------------------------- gymnasium's API
 
@@ -221,7 +252,3 @@ def vector_env(num_envs, **kwargs):
     """``num_envs`` :class:`ReachEnv` (keyword arguments ``kwargs``), each in its own process
     (``gymnasium.vector.AsyncVectorEnv``)."""
     return gymnasium.vector.AsyncVectorEnv([functools.partial(ReachEnv, **kwargs)] * int(num_envs))
-
-
-if REACH_ID not in gymnasium.registry:
-    gymnasium.register(REACH_ID, entry_point=ReachEnv)

@@ -10,6 +10,7 @@ actuator positions and loads are derived.
 """
 
 import dataclasses
+import functools
 from bisect import bisect_left
 
 import numpy as np
@@ -17,7 +18,7 @@ import numpy as np
 from .. import _checks
 from ..cables import Tension
 from ..errors import ParameterError
-from ..inputs import TimeInput
+from ..inputs import Constant, TimeInput
 from ..loads import PointForce, PointMoment
 
 #: The point loads whose vector a simulator holds.
@@ -87,6 +88,16 @@ class HeldInputs:
                 targets.append(i)
         return cls(model, tuple(kinds), tuple(targets))
 
+    @functools.cached_property
+    def _names(self):
+        """The cables' names and the loads' (None for a load without one), a step looks them up."""
+        return ([c.name for c in self.model.cables], [getattr(x, "name", None) for x in self.model.loads])
+
+    @functools.cached_property
+    def _slots(self):
+        """(kind, index of the cable or load) -> position in a held row."""
+        return {(kind, i): j for j, (kind, i) in enumerate(zip(self.kinds, self.targets))}
+
     def initial_row(self, t):
         """The held values at time ``t`` [s]: the model's inputs there."""
         row = []
@@ -112,6 +123,12 @@ class HeldInputs:
             else:
                 loads[i] = dataclasses.replace(loads[i], **{loads[i]._what: signal})
         return m.replace(cables=cables, loads=loads)
+
+    def constant(self, row):
+        """The model holding ``row`` for all time (constant inputs), as ``rodmol.linearize``
+        and ``rodmol.equilibrium`` take it."""
+        return self.model_with([Constant(np.atleast_1d(value), 3 if kind == "load" else 1)
+                                for kind, value in zip(self.kinds, row)])
 
     def live(self, row):
         """(model, its :class:`Held` inputs) holding ``row``."""
@@ -150,7 +167,7 @@ class HeldInputs:
     def _slot(self, what, key):
         """Position in the row of the input ``key`` (a name or an index among the cables or loads)."""
         pool = self.model.loads if what == "load" else self.model.cables
-        names = [getattr(x, "name", None) for x in pool]
+        names = self._names[what == "load"]
         if isinstance(key, (int, np.integer)) and not isinstance(key, bool):
             if not 0 <= key < len(pool):
                 raise ParameterError(f"`{what}s`: index {key!r} is out of range (the model has "
@@ -165,9 +182,9 @@ class HeldInputs:
             raise ParameterError(f"`{what}s`: unknown {'load' if what == 'load' else 'cable'} "
                                  f"{_checks.short(key)}{_checks.did_you_mean(key, names)}; valid: "
                                  f"{', '.join(map(repr, names))} or an index")
-        for j, (kind, target) in enumerate(zip(self.kinds, self.targets)):
-            if target == i and kind == what:
-                return j
+        j = self._slots.get((what, i))
+        if j is not None:
+            return j
         label = f"{'load' if what == 'load' else 'cable'} {names[i]!r}"
         if what == "load":
             raise ParameterError(f"`loads`: {label} is not a point load (only PointForce and PointMoment "

@@ -146,6 +146,12 @@ class Simulator:
             out[f"{kind}s"][pool[i].name] = value.copy() if kind == "load" else value
         return out
 
+    def held_model(self):
+        """The model with the inputs held now as constants (a tension schedule of the model
+        replaced by its held value): with :attr:`y` and :attr:`t`, the operating point a
+        model-based controller linearises about, ``rodmol.linearize(sim.held_model(), sim.y, sim.t)``."""
+        return self._inputs.constant(self._row)
+
     def step(self, dt, tensions=None, *, displacements=None, loads=None):
         """Advance by ``dt`` [s] with the inputs held; returns the new :attr:`state`.
 
@@ -172,13 +178,17 @@ class Simulator:
         if not t_end > t_start:
             raise ParameterError(f"`dt` = {dt!r} s is below the time resolution at t = {t_start!r} s")
         changed = not _same(row, self._row)
-        self._hold(row)
+        if changed:
+            self._hold(row)
         started = time.perf_counter()
-        failed = self._stepper.advance(t_end, restart=changed or self._restart,
+        # Inputs that jumped restart CVODE here, and are likely to jump again at the step's
+        # end: its steps end there. Held ones let its steps run on past it, as simulate's.
+        failed = self._stepper.advance(t_end, restart=changed or self._restart, exact_end=changed,
                                        max_wall_time=self.max_wall_time, progress=self._report)
         self._wall += time.perf_counter() - started
         if failed:
-            self._hold(self._row)
+            if changed:
+                self._hold(self._row)
             reason, error = failed
             raise IntegrationError(f"the step from t = {t_start:.6g} s to {t_end:.6g} s failed "
                                    f"(the simulator stays at t = {t_start:.6g} s): {reason}") from error
@@ -277,5 +287,5 @@ class Simulator:
 
 
 def _same(a, b):
-    """True if the held rows ``a`` and ``b`` are equal."""
-    return all(np.array_equal(x, y) for x, y in zip(a, b))
+    """True if the held rows ``a`` and ``b`` are equal (numbers, and vectors of point loads)."""
+    return all(x == y if isinstance(x, float) else np.array_equal(x, y) for x, y in zip(a, b))

@@ -1,6 +1,5 @@
 """SUNDIALS CVODE (BDF) through scikit-sundae."""
 
-from ..inputs import knot_times
 from .outputs import Outputs, run_steps
 from .stepping import Stepper
 from .watch import Watch
@@ -64,13 +63,10 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, l
     t_end = float(t_out[-1])
 
     def steps():
-        # Steps stop at the inputs' knots: a rod at rest takes long steps and
-        # would stride over a short ramp that starts between two of them.
-        kinks = [t for t in knot_times(system.model) if t_out[0] < t < t_end][::-1]
         while not out.done:
-            while kinks and kinks[-1] <= stepper.reached:
-                kinks.pop()
-            r, problem = stepper.step(t_end, kinks[-1] if kinks else t_end, watch)
+            # at the inputs' knots: a rod at rest takes long steps and would
+            # stride over a short ramp that starts between two of them
+            r, problem = stepper.step(t_end, stepper.stop_time(t_end), watch)
             if problem:  # the frames inside a broken step are not kept either
                 return stop(problem)
             while not out.done and out.t_out[out.next_index] <= r.t:

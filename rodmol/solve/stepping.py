@@ -22,6 +22,7 @@ from scipy import sparse
 
 from ..discretise.preconditioner import check_structure
 from ..errors import ParameterError
+from ..inputs import knot_times
 from .outputs import cause, step_size_stats
 from .watch import Watch
 
@@ -30,6 +31,8 @@ LINEAR_SOLVERS = ("gmres", "band", "lapackband", "sparse", "dense")
 JACOBIANS = ("compiled", "sundials")
 #: From this many elements on, linsolver="auto" picks the preconditioned GMRES.
 GMRES_MIN_ELEMENTS = 50
+#: The reason :meth:`Stepper.advance` gives for a Ctrl-C.
+INTERRUPTED = "interrupted"
 
 
 class StepFailed(Exception):
@@ -59,12 +62,14 @@ class Stepper:
         self.restarts, self._njev, self._njev_before = 0, 0, 0  # CVODE's Jacobian count restarts with it
         #: Time [s] of the last right-hand side that raised (None: none did).
         self.failed_at = None
+        self._watch = None  # the first advance's, renewed for each
         with warnings.catch_warnings():
             # scikit-sundae warns that its own coloured differences are not used
             # when both `sparsity` and `jacfn` are given: that is the point.
             warnings.filterwarnings("ignore", "Custom sparse Jacobian", UserWarning)
             self._solver = CVODE(self._rhs, **options)
         self.t, self.y = float(t0), np.array(y0, dtype=float)
+        self.knots = knot_times(system.model)  # the inputs' kinks [s], sorted
         #: Time [s] CVODE's steps have reached (beyond ``t`` inside an advance).
         self.reached = self.t
         self._fresh = False  # CVODE holds no history to continue from
@@ -114,40 +119,69 @@ class Stepper:
         """The state at ``t`` [s] inside the last step, by CVODE's interpolant."""
         return self._solver.step(t).y
 
-    def advance(self, t_end, restart=False, max_wall_time=None, progress=None):
-        """Integrate to ``t_end`` [s]; ``restart`` re-initialises CVODE first (the inputs
-        jumped). Returns None if all went well, else (reason, exception or None); the
-        stepper then stays at its state before the call (re-initialised there)."""
+    def advance(self, t_end, restart=False, max_wall_time=None, progress=None, exact_end=True):
+        """Integrate to ``t_end`` [s]. Returns None if all went well, else (reason, exception
+        or None); the stepper then stays at its state before the call (re-initialised there).
+
+        ``restart`` re-initialises CVODE first (the inputs jumped). ``exact_end`` ends the
+        last internal step at ``t_end`` (the inputs may jump there); False lets the steps go
+        on past it, as one run's do past an output time, and the state at ``t_end`` is
+        CVODE's interpolant: a caller holding its inputs over many calls then costs what one
+        run costs. A following call that restarts drops the steps taken past its start. A
+        call without ``exact_end`` that fails is tried once more with it (from the same
+        start), so a step past ``t_end`` does not fail a call that stops before it.
+        """
         t_start, y_start = self.t, self.y
         if restart and not self._fresh:
             self.restart(t_start, y_start)
-        watch = Watch(self.system, (t_start, t_end), max_wall_time, progress)
-        try:
-            self._steps(t_end, watch)
-        except StepFailed as failed:
+        if self._watch is None:
+            self._watch = Watch(self.system, (t_start, t_end))
+        watch = self._watch.again((t_start, t_end), max_wall_time, progress)
+        failed = self._attempt(t_end, watch, exact_end)
+        if failed and not exact_end and failed[0] != INTERRUPTED:
             self.restart(t_start, y_start)
+            failed = self._attempt(t_end, watch, True)
+        if failed:
+            self.restart(t_start, y_start)
+        return failed
+
+    def _attempt(self, t_end, watch, exact_end):
+        """Steps to ``t_end`` [s] from where CVODE is: None, or (reason, exception or None)."""
+        t_start = self.t
+        try:
+            self._steps(t_end, watch, exact_end)
+        except StepFailed as failed:
             return failed.reason, failed.error
         except KeyboardInterrupt:
-            self.restart(t_start, y_start)
-            return "interrupted", None
+            return INTERRUPTED, None
         except Exception as exc:  # noqa: BLE001 (a user callback's: reported, the state kept)
-            self.restart(t_start, y_start)
             return cause(exc, t_start), exc
         return None
 
-    def _steps(self, t_end, watch):
-        while True:
-            r, problem = self.step(t_end, t_end, watch)
+    def _steps(self, t_end, watch, exact_end):
+        r = None
+        while self.reached < t_end:
+            r, problem = self.step(t_end, self.stop_time(t_end, exact_end), watch)
             if problem:
                 raise StepFailed(_why(watch, problem))
-            if r.t >= t_end:
-                # unit quaternions, as simulate's frames (the dynamics do not see |Q|)
-                self.t, self.y = float(t_end), np.array(r.y)
-                self.system.layout.project_quaternions(self.y)
-                return
             slow = watch.pace(r.t, r.y)
-            if slow:
+            if slow and r.t < t_end:
                 raise StepFailed(_why(watch, slow))
+        # At a step's end its state, else CVODE's interpolant inside the last step.
+        y = r.y if r is not None and r.t == t_end else self.interpolate(t_end)
+        # unit quaternions, as simulate's frames (the dynamics do not see |Q|)
+        self.t, self.y = float(t_end), np.array(y)
+        self.system.layout.project_quaternions(self.y)
+
+    def stop_time(self, t_end, exact_end=True):
+        """Where the next internal step must end at the latest [s]: the first knot of the
+        inputs after the steps reached (``rodmol.inputs.knot_times``: a long step must not
+        stride over a short ramp), and ``t_end`` if ``exact_end``; None: anywhere."""
+        k = np.searchsorted(self.knots, self.reached, side="right")
+        knot = float(self.knots[k]) if k < len(self.knots) else None
+        if exact_end and (knot is None or knot > t_end):
+            return float(t_end)
+        return knot
 
     def stats(self):
         """Steps, evaluations and step sizes so far, as a run's ``stats``."""

@@ -28,6 +28,7 @@ The same scan checks the static equilibrium and a user's initial state
 (:func:`state_problem`; a system's, each rod's part: :func:`assembly_state_problem`).
 """
 
+import copy
 import math
 import time
 
@@ -156,12 +157,6 @@ class Watch:
     def __init__(self, system, t_span, max_wall_time=None, progress=None):
         self.layout, self.ds = system.layout, system.model.ds
         self.n = self.layout.n_elements
-        self.t0, self.t_end = float(t_span[0]), float(t_span[-1])
-        self.max_wall_time, self.progress = max_wall_time, progress
-        self.start = time.perf_counter()
-        self.reported = self.start
-        self.steps, self.h_last, self.t = 0, 0.0, self.t0
-        self._window_start, self._checked, self._worst = self.t0, 0, (0, 1.0)
         # The tip section carries the pull of the cables anchored there: a pull
         # near its axial stiffness EA crushes it (the Result's tip strain
         # 1 - T / EA turns negative) though no element of the state does.
@@ -169,6 +164,22 @@ class Watch:
         self.system = system
         self.tip_cables = np.flatnonzero(system.routing.weights[:, -1] == 1.0)  # anchored at the tip
         self.tip_stiffness = float(model.rod.stiffness(model.rod.length)[0][0])
+        self._begin(t_span, max_wall_time, progress)
+
+    def again(self, t_span, max_wall_time=None, progress=None):
+        """A new watch of the same system over ``t_span`` (its constants not derived again:
+        a stepping simulator starts one per step)."""
+        watch = copy.copy(self)
+        watch._begin(t_span, max_wall_time, progress)
+        return watch
+
+    def _begin(self, t_span, max_wall_time, progress):
+        self.t0, self.t_end = float(t_span[0]), float(t_span[-1])
+        self.max_wall_time, self.progress = max_wall_time, progress
+        self.start = time.perf_counter()
+        self.reported = self.start
+        self.steps, self.h_last, self.t = 0, 0.0, self.t0
+        self._window_start, self._checked, self._worst = self.t0, 0, (0, 1.0)
 
     def state(self, t, h, y):
         """Check the state ``y`` at the end ``t`` [s] of an accepted step of size ``h`` [s]."""

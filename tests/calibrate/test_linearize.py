@@ -83,6 +83,8 @@ def test_tendon_stiffness_is_in_a_and_displacement_columns_match():
     assert system.tensions(0.0, y)[11] > 0.05  # the tendon is taut
     lin = linearize(model, y)
     assert lin.inputs[-1] == "cable 12 displacement [m]" and lin.B.shape == (y.size, 13)
+    assert lin.u0[-1] == -0.01 and list(lin.bounds[-1]) == [-np.inf, np.inf]
+    assert lin.u0[11] == pytest.approx(system.tensions(0.0, y)[11], rel=1e-12)  # the tendon's own pull
     reference = central(lambda x: system(0.0, x), y, 1e-6 * system.atol_scale())
     assert np.max(np.abs(lin.A - reference)) < 1e-6 * np.abs(reference).max()
     dz = 1e-5
@@ -105,6 +107,7 @@ def test_point_load_columns_match_models_with_other_loads(bent):
     lin = linearize(arm(force, moment), y, 0.3)
     assert lin.inputs[12:] == ("tip force x [N]", "tip force y [N]", "tip force z [N]",
                                "twist x [N m]", "twist y [N m]", "twist z [N m]")
+    np.testing.assert_array_equal(lin.u0[12:], np.concatenate([force, moment]))  # in each load's frame
     for j, (f, mo) in enumerate([(e, 0 * e) for e in np.eye(3)] + [(0 * e, e) for e in np.eye(3)]):
         up = rodmol.SemiDiscrete(arm(force + 0.1 * f, moment + 0.1 * mo))(0.3, y)
         down = rodmol.SemiDiscrete(arm(force - 0.1 * f, moment - 0.1 * mo))(0.3, y)
@@ -199,3 +202,75 @@ def test_linear_step_response_is_the_nonlinear_one_to_first_order(hanging):
             linear.append(sampled.C @ x)
         errors.append(np.max(np.abs(run.tip - run.tip[0] - np.array(linear))))
     assert 1.6 < np.log(errors[1] / errors[0]) / np.log(4.0) < 2.4
+
+
+@pytest.fixture(scope="module")
+def swinging():
+    """The paper's arm (N = 8) 0.1 s after cable 11 pulled 1 N from rest without tension: a
+    state in motion (not an equilibrium), and its linearisation there."""
+    model = rodmol.paper_arm(8, tensions={11: 1.0})
+    rest = rodmol.equilibrium(rodmol.paper_arm(8))
+    y = rodmol.simulate(model, 0.1, initial=rest, output_dt=0.05).states[-1]
+    return model, y, linearize(model, y, 0.1)
+
+
+def test_drift_is_the_rates_at_the_operating_point_and_vanishes_at_an_equilibrium(swinging, hanging):
+    model, y, lin = swinging
+    rates = rodmol.SemiDiscrete(model)(0.1, y)
+    np.testing.assert_array_equal(lin.f0, rates)
+    scale = np.abs(rates).max()
+    assert scale > 10.0  # in motion
+    assert np.abs(hanging[1].f0).max() < 1e-12 * scale  # measured 2e-16
+    # the operating point's inputs, their bounds and the tip there
+    np.testing.assert_array_equal(lin.u0, np.eye(12)[10])
+    np.testing.assert_array_equal(lin.bounds, np.tile([0.0, np.inf], (12, 1)))  # cables only pull
+    tip = lin.output("tip")
+    np.testing.assert_array_equal(tip.y0, rodmol.SemiDiscrete(model).state_view(0.1, y).tip)
+    c = np.eye(y.size)[:2]
+    np.testing.assert_array_equal(lin.output(c).y0, y[:2])
+    reduced = lin.reduced(output="tip", order=16)
+    np.testing.assert_allclose(reduced.f0, reduced.projection @ lin.f0)
+    np.testing.assert_array_equal(reduced.y0, tip.y0)
+    np.testing.assert_allclose(reduced.coordinates(y), 0.0, atol=0.0)
+
+
+def test_affine_model_predicts_the_motion_about_a_state_in_motion(swinging):
+    """From the moving state, cable 5 stepped to 0.2 N: the sampled affine model's tip over
+    5 periods of 10 ms against simulate, and against the same model without its drift
+    (the motion it is in): measured 30-50 times closer."""
+    model, y, lin = swinging
+    sampled = lin.output("tip").discretize(0.01)
+    run = rodmol.simulate(rodmol.paper_arm(8, tensions={11: 1.0, 5: 0.2}), 0.15, initial=y, t0=0.1,
+                          output_dt=0.01, rtol=1e-8)
+    u = 0.2 * np.eye(12)[4]
+    errors = []
+    for drift in (sampled.f0, 0.0 * sampled.f0):
+        x, tips = np.zeros(y.size), [sampled.y0]
+        for _ in range(len(run.t) - 1):
+            x = sampled.A @ x + sampled.B @ u + drift
+            tips.append(sampled.y0 + sampled.C @ x + sampled.D @ u)
+        errors.append(np.max(np.abs(np.array(tips) - run.tip)[1:], axis=1))
+    assert np.max(np.abs(run.tip - run.tip[0])) > 0.005  # it moved 5 mm or more
+    assert np.all(errors[0] < 0.1 * errors[1]), errors
+
+
+def test_zero_order_hold_of_the_drift_matches_the_affine_ode(swinging):
+    """x(dt) of dx/dt = A x + B u + f0 with u held, against the sampled A x0 + B u + f0:
+    the reduced tip model by BDF (scipy's solve_ivp), the whole state from its modes."""
+    _, _, lin = swinging
+    dt = 0.02
+    rng = np.random.default_rng(2)
+    reduced = lin.reduced(output="tip", order=16)
+    x0 = 1e-3 * rng.standard_normal(reduced.A.shape[0])
+    u = rng.standard_normal(lin.B.shape[1])
+    exact = solve_ivp(lambda _, x: reduced.A @ x + reduced.B @ u + reduced.f0, (0.0, dt), x0, method="BDF",
+                      jac=reduced.A, rtol=1e-10, atol=1e-14).y[:, -1]
+    sampled = reduced.discretize(dt)
+    assert np.max(np.abs(sampled.A @ x0 + sampled.B @ u + sampled.f0 - exact)) < 1e-8 * np.abs(exact).max()
+
+    x0 = 1e-3 * rng.standard_normal(lin.A.shape[0])
+    lam, right, left = lin.modes()
+    held = np.where(np.abs(lam) * dt > 1e-12, np.expm1(lam * dt) / np.where(lam == 0, 1, lam), dt)
+    exact = (right @ (np.exp(lam * dt) * (left @ x0) + held * (left @ (lin.B @ u + lin.f0)))).real
+    sampled = lin.discretize(dt)
+    assert np.max(np.abs(sampled.A @ x0 + sampled.B @ u + sampled.f0 - exact)) < 1e-8 * np.abs(exact).max()
