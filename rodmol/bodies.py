@@ -9,8 +9,11 @@ from . import _checks
 from .base_motion import BaseMotion
 from .errors import ParameterError
 from .loads import CONTACT_NAMES, CONTACT_SHAPES, SMOOTHING_FRACTION
-from .meshes import mesh_properties  # noqa: F401 (its home before rodmol.meshes)
-from .meshes import read_surface, solid_properties
+from .meshes import (
+    mesh_properties,  # noqa: F401 (its home before rodmol.meshes)
+    read_surface,
+    solid_properties,
+)
 
 #: Motions of a body besides a prescribed :class:`BaseMotion`.
 MOTIONS = ("free", "fixed")

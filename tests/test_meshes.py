@@ -49,7 +49,7 @@ def test_a_tenth_of_a_metre_cube_of_water_has_the_analytic_mass_and_inertia(tmp_
 def test_a_cube_with_one_face_turned_inwards_is_refused_naming_it(tmp_path):
     turned = _CUBE.copy()
     turned[4:6] = turned[4:6, ::-1]  # the square x = -1/2: before, 0.667 kg instead of 1 kg
-    message = _refused(tmp_path, 0.1 * _CORNERS, turned, "not consistently oriented", "faces 4, 5 are turned")
+    _refused(tmp_path, 0.1 * _CORNERS, turned, "not consistently oriented", "faces 4, 5 are turned")
 
 
 @_STL_PROBE

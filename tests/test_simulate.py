@@ -107,7 +107,6 @@ def test_a_refused_initial_state_leaves_the_run_overwrite_would_replace(tmp_path
 
 def test_a_sink_that_cannot_resume_is_refused_before_any_work(tmp_path):
     from rodmol.output.stream import RunWriter
-
     from rodmol.output.system_stream import SystemRunWriter
 
     with pytest.raises(rodmol.ParameterError, match="holds no run to resume"):

@@ -13,6 +13,7 @@ raises ``KeyboardInterrupt`` at once (the user insists), unless ``forcing``
 is off.
 """
 
+import contextlib
 import os
 import signal
 import sys
@@ -76,7 +77,5 @@ class DeferredSignals:
 def _write_stderr(text):
     """``text`` on standard error by one system call: a handler that printed through
     ``sys.stderr`` could land inside another write to it (a reentrant call)."""
-    try:
+    with contextlib.suppress(AttributeError, OSError, ValueError):  # no file behind it (a test's capture)
         os.write(sys.stderr.fileno(), f"\n{text}\n".encode())
-    except (AttributeError, OSError, ValueError):  # no file behind it (a test's capture): not said
-        pass

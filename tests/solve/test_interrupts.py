@@ -16,7 +16,6 @@ import rodmol
 from rodmol.discretise.assembly import Assembly
 from rodmol.solve.interrupts import DeferredSignals, stop_reason
 
-
 TWO_ARMS = Path(__file__).resolve().parents[2] / "examples" / "two_arms.toml"
 
 
