@@ -68,12 +68,16 @@ def scan(y, n, ds, min_stretch, max_stretch, max_turn, max_drift):
     return OK, worst, worst_q1
 
 
+def limits(n_elements, ds):
+    """:func:`scan`'s arguments after the state, of a rod of ``n_elements`` of length ``ds`` [m]."""
+    return n_elements, ds, MIN_STRETCH, MAX_STRETCH, MAX_TURN, MAX_QUATERNION_DRIFT
+
+
 def state_problem(layout, ds, t, y):
     """A sentence naming what is wrong with the rod's state ``y`` at time ``t`` [s], or None
     (``layout``: its :class:`~rodmol.discretise.layout.StateLayout`, ``ds`` [m] its elements' length)."""
     y = np.ascontiguousarray(y, dtype=float)
-    code, i, value = scan(y, layout.n_elements, ds, MIN_STRETCH, MAX_STRETCH, MAX_TURN, MAX_QUATERNION_DRIFT)
-    return _describe(layout, ds, t, code, i, value)
+    return describe(layout, ds, t, *scan(y, *limits(layout.n_elements, ds)))
 
 
 def tip_problem(t, pull, stiffness):
@@ -105,7 +109,8 @@ def least_stretch(layout, y):
     return float(np.min(layout.field(y, "q")[:, 0]))
 
 
-def _describe(layout, ds, t, code, i, value):
+def describe(layout, ds, t, code, i, value):
+    """:func:`scan`'s finding (``code``, ``i``, ``value``) at ``t`` [s] as a sentence (None if OK)."""
     at = f"at t = {t:.6g} s"
     if code == NON_FINITE:
         return (f"the state became non-finite {at} ({layout.entry_name(i)} = {value!r}): the "

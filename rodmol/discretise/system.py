@@ -23,7 +23,7 @@ from .preconditioner import check_structure
 from .routing import CableRouting
 from .sampling import Sampled, cell_properties
 from .schemes import DEFAULT_SCHEME, get_scheme
-from .state_checks import stall_diagnosis, state_problem, tip_problem
+from .state_checks import OK, describe, limits, scan, stall_diagnosis, state_problem, tip_problem
 from .state_view import StateView
 from .undeformed import undeformed_state
 
@@ -129,6 +129,7 @@ class SemiDiscrete:
         self.scheme = get_scheme(scheme)
         self.lightly_damped = bool(grid_damping_ratio(model) < 1.0)
         self.layout = StateLayout(model.n_elements)
+        self._limits = limits(model.n_elements, model.ds)
         self.size = self.layout.size
         # Feedback and displacement-controlled tensions and friction read the whole state.
         self._friction = model.friction  # a property over the cables: read once, not per call
@@ -329,9 +330,12 @@ class SemiDiscrete:
         """:meth:`state_problem`, and the tip section crushed by the cables anchored there
         (:func:`rodmol.discretise.state_checks.tip_problem`), of the state ``y`` at ``t`` [s]
         after a step of a run, or None."""
-        problem = state_problem(self.layout, self.model.ds, t, y)
-        if problem or self._tip_stiffness is None:
-            return problem
+        # Compiled scan with its arguments kept: this runs at every step of a run.
+        code, i, value = scan(y, *self._limits)
+        if code != OK:
+            return describe(self.layout, self.model.ds, t, code, i, value)
+        if self._tip_stiffness is None:
+            return None
         return tip_problem(t, float(np.sum(self.tensions(t, y)[self._tip_cables])), self._tip_stiffness)
 
     def describe_stall(self, y):

@@ -62,7 +62,7 @@ class Watch:
     """
 
     def __init__(self, system, t_span, max_wall_time=None, progress=None):
-        self.system = system
+        self.system, self._step_problem = system, system.step_problem
         self.t0, self.t_end = float(t_span[0]), float(t_span[-1])
         self.max_wall_time, self.progress = max_wall_time, progress
         self.start = time.perf_counter()
@@ -74,7 +74,7 @@ class Watch:
         """Check the state ``y`` at the end ``t`` [s] of an accepted step of size ``h`` [s]."""
         self.steps += 1
         self.t, self.h_last = t, h
-        return self.system.step_problem(t, y)
+        return self._step_problem(t, y)
 
     def pace(self, t, y):
         """After the outputs of a step: the stall test, the wall-time budget, progress."""
