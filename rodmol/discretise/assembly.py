@@ -69,7 +69,7 @@ from .physics import quaternion_rate
 from .protocol import pattern_bandwidths
 from .rigid import clamp_wrench, free_body_rates
 from .rotations import from_matrix, matrices
-from .state_checks import least_stretch
+from .state_checks import LIMITS, OK, describe, least_stretch, scan_parts
 from .stencil import WORK_TOTAL
 from .system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE, SemiDiscrete, field_scales
 
@@ -133,6 +133,7 @@ class Assembly:
                 part.body_joints.append(joint)
         self.free = [p for p in self.bodies.values() if p.body.free]
         self.lightly_damped = any(sd.lightly_damped for sd in self.rods.values())
+        self._scan = None  # the arguments of step_problem's compiled scan, made at its first call
         self._gravity = np.ascontiguousarray(system.gravity, dtype=float)
 
     def _rod_base(self, name):
@@ -394,9 +395,28 @@ class Assembly:
         return self._problem("state_problem", t, y)
 
     def step_problem(self, t, y):
-        """:meth:`state_problem` after a step of a run, each rod's part by its own
-        ``step_problem`` (its tip section too)."""
-        return self._problem("step_problem", t, y)
+        """:meth:`state_problem` after a step of a run, and each rod's tip section
+        (``SemiDiscrete.tip_problem``). The rods' scans and the bodies' entries are one
+        compiled call (:func:`rodmol.discretise.state_checks.scan_parts`): this runs at every step."""
+        if self._scan is None:
+            rods = list(self.rods.values())
+            self._scan = (np.array([self.parts[name].start for name in self.rods], dtype=np.int64),
+                          np.array([sd.model.n_elements for sd in rods], dtype=np.int64),
+                          np.array([sd.model.ds for sd in rods]),
+                          min((p.slice.start for p in self.bodies.values()), default=self.size), *LIMITS)
+        part, code, i, value = scan_parts(y, *self._scan)
+        if code != OK:
+            if part < len(self.rods):
+                name = list(self.rods)[part]
+                sd = self.rods[name]
+                return f"rod {name!r}: {describe(sd.layout, sd.model.ds, t, code, i, value)}"
+            return self._problem("state_problem", t, y)  # a body's: named as the state check names it
+        for name, sd in self.rods.items():
+            if sd.tip_anchored:
+                problem = sd.tip_problem(t, y[self.parts[name]])
+                if problem:
+                    return f"rod {name!r}: {problem}"
+        return None
 
     def _problem(self, check, t, y):
         for name, sd in self.rods.items():

@@ -68,9 +68,31 @@ def scan(y, n, ds, min_stretch, max_stretch, max_turn, max_drift):
     return OK, worst, worst_q1
 
 
+@numba.njit(cache=True, nogil=True)
+def scan_parts(y, starts, ns, dss, rest, min_stretch, max_stretch, max_turn, max_drift):
+    """:func:`scan` of each rod's part of a system's state ``y`` (rod r's state from ``starts[r]``,
+    ``ns[r]`` elements of length ``dss[r]``) and the finiteness of ``y[rest:]`` (the bodies'),
+    in one call: (part, code, index, value) of the first problem, the part r, or ``len(starts)``
+    for the bodies' (index from ``rest``); part -1 and OK when all is well."""
+    for r in range(starts.size):
+        n = ns[r]
+        part = y[starts[r]:starts[r] + HEADER + n * BLOCK]
+        code, i, value = scan(part, n, dss[r], min_stretch, max_stretch, max_turn, max_drift)
+        if code != OK:
+            return r, code, i, value
+    for i in range(rest, y.size):
+        if not np.isfinite(y[i]):
+            return starts.size, NON_FINITE, i - rest, y[i]
+    return -1, OK, 0, 0.0
+
+
+#: :func:`scan`'s limits, its last arguments.
+LIMITS = (MIN_STRETCH, MAX_STRETCH, MAX_TURN, MAX_QUATERNION_DRIFT)
+
+
 def limits(n_elements, ds):
     """:func:`scan`'s arguments after the state, of a rod of ``n_elements`` of length ``ds`` [m]."""
-    return n_elements, ds, MIN_STRETCH, MAX_STRETCH, MAX_TURN, MAX_QUATERNION_DRIFT
+    return n_elements, ds, *LIMITS
 
 
 def state_problem(layout, ds, t, y):

@@ -334,6 +334,16 @@ class SemiDiscrete:
         code, i, value = scan(y, *self._limits)
         if code != OK:
             return describe(self.layout, self.model.ds, t, code, i, value)
+        return self.tip_problem(t, y)
+
+    @property
+    def tip_anchored(self):
+        """True if cables are anchored at the tip (:meth:`tip_problem` then checks its section)."""
+        return self._tip_stiffness is not None
+
+    def tip_problem(self, t, y):
+        """The tip section crushed at ``t`` [s] by the cables anchored there
+        (:func:`rodmol.discretise.state_checks.tip_problem`), or None."""
         if self._tip_stiffness is None:
             return None
         return tip_problem(t, float(np.sum(self.tensions(t, y)[self._tip_cables])), self._tip_stiffness)

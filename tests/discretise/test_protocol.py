@@ -181,3 +181,16 @@ def test_a_stall_is_described_by_the_most_compressed_rod(make):
     described = system.describe_stall(y)
     assert f"element 2 (q1 = 0.5), largest turn {3.0 * rod.model.ds:.3g} rad over element 1" in described
     assert described.startswith("In rod 'short': ") == (rod is not system)
+
+
+def test_a_systems_step_check_finds_what_its_state_check_finds():
+    """The per-step check scans every rod and the bodies in one compiled call: it names the
+    same rod, element and body as the state check, rod by rod."""
+    system = _system()
+    for part, entry in (("arm", 3), ("short", 30), ("head", 5)):
+        y = system.undeformed_state()
+        y[system.parts[part].start + entry] = np.nan
+        assert system.step_problem(0.2, y) == system.state_problem(0.2, y)
+    y = system.undeformed_state()
+    system.rods["short"].layout.field(y[system.parts["short"]], "q")[1, 0] = -0.5
+    assert system.step_problem(0.2, y).startswith("rod 'short': element 1 inverted at t = 0.2 s")
