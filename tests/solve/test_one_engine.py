@@ -71,3 +71,16 @@ def test_the_rods_cvode_options_run_a_system():
         np.testing.assert_allclose(run["arm"].tip, runs[0]["arm"].tip, atol=1e-7 * 0.2)
     with pytest.raises(rodmol.ParameterError, match="jacobian='compiled' with linsolver='dense': a system's"):
         rodmol.simulate(system, 0.1, linsolver="dense", jacobian="compiled")
+
+
+def test_a_systems_inputs_are_never_read_past_the_end_of_its_run():
+    """CVODE's last step ends at t_end, as a rod's: the System's driver stepped past it and
+    failed on an input recorded up to the end only."""
+    def tension(t):
+        if t > 0.2:
+            raise ValueError(f"no tension recorded after 0.2 s (t = {t})")
+        return 0.1 * t / 0.2
+
+    system = rodmol.System({"arm": _arm(tension)}, gravity=(0.0, 0.0, 0.0))
+    run = rodmol.simulate(system, 0.2, output_dt=0.05)
+    assert run.success and run.t[-1] == 0.2
