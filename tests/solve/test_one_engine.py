@@ -30,7 +30,7 @@ def test_a_system_that_fails_reads_as_the_same_rod_failing():
             runs.append(rodmol.simulate(thing, 1.0, initial="straight", linsolver="gmres"))
     alone, system = runs
     assert not alone.success and not system.success
-    assert alone.message.startswith("CVODE stopped after t = 0.04 s (last output frame; the solver reached t = ")
+    assert alone.message.startswith("CVODE stopped after t = 0.04 s (last output frame; the solver reached")
     head, cause = alone.message.split("): ", 1)
     assert system.message == f"{head}): rod 'arm': {cause}" and "turns by" in cause
     assert system.stats["steps"] == alone.stats["steps"] and f"in {alone.stats['steps']} steps" in head
@@ -47,7 +47,8 @@ def test_a_systems_steps_stop_at_the_knots_of_its_inputs():
     system = rodmol.simulate(rodmol.System({"arm": arm}, gravity=(0.0, 0.0, 0.0)), 0.4, output_times=[0.35])
     moved = alone.tip[-1] - alone.tip[0]
     assert np.linalg.norm(moved) > 1e-4  # m: the pulse swings the tip
-    np.testing.assert_allclose(system["arm"].tip[-1] - system["arm"].tip[0], moved, atol=1e-3 * np.linalg.norm(moved))
+    tip = system["arm"].tip
+    np.testing.assert_allclose(tip[-1] - tip[0], moved, atol=1e-3 * np.linalg.norm(moved))
 
 
 def test_a_linear_solver_the_system_does_not_offer_is_refused_before_its_directory_is_made(tmp_path):
