@@ -2,10 +2,10 @@
 rod (:class:`rodmol.Model`) and a system of rods and rigid bodies (:class:`rodmol.System`).
 
 Everything else about a run (the checks, resuming, the output times, the tolerances, the
-initial state, the chunked run into a sink, the report of a failure) is one path for both, in
-:mod:`rodmol.simulate`. A new kind of model is one more :class:`RunKind` in :data:`KINDS`; its
-discretised system offers what that path reads: ``size``, ``scheme``, ``atol_scale()``,
-``undeformed_state()``, ``entry_name(i)``, ``inputs_vary`` and the rates ``system(t, y)``, and
+initial state, the backends of :data:`rodmol.solve.backends.BACKENDS`, the chunked run into a
+sink, the report of a failure) is one path for both, in :mod:`rodmol.simulate`. A new kind of
+model is one more :class:`RunKind` in :data:`KINDS`; its discretised system is a
+:class:`rodmol.discretise.protocol.Discretised` (what that path and every backend read), and
 :func:`rodmol.solve.equilibrium.equilibrium` takes it.
 """
 
@@ -18,9 +18,7 @@ from .errors import ParameterError
 from .model import Model
 from .result import Result, from_states
 from .solve import kernels
-from .solve.backends import BACKENDS, SYSTEM_BACKENDS
 from .solve.scales import check_scales
-from .solve.watch import assembly_state_problem, rod_state_problem
 from .system_result import SystemResult
 from .systems import System
 
@@ -31,10 +29,8 @@ class RunKind:
 
     #: The user's model (the problem floor's noun).
     model: type
-    #: ``(model, scheme)`` -> its discretised system, built once per run.
+    #: ``(model, scheme)`` -> its discretised system (a ``Discretised``), built once per run.
     discretise: object
-    #: Backend name -> ``run(system, y0, t_out, **options)``, a RawSolution.
-    backends: dict
     #: ``initial=None``: "equilibrium" (the paper's choice) or "straight" (from rest).
     default_initial: str
     #: ``(system, t, states, success, message, stats)`` -> the run's result.
@@ -43,8 +39,6 @@ class RunKind:
     results: type
     #: ``(directory, resume=, overwrite=)`` -> the sink of ``out=DIR`` (:mod:`rodmol.run_sinks`).
     directory_sink: object
-    #: ``(system, t, y)`` -> what is wrong with the state ``y`` at ``t`` [s], or None.
-    state_problem: object
     #: ``(system, t, y, run, rtol, atol, options)``: the compiled kernels made ready before the
     #: run, by a run of a microsecond (:mod:`rodmol.solve.kernels`); None: in the first step.
     prepare: object = None
@@ -56,10 +50,8 @@ def _prepare_rod(system, t, y, run, rtol, atol, options):
 
 
 KINDS = (
-    RunKind(Model, SemiDiscrete, BACKENDS, "equilibrium", from_states, Result, run_sinks.directory_sink,
-            rod_state_problem, _prepare_rod),
-    RunKind(System, Assembly, SYSTEM_BACKENDS, "straight", SystemResult, SystemResult, run_sinks.system_writer,
-            assembly_state_problem),
+    RunKind(Model, SemiDiscrete, "equilibrium", from_states, Result, run_sinks.directory_sink, _prepare_rod),
+    RunKind(System, Assembly, "straight", SystemResult, SystemResult, run_sinks.system_writer),
 )
 
 

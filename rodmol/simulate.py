@@ -248,7 +248,7 @@ def check_run(*, initial, t0, scheme, backend, rtol, atol, progress, max_wall_ti
     rtol = options.rtol(scheme.default_rtol if rtol is None else rtol)
     progress = options.progress(progress)
     max_wall_time = options.max_wall_time(max_wall_time)
-    run = get_backend(backend, kind.backends)
+    run = get_backend(backend)
     backend_options = options.backend_options(backend, run, backend_options)
     return RunArguments(initial, t0, scheme, rtol, atol, progress, max_wall_time, backend, run,
                         backend_options, kind)
@@ -257,13 +257,15 @@ def check_run(*, initial, t0, scheme, backend, rtol, atol, progress, max_wall_ti
 def fit(args, system):
     """``args`` with ``initial`` and ``atol`` checked against the state of ``system``: an
     ``initial`` result gives its last state, ``atol=None`` the system's ``atol_scale()``
-    (:meth:`~rodmol.discretise.system.SemiDiscrete.atol_scale`) times ``rtol``."""
+    (:meth:`~rodmol.discretise.system.SemiDiscrete.atol_scale`) times ``rtol``; a backend
+    option the system does not offer (a linear solver) is refused."""
     initial = args.initial
     if isinstance(initial, RESULTS):
         initial = _last_state(initial, args.kind, system)
     if not isinstance(initial, str):  # before any sink is made (`overwrite` then clears the earlier run)
-        initial = check_state("initial", initial, system, args.t0, args.kind)
+        initial = check_state("initial", initial, system, args.t0)
     atol = None if args.atol is None else _state_sized("atol", args.atol, system, positive=True)
+    options.offered_by(system, args.backend_options)
     return replace(args, initial=initial, asked_atol=atol,
                    atol=args.rtol * system.atol_scale() if atol is None else atol)
 
@@ -277,16 +279,16 @@ def check_word(name, value):
     return value
 
 
-def check_state(name, value, system, t=0.0, kind=KINDS[0]):
+def check_state(name, value, system, t=0.0):
     """``value``, the parameter ``name``, as a state vector of ``system`` (a copy), or a
     ParameterError naming it: the rule for every state a user gives (simulate's and the
     Simulator's ``initial``, linearize's ``state``). Refused: another size, a non-finite
-    entry (named) and what the ``kind``'s ``state_problem`` at ``t`` [s] finds (an element
+    entry (named) and what the system's ``state_problem`` at ``t`` [s] finds (an element
     inverted or torn, an orientation whose quaternion norm is off 1 by more than
     ``watch.MAX_QUATERNION_DRIFT``, a zero one too); a quaternion within it is taken as it
     is (the rotations are normalised on the fly), as an integration takes its own."""
     state = _state_sized(name, value, system)
-    problem = kind.state_problem(system, t, state)
+    problem = system.state_problem(t, state)
     if problem:
         raise ParameterError(f"`{name}` is not a state of this model: {problem}")
     return state

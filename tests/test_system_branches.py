@@ -43,7 +43,10 @@ def test_an_arm_clamped_under_a_beam_loads_it_as_its_weight_at_midspan(n):
     assert sag == pytest.approx(expected, rel=1e-7)
     assert abs(run["arm"].tip[0, 0] - LB / 2) < 1e-3 * LA  # it hangs straight down (measured 4e-7 m off)
     assert run["arm"].tip[0, 2] == pytest.approx(sag - LA, abs=1e-3 * LA)
-    assert run.success and np.abs(run.states[-1] - run.states[0]).max() < 1e-5  # a rest of the dynamics
+    # A rest of the dynamics: the state stays there within the run's tolerances (the joint's
+    # compliance moves the base body's angular velocity by about one atol, 1.1e-5 rad/s at N = 16).
+    atol = rodmol.default_atol(system, rodmol.SCHEMES["centred"].default_rtol)
+    assert run.success and np.max(np.abs(run.states[-1] - run.states[0]) / atol) < 2
 
 
 def test_a_pinned_branch_rests_where_the_clamped_one_does():

@@ -60,19 +60,23 @@ the segments' at their clamps) and quadratic drag.
 import numpy as np
 from scipy import sparse
 
+from ..inputs import knot_times
 from .body_joints import BodyJointPart, body_joint_frequency
 from .body_part import BodyPart, clamp_velocities, cross, first_element
 from .contact_parts import contact_parts
 from .joints import JOINT_COLUMNS, JOINT_ROWS, JointPart, RecordedJoints, RodJointPart
 from .physics import quaternion_rate
+from .protocol import pattern_bandwidths
 from .rigid import clamp_wrench, free_body_rates
 from .rotations import from_matrix, matrices
+from .state_checks import LIMITS, OK, describe, least_stretch, scan_parts
 from .stencil import WORK_TOTAL
 from .system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE, SemiDiscrete, field_scales
 
 
 class Assembly:
-    """The method-of-lines system of a :class:`rodmol.System`.
+    """The method-of-lines system of a :class:`rodmol.System`, a
+    :class:`rodmol.discretise.protocol.Discretised`.
 
     Parameters
     ----------
@@ -128,6 +132,7 @@ class Assembly:
                 part.body_joints.append(joint)
         self.free = [p for p in self.bodies.values() if p.body.free]
         self.lightly_damped = any(sd.lightly_damped for sd in self.rods.values())
+        self._scan = None  # the arguments of step_problem's compiled scan, made at its first call
         self._gravity = np.ascontiguousarray(system.gravity, dtype=float)
 
     def _rod_base(self, name):
@@ -171,6 +176,14 @@ class Assembly:
                 field = next(f for f, entries in fields if entries.start <= index < entries.stop)
                 return f"body {name!r} ({field})"
         raise IndexError(f"state entry {index} of a system of {self.size}")
+
+    def knot_times(self):
+        """The times [s] of the kinks of every rod's and body's inputs (:func:`rodmol.inputs.knot_times`)."""
+        return knot_times(self.system)
+
+    def bending_period(self):
+        """The shortest of the rods' first bending periods [s]."""
+        return min(sd.bending_period() for sd in self.rods.values())
 
     def body_state(self, part, t, y):
         """A body's (x, Q, v, w) at (t, y) (``rigid.FREE_BODY.size``,): its pose and velocities
@@ -322,6 +335,44 @@ class Assembly:
                         pat[np.ix_(velocity, np.arange(other.slice.start, other.slice.stop))] = True
         return pat.tocsc()
 
+    def bandwidths(self):
+        """(lower, upper) half-bandwidths of :meth:`pattern`."""
+        return pattern_bandwidths(self.pattern())
+
+    def linear_solvers(self):
+        """CVODE's linear solvers on a system (:meth:`rodmol.discretise.protocol.Discretised.linear_solvers`):
+
+        * ``"gmres"`` (``"auto"``): GMRES preconditioned by the rods' exact block
+          preconditioners, the bodies' own blocks and, for free bodies with clamped
+          rods or penalty joints, their Schur complement, and the blocks of penalty
+          joints between two rods' nodes by theirs (:meth:`preconditioner`); about
+          2-3x faster than "sparse" on the octopus (``solvers/octopus.py``,
+          docs/performance.md), as fast or faster on loops, 1.1 to 2 times faster
+          from N = 32 per rod (``solvers/loops.py``, docs/systems.md);
+        * ``"sparse"``: SuperLU_MT on :meth:`pattern`, the Jacobian by scikit-sundae's
+          coloured differences over it (twice as fast on the octopus as the
+          differences of :meth:`jacobian`, run by Python);
+        * ``"dense"``: small systems and cross-checks.
+
+        No band solver: a body's rows couple entries far apart in the state."""
+        return {"gmres": "compiled", "sparse": "sundials", "dense": "sundials"}
+
+    def jacobian(self, scale, matrix="sparse"):
+        """The Jacobian by coloured differences on :meth:`pattern`
+        (:class:`rodmol.discretise.system_jacobian.SystemJacobian`), sparse only (else ValueError)."""
+        from .system_jacobian import SystemJacobian
+
+        if matrix != "sparse":
+            raise ValueError(f"a system's compiled Jacobian is sparse only, not {matrix!r}")
+        return SystemJacobian(self, scale)
+
+    def preconditioner(self, scale):
+        """The block preconditioner of CVODE's Newton matrix
+        (:class:`rodmol.discretise.system_preconditioner.SystemPreconditioner`)."""
+        from .system_preconditioner import SystemPreconditioner
+
+        return SystemPreconditioner(self, scale)
+
     def atol_scale(self):
         """Typical magnitude of each entry: the rods' own
         (:meth:`SemiDiscrete.atol_scale`); a body's position the longest rod,
@@ -336,6 +387,50 @@ class Assembly:
         return np.concatenate(scales)
 
     # ------------------------------------------------------------------ checks
+
+    def state_problem(self, t, y):
+        """What is wrong with the state ``y`` at ``t`` [s]: each rod's part as a single rod's
+        state (the message names the rod), the bodies' entries for finiteness; or None."""
+        return self._problem("state_problem", t, y)
+
+    def step_problem(self, t, y):
+        """:meth:`state_problem` after a step of a run, and each rod's tip section
+        (``SemiDiscrete.tip_problem``). The rods' scans and the bodies' entries are one
+        compiled call (:func:`rodmol.discretise.state_checks.scan_parts`): this runs at every step."""
+        if self._scan is None:
+            rods = list(self.rods.values())
+            self._scan = (np.array([self.parts[name].start for name in self.rods], dtype=np.int64),
+                          np.array([sd.model.n_elements for sd in rods], dtype=np.int64),
+                          np.array([sd.model.ds for sd in rods]),
+                          min((p.slice.start for p in self.bodies.values()), default=self.size), *LIMITS)
+        part, code, i, value = scan_parts(y, *self._scan)
+        if code != OK:
+            if part < len(self.rods):
+                name = list(self.rods)[part]
+                sd = self.rods[name]
+                return f"rod {name!r}: {describe(sd.layout, sd.model.ds, t, code, i, value)}"
+            return self._problem("state_problem", t, y)  # a body's: named as the state check names it
+        for name, sd in self.rods.items():
+            if sd.tip_anchored:
+                problem = sd.tip_problem(t, y[self.parts[name]])
+                if problem:
+                    return f"rod {name!r}: {problem}"
+        return None
+
+    def _problem(self, check, t, y):
+        for name, sd in self.rods.items():
+            problem = getattr(sd, check)(t, y[self.parts[name]])
+            if problem:
+                return f"rod {name!r}: {problem}"
+        for name, part in self.bodies.items():
+            if not np.all(np.isfinite(y[part.slice])):
+                return f"the state of body {name!r} became non-finite at t = {t:.6g} s: the solution blew up"
+        return None
+
+    def describe_stall(self, y):
+        """The stall's diagnosis of the most compressed rod (its ``describe_stall``), naming it."""
+        name = min(self.rods, key=lambda n: least_stretch(self.rods[n].layout, y[self.parts[n]]))
+        return f"In rod {name!r}: {self.rods[name].describe_stall(y[self.parts[name]])}"
 
     def momentum(self, y):
         """Total linear momentum [kg m/s] and angular momentum about the

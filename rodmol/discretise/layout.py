@@ -226,6 +226,8 @@ class StateLayout(BlockLayout):
 
     def entry_name(self, index):
         """A readable name of state entry ``index`` (``"k[2] of element 7"``)."""
+        if not 0 <= index < self.size:
+            raise IndexError(f"state entry {index} of a rod's state of {self.size}")
         if index < HEADER:
             return f"base {'u' if index < 3 else 'Q'}[{index if index < 3 else index - 3}]"
         b, j = divmod(index - HEADER, BLOCK)

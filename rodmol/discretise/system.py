@@ -5,22 +5,25 @@ scheme, evaluates the time-dependent inputs (tensions, base velocities, load
 values) at each call, and owns the structure the solvers need: the state
 layout, the Jacobian pattern and bandwidths derived from the scheme's and the
 loads' declared dependencies, and factories for the compiled Jacobian and the
-block preconditioner. Backends and the equilibrium solver use only this
-interface (``size``, ``__call__``, ``layout``, ``pattern``, ``bandwidths``,
-``jacobian``, ``preconditioner``, ``global_coupling``, ``update_inputs``,
-``inputs_vary``).
+block preconditioner. It is a :class:`rodmol.discretise.protocol.Discretised`,
+which is all the backends read; the equilibrium solver and the fixed-step
+Newton matrix also read its rod's own members (``layout``, ``model``,
+``depends``, ``global_coupling``, ``update_inputs``, ``kernel_arguments``).
 """
 
 from dataclasses import replace
 
 import numpy as np
 
+from ..inputs import knot_times
 from . import external, load_entries, stencil
 from .layout import StateLayout, merge
 from .physics import compile_signatures
+from .preconditioner import check_structure
 from .routing import CableRouting
 from .sampling import Sampled, cell_properties
 from .schemes import DEFAULT_SCHEME, get_scheme
+from .state_checks import OK, describe, limits, scan, stall_diagnosis, state_problem, tip_problem
 from .state_view import StateView
 from .undeformed import undeformed_state
 
@@ -32,6 +35,8 @@ QUATERNION_RESTORING_RATE = 1.0
 #: Smoothing speed [m/s] of |v| in the drag law, so the implicit solver's
 #: Newton iterations see a differentiable right-hand side near v = 0.
 DRAG_SMOOTHING_SPEED = 1e-6
+#: From this many elements on, CVODE's linsolver="auto" picks the preconditioned GMRES.
+GMRES_MIN_ELEMENTS = 50
 
 
 def first_bending_frequency(model):
@@ -122,8 +127,9 @@ class SemiDiscrete:
     def __init__(self, model, scheme=DEFAULT_SCHEME):
         self.model = model
         self.scheme = get_scheme(scheme)
-        self.lightly_damped = grid_damping_ratio(model) < 1.0
+        self.lightly_damped = bool(grid_damping_ratio(model) < 1.0)
         self.layout = StateLayout(model.n_elements)
+        self._limits = limits(model.n_elements, model.ds)
         self.size = self.layout.size
         # Feedback and displacement-controlled tensions and friction read the whole state.
         self._friction = model.friction  # a property over the cables: read once, not per call
@@ -175,6 +181,12 @@ class SemiDiscrete:
             active = [i for i, value in enumerate(constant) if value != 0.0]
         self._active = np.array(active, dtype=int)
         self.routing = CableRouting(m, s_cells)
+        # The tip section carries the pull of the cables anchored there: a pull near its axial
+        # stiffness EA crushes it (the Result's tip strain 1 - T / EA turns negative) though no
+        # element of the state shows it (:meth:`step_problem`). The share of the last cell is 1
+        # up to round-off (anchor / ds).
+        self._tip_cables = np.flatnonzero(np.isclose(self.routing.weights[:, -1], 1.0, rtol=0.0, atol=1e-9))
+        self._tip_stiffness = float(m.rod.stiffness(m.rod.length)[0][0]) if len(self._tip_cables) else None
         self._offsets = np.ascontiguousarray(self.routing.geometry[self._active]).reshape(
             len(active), m.n_elements, 6)
         self._path_weights = np.ascontiguousarray(self.routing.weights[self._active]).reshape(
@@ -295,6 +307,51 @@ class SemiDiscrete:
         """The unloaded rod at rest in its rest shape, on this system's cells (:func:`undeformed_state`)."""
         return self._undeformed.copy()
 
+    def project_quaternions(self, y):
+        """Scale the quaternions of the states ``y`` (..., size) to unit norm, in place (the layout's)."""
+        self.layout.project_quaternions(y)
+
+    def knot_times(self):
+        """The times [s] of the kinks of the model's inputs (:func:`rodmol.inputs.knot_times`)."""
+        return knot_times(self.model)
+
+    def bending_period(self):
+        """The period [s] of the first bending mode (:func:`first_bending_frequency`)."""
+        return 2.0 * np.pi / first_bending_frequency(self.model)
+
+    # ------------------------------------------------------------------ checks
+
+    def state_problem(self, t, y):
+        """What is wrong with the state ``y`` at ``t`` [s], or None
+        (:func:`rodmol.discretise.state_checks.state_problem`)."""
+        return state_problem(self.layout, self.model.ds, t, y)
+
+    def step_problem(self, t, y):
+        """:meth:`state_problem`, and the tip section crushed by the cables anchored there
+        (:func:`rodmol.discretise.state_checks.tip_problem`), of the state ``y`` at ``t`` [s]
+        after a step of a run, or None."""
+        # Compiled scan with its arguments kept: this runs at every step of a run.
+        code, i, value = scan(y, *self._limits)
+        if code != OK:
+            return describe(self.layout, self.model.ds, t, code, i, value)
+        return self.tip_problem(t, y)
+
+    @property
+    def tip_anchored(self):
+        """True if cables are anchored at the tip (:meth:`tip_problem` then checks its section)."""
+        return self._tip_stiffness is not None
+
+    def tip_problem(self, t, y):
+        """The tip section crushed at ``t`` [s] by the cables anchored there
+        (:func:`rodmol.discretise.state_checks.tip_problem`), or None."""
+        if self._tip_stiffness is None:
+            return None
+        return tip_problem(t, float(np.sum(self.tensions(t, y)[self._tip_cables])), self._tip_stiffness)
+
+    def describe_stall(self, y):
+        """The most compressed element and the largest turn of the state ``y`` of a stalled run."""
+        return stall_diagnosis(self.layout, self.model.ds, y)
+
     # ------------------------------------------------------------------ evaluation
 
     def __call__(self, t, y, out=None):
@@ -363,6 +420,23 @@ class SemiDiscrete:
         """(lower, upper) half-bandwidths of :meth:`pattern`."""
         return self.layout.bandwidths(self.depends)
 
+    def linear_solvers(self):
+        """CVODE's linear solvers on one rod, each with its Jacobian under ``jacobian="auto"``
+        (:meth:`rodmol.discretise.protocol.Discretised.linear_solvers`); ``"auto"`` picks
+        "gmres" from :data:`GMRES_MIN_ELEMENTS` elements on or when the system has a global
+        coupling (feedback tensions), if the block preconditioner solves its structure, else
+        "band". GMRES's Jacobian-vector products are differences of the full right-hand side,
+        so they carry the global coupling that any banded Jacobian leaves out (20x fewer
+        steps on a P controller, N = 12). The compiled Jacobian is measured fastest with
+        "sparse"; with the band solvers, whose ``jacfn`` template is a dense (n, n) array,
+        SUNDIALS' own differences are (``docs/performance.md``)."""
+        solvers = {"gmres": "compiled", "band": "sundials", "lapackband": "sundials", "sparse": "compiled",
+                   "dense": "sundials"}
+        big = self.layout.n_blocks >= GMRES_MIN_ELEMENTS
+        if not ((big or self.global_coupling) and _block_solvable(self.depends)):
+            solvers = {"band": solvers.pop("band"), **solvers}
+        return solvers
+
     def atol_scale(self):
         """Typical magnitude of each state entry (see :func:`field_scales`)."""
         return self.layout.scales(field_scales(self.model))
@@ -378,3 +452,12 @@ class SemiDiscrete:
         from .preconditioner import BlockPreconditioner
 
         return BlockPreconditioner(self, scale)
+
+
+def _block_solvable(depends):
+    """True if the block preconditioner solves the structure of the dependency table ``depends`` exactly."""
+    try:
+        check_structure(depends)
+    except ValueError:
+        return False
+    return True

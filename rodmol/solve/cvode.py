@@ -1,4 +1,4 @@
-"""SUNDIALS CVODE (BDF) through scikit-sundae."""
+"""SUNDIALS CVODE (BDF) through scikit-sundae, of a rod or a system of rods and bodies."""
 
 from .outputs import Outputs, run_steps
 from .stepping import Stepper
@@ -7,31 +7,36 @@ from .watch import Watch
 
 def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, linsolver="auto",
           max_step=0.0, jacobian="auto", max_order="auto", max_nonlin_iters=3):
-    """SUNDIALS CVODE (BDF) through scikit-sundae.
+    """SUNDIALS CVODE (BDF) through scikit-sundae, of ``system`` (any
+    :class:`rodmol.discretise.protocol.Discretised`).
 
-    ``linsolver`` is how the Newton systems (I - gamma J) x = r are solved:
+    ``linsolver`` is how the Newton systems (I - gamma J) x = r are solved,
+    one of those the system offers (``system.linear_solvers()``):
 
-    * ``"gmres"``: GMRES preconditioned by an exact O(N) solve of the
-      structured Newton matrix (``system.preconditioner``), so it converges
-      in one or two iterations;
+    * ``"gmres"``: GMRES preconditioned by the system's own preconditioner
+      (``system.preconditioner``: of a rod an exact O(N) solve of the
+      structured Newton matrix, so it converges in one or two iterations);
     * ``"band"``: SUNDIALS' band LU of the full system (the half-bandwidths
       come from ``system.bandwidths()``);
     * ``"lapackband"``, ``"sparse"`` (SuperLU_MT on ``system.pattern()``),
       ``"dense"`` (small systems only);
-    * ``"auto"``: "gmres" from ``stepping.GMRES_MIN_ELEMENTS`` elements on or when the
-      system has a global coupling (feedback tensions), if the preconditioner
-      can solve its structure; else "band" (see ``docs/performance.md``).
+    * ``"auto"``: the system's first (a rod's: "gmres" from
+      ``rodmol.discretise.system.GMRES_MIN_ELEMENTS`` elements on or when it has a global coupling,
+      feedback tensions, if the preconditioner can solve its structure,
+      else "band"; a system of rods and bodies: "gmres"; see
+      ``docs/performance.md``).
 
     ``jacobian`` chooses how the direct solvers get J:
 
     * ``"sundials"``: SUNDIALS' own finite differences for the band and dense
       solvers, scikit-sundae's coloured differences for ``"sparse"``;
-    * ``"compiled"``: ``system.jacobian``, finite differences inside numba
-      with the colouring derived from the system's dependencies, handed over
-      as ``jacfn``;
-    * ``"auto"``: "compiled" for "sparse" and "gmres", "sundials" otherwise
-      (measured fastest with the band solvers, whose ``jacfn`` template is a
-      dense (n, n) array; see ``docs/performance.md``).
+    * ``"compiled"``: ``system.jacobian`` (a rod's: finite differences inside
+      numba with the colouring derived from the system's dependencies),
+      handed over as ``jacfn``;
+    * ``"auto"``: what the system offers with that solver (a rod's:
+      "compiled" for "sparse" and "gmres", "sundials" otherwise, measured
+      fastest with the band solvers, whose ``jacfn`` template is a dense
+      (n, n) array; a system's: "sundials" for "sparse").
 
     ``max_order`` caps the BDF order (1-5); ``"auto"`` is 5, or 2 when every
     mode of the grid oscillates (``system.lightly_damped``): BDF 3-5 are not
@@ -50,7 +55,7 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, l
     stepper = Stepper(system, t_out[0], y0, rtol=rtol, atol=atol, linsolver=linsolver, max_step=max_step,
                       jacobian=jacobian, max_order=max_order, max_nonlin_iters=max_nonlin_iters)
     watch = Watch(system, t_out, max_wall_time, progress)
-    out = Outputs(t_out, y0, progress, system.layout, "CVODE", watch)
+    out = Outputs(t_out, y0, progress, system, "CVODE", watch)
 
     def stats():
         info = stepper.stats()
@@ -64,11 +69,15 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, l
 
     def steps():
         while not out.done:
-            # at the inputs' knots: a rod at rest takes long steps and would
-            # stride over a short ramp that starts between two of them
-            r, problem = stepper.step(t_end, stepper.stop_time(t_end), watch)
+            # Towards the next output: CVODE sizes its first step by the distance to it (towards
+            # t_end, a contact's damped bounce kept ringing at 1 % where it settles at rtol); at
+            # the inputs' knots at the latest: a rod at rest takes long steps and would stride
+            # over a short ramp that starts between two of them.
+            r, problem = stepper.step(float(out.t_out[out.next_index]), stepper.stop_time(t_end), watch)
             if problem:  # the frames inside a broken step are not kept either
                 return stop(problem)
+            if not out.done and out.t_out[out.next_index] <= r.t:
+                stepper.mark()  # an output frame reached: the right-hand sides are watched afresh
             while not out.done and out.t_out[out.next_index] <= r.t:
                 t_k = out.t_out[out.next_index]
                 out.add(r.y if t_k == r.t else stepper.interpolate(t_k))

@@ -25,7 +25,6 @@ from ..model import Model
 from ..systems import System
 from .rest_equations import RestEquations, continuation, damped_newton
 from .system_equilibrium import free_rest_state
-from .watch import state_problem
 
 
 def equilibrium(model, t=0.0, *, scheme=None, tol=1e-10, max_iter=40):
@@ -87,7 +86,7 @@ def equilibrium(model, t=0.0, *, scheme=None, tol=1e-10, max_iter=40):
         raise ParameterError(f"`model` must be a rodmol.Model or its SemiDiscrete, got {model!r}")
     solve = _closed_loop if system.model.feedback else _rest_state
     y = solve(system, t, tol, max_iter)
-    problem = state_problem(system.layout, system.model.ds, t, y)
+    problem = system.state_problem(t, y)
     if problem:
         raise EquilibriumError(f"the static equilibrium is not a valid state of the rod: {problem}")
     return y

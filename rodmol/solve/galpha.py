@@ -36,7 +36,7 @@ import numpy as np
 from ..errors import ParameterError
 from .newton_matrix import CONVERGED, DIVERGED, NOT_FINITE, SLOW, newton_matrix
 from .outputs import Outputs, run_steps, step_size_stats
-from .watch import STALL_STEP, watch_for
+from .watch import STALL_STEP, Watch
 
 #: Steps per first bending period of the rod when ``dt="auto"`` (period
 #: error of the midpoint rule about (2 pi / 100)^2 / 12 = 0.03%).
@@ -66,12 +66,9 @@ def coefficients(rho_inf):
 
 
 def auto_dt(system):
-    """The step of ``dt="auto"`` [s]: the first bending period over STEPS_PER_PERIOD; of a
-    system of rods (its ``rods``, :class:`rodmol.solve.system_stepping.SteppedSystem`), the shortest rod's."""
-    from ..discretise.system import first_bending_frequency
-
-    rods = getattr(system, "rods", {"": system}).values()
-    return min(2.0 * np.pi / first_bending_frequency(sd.model) / STEPS_PER_PERIOD for sd in rods)
+    """The step of ``dt="auto"`` [s]: the system's first bending period over STEPS_PER_PERIOD
+    (of a system of rods, the shortest rod's)."""
+    return system.bending_period() / STEPS_PER_PERIOD
 
 
 def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None,
@@ -98,8 +95,8 @@ def generalized_alpha(system, y0, t_out, *, rtol, atol, progress=None, max_wall_
     alpha_m, alpha_f, gamma = coefficients(float(rho_inf))
     kappa = alpha_m * (1.0 - gamma) / gamma - (1.0 - alpha_m)  # weight of ydot_n in b
 
-    watch = watch_for(system, t_out, max_wall_time, progress)
-    out = Outputs(t_out, y0, progress, system.layout, "generalized-alpha", watch)
+    watch = Watch(system, t_out, max_wall_time, progress)
+    out = Outputs(t_out, y0, progress, system, "generalized-alpha", watch)
     scale = np.broadcast_to(atol, (system.size,)) / rtol
     matrix = newton_matrix(system, scale)
     weight = np.empty(system.size)

@@ -1,12 +1,15 @@
 """The Newton matrix I - g J of an implicit fixed-step scheme, factored once
 and reused across steps (modified Newton) until :meth:`refresh` is called.
 
-The Jacobian is the system's compiled one. Where the system's structure fits
-the block elimination, the factorisation is the exact O(N) block solve that
-CVODE's GMRES uses as preconditioner (``system.preconditioner``), and the
+The Jacobian is the system's compiled one. Where the system is one rod whose
+structure fits the block elimination, the factorisation is the exact O(N)
+block solve that CVODE's GMRES uses as preconditioner
+(``system.preconditioner``, a :class:`BlockPreconditioner`), and the
 Newton iterations of a step run compiled (:func:`block_newton`) unless the
 inputs read the state (feedback tensions); otherwise a sparse LU (SuperLU)
-of the matrix on the system's Jacobian pattern. Compiled or run by Python,
+of the matrix on the system's Jacobian pattern (``system.jacobian(scale,
+"sparse")``; a system of rods and bodies, whose preconditioner is not an
+exact solve). Compiled or run by Python,
 the iterations are one loop, :func:`modified_newton`.
 """
 
@@ -19,7 +22,7 @@ from scipy import sparse
 from scipy.sparse.linalg import splu
 
 from ..discretise.physics import jit
-from ..discretise.preconditioner import block_solve
+from ..discretise.preconditioner import BlockPreconditioner, block_solve
 
 # The right-hand side is a global, not an argument, so that numba caches the
 # loop (see rodmol/discretise/jacobian.py).
@@ -147,6 +150,8 @@ class BlockNewton(_Matrix):
 
     def __init__(self, system, scale):
         self._block = system.preconditioner(scale)
+        if not isinstance(self._block, BlockPreconditioner):
+            raise ValueError("the system's preconditioner is not one rod's exact block elimination")
         self._jnew = np.zeros(1, dtype=np.int32)
         self._args = system.kernel_arguments()
         self._r, self._x = np.empty(system.size), np.empty(system.size)

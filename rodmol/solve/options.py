@@ -90,6 +90,16 @@ def backend_options(backend, run, options):
     return checked
 
 
+def offered_by(system, options):
+    """Refuse, before any work, the checked backend ``options`` that ``system`` does not
+    offer: a CVODE ``linsolver`` outside its ``linear_solvers()``
+    (:func:`rodmol.solve.stepping.linear_solver`, the one rule)."""
+    if "linsolver" in options:
+        from .stepping import linear_solver
+
+        linear_solver(system, options["linsolver"])
+
+
 def rtol(value):
     value = _checks.positive("rtol", value)
     low, high = RTOL_RANGE

@@ -27,14 +27,14 @@ class Outputs:
     """Collects states at the output times (in one preallocated array) and reports progress.
 
     The states handed back after the first (the start, as given) have unit
-    quaternions (``layout.project_quaternions``, once over the frames, when
+    quaternions (``system.project_quaternions``, once over the frames, when
     the solution is made); the integration itself is not touched.
     ``backend`` names the backend in messages; ``watch`` (a
     :class:`rodmol.solve.watch.Watch`) says how far it got.
     """
 
-    def __init__(self, t_out, y0, progress, layout, backend, watch):
-        self.t_out, self.progress, self.layout = t_out, progress, layout
+    def __init__(self, t_out, y0, progress, system, backend, watch):
+        self.t_out, self.progress, self.system = t_out, progress, system
         self.backend, self.watch = backend, watch
         self.start = time.perf_counter()
         self.ys = np.empty((len(t_out), len(y0)))
@@ -69,7 +69,7 @@ class Outputs:
     def solution(self, success, message, error=None, reason="", **stats):
         stats["wall_time_s"] = time.perf_counter() - self.start
         n = self.next_index
-        self.layout.project_quaternions(self.ys[1:n])
+        self.system.project_quaternions(self.ys[1:n])
         return RawSolution(self.t_out[:n].copy(), self.ys[:n], success, message, stats, error,
                            self._ending(reason))
 

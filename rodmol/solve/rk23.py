@@ -4,14 +4,15 @@ import numpy as np
 from scipy.integrate import RK23
 
 from .outputs import Outputs, run_steps, step_size_stats
-from .watch import watch_for
+from .watch import Watch
 
 
 def rk23(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, max_step=np.inf):
     """scipy's explicit Bogacki-Shampine RK23 on the same right-hand side (cross-check).
 
     Its step is bounded by the explicit stability limits, so it is slow on
-    fine grids. Every step is checked by :class:`rodmol.solve.watch.Watch`.
+    fine grids. Every step is checked by :class:`rodmol.solve.watch.Watch`. ``system``: any
+    :class:`rodmol.discretise.protocol.Discretised`.
     """
     evals = [0]
 
@@ -19,8 +20,8 @@ def rk23(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, ma
         evals[0] += 1
         return system(t, y)
 
-    watch = watch_for(system, t_out, max_wall_time, progress)
-    out = Outputs(t_out, y0, progress, system.layout, "RK23", watch)
+    watch = Watch(system, t_out, max_wall_time, progress)
+    out = Outputs(t_out, y0, progress, system, "RK23", watch)
     sizes = []
 
     def stats():

@@ -1,17 +1,20 @@
 """CVODE kept alive between calls: scikit-sundae's CVODE for a system, its
-options, and the one step loop every CVODE run takes.
+options, and the one step loop every CVODE run takes, of a rod or of a system
+of rods and bodies (any :class:`rodmol.discretise.protocol.Discretised`).
 
 :func:`solver_options` turns the CVODE backend's options into scikit-sundae's
-(the linear solver, the compiled Jacobian or block preconditioner, the
-tolerances). :class:`Stepper` builds CVODE once for a system and takes its
-internal steps (:meth:`Stepper.step`, each checked by
-:class:`rodmol.solve.watch.Watch`): :func:`rodmol.solve.cvode.cvode` drives it
-through a run's output times, and the stepping simulator advances it from its
-current time to the next on request (:meth:`Stepper.advance`). Between calls
-the caller may change the system's inputs; :meth:`Stepper.restart` then
-re-initialises CVODE at the current state (``CVodeReInit``: the memory, the
-linear solver and the kernels are kept, only the BDF history is dropped),
-which :meth:`Stepper.advance` does on its own when asked.
+(the linear solver the system offers, its compiled Jacobian or
+preconditioner, the tolerances). :class:`Stepper` builds CVODE once for a
+system and takes its internal steps (:meth:`Stepper.step`, each checked by
+:class:`rodmol.solve.watch.Watch`, the right-hand sides by
+:class:`rodmol.solve.watch.RatesWatch`): :func:`rodmol.solve.cvode.cvode`
+drives it through a run's output times, and the stepping simulator advances
+it from its current time to the next on request (:meth:`Stepper.advance`).
+Between calls the caller may change the system's inputs;
+:meth:`Stepper.restart` then re-initialises CVODE at the current state
+(``CVodeReInit``: the memory, the linear solver and the kernels are kept,
+only the BDF history is dropped), which :meth:`Stepper.advance` does on its
+own when asked.
 """
 
 import contextlib
@@ -20,17 +23,14 @@ import warnings
 import numpy as np
 from scipy import sparse
 
-from ..discretise.preconditioner import check_structure
+from ..discretise.protocol import JACOBIANS, LINEAR_SOLVERS
 from ..errors import ParameterError
-from ..inputs import knot_times
 from .outputs import cause, step_size_stats
-from .watch import Watch
+from .watch import RatesNotFinite, RatesWatch, Watch
 
-LINEAR_SOLVERS = ("gmres", "band", "lapackband", "sparse", "dense")
-#: How the direct linear solvers get the Jacobian (see :func:`rodmol.solve.cvode.cvode`).
-JACOBIANS = ("compiled", "sundials")
-#: From this many elements on, linsolver="auto" picks the preconditioned GMRES.
-GMRES_MIN_ELEMENTS = 50
+#: GMRES's Krylov dimension with the preconditioner (SUNDIALS' default): with left
+#: preconditioning the fastest of {left, right} x {1, 5} on the bending test.
+KRYLOV_DIM = 5
 #: The reason :meth:`Stepper.advance` gives for a Ctrl-C.
 INTERRUPTED = "interrupted"
 
@@ -63,13 +63,19 @@ class Stepper:
         #: Time [s] of the last right-hand side that raised (None: none did).
         self.failed_at = None
         self._watch = None  # the first advance's, renewed for each
+        self.rates_watch = RatesWatch(system)
+        # An exception raised through scikit-sundae's sparse (SuperLU_MT) path crashes the
+        # process (a segmentation fault, found by review): there the right-hand side keeps
+        # it, returns NaN rates, which fail CVODE's step at once, and step raises it.
+        self._kept = None
+        rates = self._kept_rhs if self.linsolver == "sparse" else self._rhs
         with warnings.catch_warnings():
             # scikit-sundae warns that its own coloured differences are not used
             # when both `sparsity` and `jacfn` are given: that is the point.
             warnings.filterwarnings("ignore", "Custom sparse Jacobian", UserWarning)
-            self._solver = CVODE(self._rhs, **options)
+            self._solver = CVODE(rates, **options)
         self.t, self.y = float(t0), np.array(y0, dtype=float)
-        self.knots = knot_times(system.model)  # the inputs' kinks [s], sorted
+        self.knots = np.unique(np.asarray(system.knot_times(), dtype=float))  # the inputs' kinks [s], sorted
         #: Time [s] CVODE's steps have reached (beyond ``t`` inside an advance).
         self.reached = self.t
         self._fresh = False  # CVODE holds no history to continue from
@@ -86,22 +92,44 @@ class Stepper:
             # integrated again by outputs.keep_before_failure.
             self.failed_at = t
             raise
+        if self.evals > self.rates_watch.watched_from:
+            self.rates_watch.check(t, y, yp)
+
+    def _kept_rhs(self, t, y, yp):
+        if self._kept is None:
+            try:
+                return self._rhs(t, y, yp)
+            except BaseException as exc:  # noqa: BLE001 (raised again by step)
+                self._kept = exc
+        yp[:] = np.nan
+
+    def mark(self):
+        """An output frame was reached: the right-hand sides' watch counts afresh."""
+        self.rates_watch.mark(self.evals)
 
     def restart(self, t, y):
         """Re-initialise CVODE at state ``y`` at time ``t`` [s] (its BDF history is dropped)."""
         self.t, self.y = float(t), np.array(y, dtype=float)
         self.reached = self.t
+        self._kept = None
+        self.mark()
         self._njev_before, self._njev = self._njev_before + self._njev, 0
         with _small_pages():  # the first call allocates the solver's memory
             self._solver.init_step(self.t, self.y)
         self.restarts += 1
         self._fresh = True
 
-    def step(self, t_end, tstop, watch):
-        """One internal CVODE step towards ``t_end`` [s], ending at ``tstop`` [s]
-        at the latest, checked by ``watch``: returns (scikit-sundae's result,
-        None) or (the result, why the integration must stop)."""
-        r = self._solver.step(t_end, method="onestep", tstop=tstop)
+    def step(self, tout, tstop, watch):
+        """One internal CVODE step towards ``tout`` [s] (the first step is sized by the
+        distance to it), ending at ``tstop`` [s] at the latest, checked by ``watch``:
+        returns (scikit-sundae's result, None) or (the result or None, why the
+        integration must stop)."""
+        try:
+            r = self._solver.step(tout, method="onestep", tstop=tstop)
+            if self._kept is not None:
+                raise self._kept
+        except RatesNotFinite as exc:
+            return None, str(exc)
         self._fresh, self._njev = False, int(r.njev)
         if not r.success:
             return r, r.message
@@ -134,6 +162,7 @@ class Stepper:
         t_start, y_start = self.t, self.y
         if restart and not self._fresh:
             self.restart(t_start, y_start)
+        self.mark()
         if self._watch is None:
             self._watch = Watch(self.system, (t_start, t_end))
         watch = self._watch.again((t_start, t_end), max_wall_time, progress)
@@ -171,11 +200,11 @@ class Stepper:
         y = r.y if r is not None and r.t == t_end else self.interpolate(t_end)
         # unit quaternions, as simulate's frames (the dynamics do not see |Q|)
         self.t, self.y = float(t_end), np.array(y)
-        self.system.layout.project_quaternions(self.y)
+        self.system.project_quaternions(self.y)
 
     def stop_time(self, t_end, exact_end=True):
         """Where the next internal step must end at the latest [s]: the first knot of the
-        inputs after the steps reached (``rodmol.inputs.knot_times``: a long step must not
+        inputs after the steps reached (the system's ``knot_times()``: a long step must not
         stride over a short ramp), and ``t_end`` if ``exact_end``; None: anywhere."""
         k = np.searchsorted(self.knots, self.reached, side="right")
         knot = float(self.knots[k]) if k < len(self.knots) else None
@@ -201,23 +230,27 @@ def _why(watch, reason):
             f"(last step {watch.h_last:.3g} s): {reason}")
 
 
+def linear_solver(system, linsolver):
+    """The linear solver ``linsolver`` ("auto" or a name) on ``system``, or a ParameterError
+    naming those it offers (:meth:`~rodmol.discretise.protocol.Discretised.linear_solvers`)."""
+    offered = system.linear_solvers()
+    if linsolver == "auto":
+        return next(iter(offered))
+    if linsolver not in offered:
+        which = "" if set(offered) == set(LINEAR_SOLVERS) else " for this system"
+        raise ParameterError(f"unknown `linsolver` {linsolver!r}{which}; valid: {['auto', *offered]}")
+    return linsolver
+
+
 def solver_options(system, rtol, atol, linsolver="auto", max_step=0.0, jacobian="auto", max_order="auto",
                    max_nonlin_iters=3):
     """scikit-sundae's ``CVODE`` options for ``system`` (see :func:`rodmol.solve.cvode.cvode` for the
-    arguments): returns (options, the linear solver chosen, the block preconditioner
-    or None)."""
+    arguments): returns (options, the linear solver chosen, the preconditioner or None)."""
     from sksundae.cvode import CVODEPrecond
 
-    if linsolver == "auto":
-        # GMRES's Jacobian-vector products are differences of the full right-hand
-        # side, so they carry the global coupling of feedback tensions that any
-        # banded Jacobian leaves out (20x fewer steps on a P controller, N = 12).
-        big = system.layout.n_blocks >= GMRES_MIN_ELEMENTS
-        linsolver = "gmres" if (big or system.global_coupling) and _block_solvable(system) else "band"
-    if linsolver not in LINEAR_SOLVERS:
-        raise ParameterError(f"unknown `linsolver` {linsolver!r}; valid: {['auto', *LINEAR_SOLVERS]}")
+    linsolver = linear_solver(system, linsolver)
     if jacobian == "auto":
-        jacobian = "compiled" if linsolver in ("sparse", "gmres") else "sundials"
+        jacobian = system.linear_solvers()[linsolver]
     if jacobian not in JACOBIANS:
         raise ParameterError(f"unknown `jacobian` {jacobian!r}; valid: {['auto', *JACOBIANS]}")
     if linsolver == "gmres" and jacobian != "compiled":
@@ -232,15 +265,16 @@ def solver_options(system, rtol, atol, linsolver="auto", max_step=0.0, jacobian=
     precond = None
     if linsolver == "gmres":
         precond = system.preconditioner(scale)
-        # Left preconditioning, SUNDIALS' default Krylov dimension (5): the
-        # fastest of {left, right} x {1, 5} on the bending test.
         options["precond"] = CVODEPrecond(precond.setup, precond.solve, "left")
-        options["krylov_dim"] = 5
+        options["krylov_dim"] = KRYLOV_DIM
     elif linsolver in ("band", "lapackband"):
         options["lband"], options["uband"] = system.bandwidths()
     if jacobian == "compiled" and linsolver != "gmres":
         matrix = "band" if linsolver in ("band", "lapackband") else linsolver
-        jac = system.jacobian(scale, matrix)
+        try:
+            jac = system.jacobian(scale, matrix)
+        except ValueError as exc:
+            raise ParameterError(f"jacobian='compiled' with linsolver={linsolver!r}: {exc}") from None
         options["jacfn"] = jac
         if matrix == "sparse":
             options["sparsity"] = jac.sparsity
@@ -270,12 +304,3 @@ def _small_pages():
         yield
     finally:
         setter(previous)
-
-
-def _block_solvable(system):
-    """True if the block preconditioner solves this system's structure exactly."""
-    try:
-        check_structure(system.depends)
-    except ValueError:
-        return False
-    return True

@@ -36,7 +36,6 @@ from ..errors import EquilibriumError
 from ..holds import Hold
 from ..loads import P_STIFFNESS
 from .rest_equations import STATIC_FIELDS, RestEquations, continuation
-from .watch import state_problem
 
 #: A free body's pose unknowns: position (3) and rotation increment (3).
 POSE_UNKNOWNS = 6
@@ -268,7 +267,7 @@ def free_rest_state(assembly, t, tol, max_iter):
                                "in every direction (a single pin leaves it free to turn)") from exc
     y = equations.state(z)
     for name, sd in assembly.rods.items():
-        problem = state_problem(sd.layout, sd.model.ds, t, y[assembly.parts[name]])
+        problem = sd.state_problem(t, y[assembly.parts[name]])
         if problem:
             raise EquilibriumError(f"rod {name!r}: the static equilibrium is not a valid state: {problem}")
     return y

@@ -193,3 +193,12 @@ def test_degenerate_equilibrium_is_an_error():
     rod = rodmol.Rod(0.3, 0.01, rodmol.Material(E=1.0, nu=0.5, rho=1080.0))
     with pytest.raises(rodmol.EquilibriumError, match="not a valid state of the rod|no static"):
         rodmol.equilibrium(rodmol.Model(rod, 10, gravity=(-9.81, 0.0, 0.0)))
+
+
+def test_the_tip_crushed_is_seen_whatever_the_round_off_of_the_anchors_cell_share():
+    """L = 0.2 m on N = 4: the tip cable's share of the last cell is 1 - 1e-16, and the tip
+    check, which looked for exactly 1, never ran: the run crept on until an element turned."""
+    rod = rodmol.Rod(0.2, 0.01, rodmol.Material(E=1e5, **WATER_ARM))
+    cable = rodmol.Cable((0.005, 0.0), 0.2, tension=[(0.0, 0.0), (0.1, 1e4)])
+    result = run(rodmol.Model(rod, 4, cables=[cable]), 0.2, initial="straight")
+    assert_stopped_well(result, r"the tip section is crushed at t = [0-9.e-]+ s: the cables anchored")
