@@ -123,8 +123,7 @@ class Result:
         """Write the result to ``path`` (.npz); read it back with :func:`rodmol.load_result`.
         A file already there is kept unless ``overwrite`` (:func:`rodmol._files.claim`)."""
         refuse_directories([path], "path")  # before the arrays are compressed
-        if not overwrite:  # replaced atomically below
-            claim([path], False)
+        claim([path], overwrite, remove=False)  # replaced atomically below
         info = dict(success=self.success, message=self.message, stats=self.stats, meta=self.meta,
                     units=ARRAYS)
         arrays = {k: getattr(self, k) for k in ARRAYS}

@@ -12,6 +12,7 @@ Importing this module registers ``"rodmol/Reach-v0"`` (:class:`ReachEnv`)::
 rodmol itself never imports this module, so it works without gymnasium.
 """
 
+import contextlib
 import functools
 from pathlib import Path
 
@@ -75,7 +76,8 @@ class ReachEnv(gymnasium.Env):
         Stream every episode into ``record/episode_NNNN`` (``result.h5`` and
         ParaView's ``rod.xdmf``), through the Simulator's ``out``.
     overwrite : bool
-        With ``record``: replace episodes recorded there earlier (otherwise refused).
+        With ``record``: replace the episodes recorded there earlier, all of them (otherwise
+        refused when the environment is made).
     """
 
     metadata = {"render_modes": []}
@@ -84,6 +86,8 @@ class ReachEnv(gymnasium.Env):
                  effort_weight=1e-3, record=None, overwrite=False):
         self.period, self.episode_steps = float(period), int(episode_steps)
         self.max_tension, self.effort_weight = float(max_tension), float(effort_weight)
+        if record is not None:  # before any work: the episodes recorded there earlier
+            _claim_record(Path(record), overwrite)
         self.model = paper_arm(n_elements, medium="water")
         self.sim = Simulator(self.model)
         self._start, self._y0 = self.sim.copy(), self.sim.y
@@ -154,3 +158,17 @@ def vector_env(num_envs, **kwargs):
 
 if REACH_ID not in gymnasium.registry:
     gymnasium.register(REACH_ID, entry_point=ReachEnv)
+
+
+def _claim_record(record, overwrite):
+    """Refuse the episodes recorded in ``record`` earlier unless ``overwrite``, which removes them
+    all (a shorter recording would leave the later ones): :func:`rodmol.output.run_files.claim`."""
+    from ..output import run_files
+
+    episodes = sorted(record.glob("episode_[0-9][0-9][0-9][0-9]*")) if record.is_dir() else []
+    for folder in episodes:
+        run_files.refuse_replacing(folder, overwrite)
+    for folder in episodes:
+        run_files.claim(folder, True)
+        with contextlib.suppress(OSError):  # holds files not rodmol's
+            folder.rmdir()

@@ -4,7 +4,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .._files import claim
+from .._files import claim, output_directory
 from .run_files import PLOTTED, RENDERED
 
 
@@ -19,7 +19,8 @@ def render(result, directory, size=(960, 720), frames=60, progress=None, overwri
     Earlier pictures there are kept unless ``overwrite`` (:func:`rodmol._files.claim`:
     refused before anything is drawn; with ``overwrite`` both are removed first).
     """
-    claim([Path(directory) / name for name in RENDERED], overwrite)
+    directory = output_directory(directory, "directory")
+    claim([directory / name for name in RENDERED], overwrite)
     import pyvista as pv
     from PIL import Image
 
@@ -110,7 +111,8 @@ def plot(result, directory, overwrite=False):
     """Tip and marker paths, marker positions vs time and tensions vs time, as PNGs in
     ``directory`` (like the paper's Figs. 7-8); returns their paths. Earlier plots there are
     kept unless ``overwrite`` (:func:`rodmol._files.claim`)."""
-    claim([Path(directory) / name for name in PLOTTED], overwrite)
+    directory = output_directory(directory, "directory")
+    claim([directory / name for name in PLOTTED], overwrite)
     import matplotlib
 
     matplotlib.use("Agg")
