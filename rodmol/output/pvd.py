@@ -58,12 +58,13 @@ class Collection:
 
     :meth:`add` queues an entry; :meth:`flush` writes the queued ones into the
     file (see the module); :meth:`close` flushes and leaves the file without
-    room. ``written`` counts the bytes written to the file [bytes].
+    room. ``written`` counts the bytes written to the file [bytes], ``rewrites`` the times it
+    was written whole.
     """
 
     def __init__(self, path):
         self.path = Path(path)
-        self.entries, self.queued, self.written = [], [], 0
+        self.entries, self.queued, self.written, self.rewrites = [], [], 0, 0
         self._rewrite(FIRST_ROOM)
 
     def add(self, t, file):
@@ -117,3 +118,4 @@ class Collection:
         self._at = write_pvd(self.path, self.entries, room)
         self._end = self._at + room
         self.written += self._end + len(TAIL)
+        self.rewrites += 1
