@@ -8,7 +8,7 @@ before: the same writer whose flush writes each collection whole, as it did.
 
 Two cases, both policies in the same run:
 
-* ``series``: the whole series of a small rod (``examples/uniform_arm_air.toml``,
+* ``series``: (the fastest of ``--reps`` runs, the policies in turn) the whole series of a small rod (``examples/uniform_arm_air.toml``,
   N = 4, a cable and markers: three parts) of a given number of frames, written
   by ``SeriesWriter`` with its half-second flushes; the total wall time and per
   frame, the bytes written to the collections and how many times one was
@@ -55,7 +55,7 @@ def rewriting_writer():
                 for t, file in collection.entries:
                     ET.SubElement(listed, "DataSet", timestep=repr(float(t)), group="", part="0", file=str(file))
                 ET.indent(root)
-                write_atomically(self.pvd(part), lambda handle: ET.ElementTree(root).write(
+                write_atomically(self.pvd(part), lambda handle, root=root: ET.ElementTree(root).write(
                     handle, encoding="utf-8", xml_declaration=True))
                 self.rewrites += 1
                 self.pvd_bytes += self.pvd(part).stat().st_size
@@ -129,10 +129,13 @@ def main(argv=None):
     rows, per_frame, parts = [], None, None
     for frames in C.pick(args, [1000, 10000], [1000, 5000], [200]):
         result = small_run(frames)
-        row = dict(case="series", frames=frames)
-        for name, policy in policies.items():
-            with tempfile.TemporaryDirectory(prefix="rodmol_vtp_") as tmp:
-                seconds, writer = write_series(policy, result, Path(tmp))
+        row, best = dict(case="series", frames=frames), {}
+        for _ in range(args.reps):  # the policies in turn, the fastest of each kept: a shared machine's load
+            for name, policy in policies.items():
+                with tempfile.TemporaryDirectory(prefix="rodmol_vtp_") as tmp:
+                    seconds, writer = write_series(policy, result, Path(tmp))
+                best[name] = min(best.get(name, (seconds, writer)), (seconds, writer), key=lambda pair: pair[0])
+        for name, (seconds, writer) in best.items():
             written, whole = counts(writer)
             row.update({f"{name}_s": seconds, f"{name}_ms_per_frame": 1e3 * seconds / frames,
                         f"{name}_pvd_mb": written / 1e6, f"{name}_whole_writes": whole})

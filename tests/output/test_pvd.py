@@ -38,12 +38,12 @@ def collection_cost(folder, frames, monkeypatch):
 @pytest.mark.parametrize("frames", [150, 600])
 def test_a_long_series_writes_its_collection_in_linear_bytes(frames, tmp_path, monkeypatch):
     """Listing every frame as it is written (the worst case of the half-second flushes) writes
-    a bounded multiple of the collection's own size: the entries once, the room's doublings,
-    the last rewrite (rewriting the whole collection each time wrote frames/2 times its size:
-    O(frames^2))."""
+    a bounded multiple of the collection's own size: the entries once, the whole file at each
+    doubling of its room (at most four times its size in all), the last rewrite (rewriting the
+    whole collection each time wrote frames/2 times its size: O(frames^2))."""
     written, size = collection_cost(tmp_path, frames, monkeypatch)
     assert len(read_pvd(tmp_path / "rod.pvd")) == frames
-    assert written < 5 * size + 32 * 1024, (written, size)
+    assert written < 6 * size + 64 * 1024, (written, size)
 
 
 def test_the_collection_is_valid_after_every_write_and_no_write_crosses_a_page(tmp_path, monkeypatch):
