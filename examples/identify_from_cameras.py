@@ -114,8 +114,8 @@ def main():
                     "Synthetic fetching test: errors of eq. (15)", overwrite=True)
         print(f"\nwrote {args.figures / 'calibration_errors.png'}")
         if study:
-            study.plot(args.figures / "calibration_table5.png", "Worsened models (Table V), synthetic fetching",
-                       overwrite=True)
+            study.plot(args.figures / "calibration_table5.png",
+                       "Worsened models (Table V), synthetic fetching", overwrite=True)
             print(f"wrote {args.figures / 'calibration_table5.png'}")
     print(f"\ndone in {time.perf_counter() - started:.0f} s (rodmol {rodmol.__version__})")
 

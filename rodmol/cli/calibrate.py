@@ -134,8 +134,8 @@ def _identify(args):
         residual_m=fit.residual, runs=fit.runs, success=fit.success, message=fit.message,
         mean_error=[fit.errors_before.mean_average, fit.errors_after.mean_average],
         tip_error=[fit.errors_before.tip_average, fit.errors_after.tip_average]), indent=2), encoding="utf-8")
-    plot_errors([fit.errors_before, fit.errors_after], out / "errors.png", f"{spec.name}: before and after the fit",
-                overwrite=args.overwrite)
+    plot_errors([fit.errors_before, fit.errors_after], out / "errors.png",
+                f"{spec.name}: before and after the fit", overwrite=args.overwrite)
     say(fit.table())
     say(f"rodmol: wrote {out / 'fit.md'}, {out / 'fit.json'} and {out / 'errors.png'}")
     return 0 if fit.success else 1

@@ -84,7 +84,7 @@ class Collection:
             return
         batches, at = [], self._at
         for line in lines:
-            if at // PAGE != (at + len(line) - 1) // PAGE:  # not across a page: the rest of this one stays blank
+            if at // PAGE != (at + len(line) - 1) // PAGE:  # never across a page: the rest stays blank
                 at = (at // PAGE + 1) * PAGE
             if not batches or batches[-1][0] // PAGE != at // PAGE:
                 batches.append([at, b""])

@@ -232,8 +232,9 @@ class SystemRunWriter:
             return
         info = read_info(self.directory)["info"]
         if info.get("complete", True) and info["success"]:
-            raise ParameterError(kept(f"the output directory {str(self.directory)!r} holds a finished system run",
-                                      "overwrite=True (`--overwrite`)", "output directory"))
+            where = f"the output directory {str(self.directory)!r}"
+            raise ParameterError(kept(f"{where} holds a finished system run", "overwrite=True (`--overwrite`)",
+                                      "output directory"))
         raise ParameterError(f"the output directory {str(self.directory)!r} holds an unfinished system run: "
                              "continue it with resume=True (`--resume`), or replace it with overwrite=True")
 

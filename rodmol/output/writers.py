@@ -179,7 +179,8 @@ class SeriesWriter:
             raise ParameterError(f"unknown `parts` {unknown}; valid are {list(PARTS)}")
         self.directory = output_directory(directory, "directory")
         self.parts = tuple(parts)
-        claim([*(self.pvd(part) for part in PARTS), *run_files.numbered(self.directory, SUBDIRECTORY)], overwrite)
+        series = [self.pvd(part) for part in PARTS] + run_files.numbered(self.directory, SUBDIRECTORY)
+        claim(series, overwrite)
         (self.directory / SUBDIRECTORY).mkdir(exist_ok=True)
         self.frames, self.flush_interval = 0, float(flush_interval)
         self.collections = {part: Collection(self.pvd(part)) for part in self.parts}
