@@ -96,3 +96,33 @@ def test_a_series_cut_short_is_read_by_paraviews_reader(result, tmp_path):
     writer.close()  # the room goes: the file as small as its entries
     assert b"     " not in (tmp_path / "rod.pvd").read_bytes().replace(b"    <DataSet", b"")
     assert len(read_pvd(tmp_path / "rod.pvd")) == 7
+
+
+def test_a_full_disk_while_adding_leaves_the_entries_before(tmp_path, monkeypatch):
+    """A write that fails (a full disk) leaves the collection valid, listing what it listed;
+    the entries are added by the next flush that succeeds."""
+    import errno
+
+    from rodmol.output.pvd import PAGE, Collection
+
+    collection = Collection(tmp_path / "rod.pvd")
+    collection.add(0.0, "vtk/rod_000000.vtp")
+    collection.flush()
+    pwrite, calls = os.pwrite, []
+
+    def full(fd, data, offset):
+        calls.append(offset)
+        if len(calls) == 2:  # the first page of entries lands, then the disk is full
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return pwrite(fd, data, offset)
+
+    monkeypatch.setattr(os, "pwrite", full)
+    for k in range(1, 90):  # more than a page of entries, within the room
+        collection.add(0.1 * k, f"vtk/rod_{k:06d}.vtp")
+    with pytest.raises(OSError, match="No space left"):
+        collection.flush()
+    assert calls[1] // PAGE > calls[0] // PAGE  # the second page failed (the first blanked again)
+    assert [t for t, _ in read_pvd(tmp_path / "rod.pvd")] == [0.0]
+    monkeypatch.undo()
+    collection.flush()
+    assert len(read_pvd(tmp_path / "rod.pvd")) == 90
