@@ -8,16 +8,19 @@ before: the same writer whose flush writes each collection whole, as it did.
 
 Two cases, both policies in the same run:
 
-* ``series``: (the fastest of ``--reps`` runs, the policies in turn) the whole series of a small rod (``examples/uniform_arm_air.toml``,
+* ``series``: the whole series of a small rod (``examples/uniform_arm_air.toml``,
   N = 4, a cable and markers: three parts) of a given number of frames, written
-  by ``SeriesWriter`` with its half-second flushes; the total wall time and per
-  frame, the bytes written to the collections and how many times one was
-  written whole;
+  by ``SeriesWriter`` with its half-second flushes (the least CPU time of
+  ``--reps`` runs, the policies in turn); the wall and CPU time, the time spent
+  in the collections (``collections_s``: the flushes and the close, what the
+  policies differ by; the rest, the frame files, is the same work and on a
+  shared machine mostly the other processes' load), the bytes written to the
+  collections and how many times one was written whole;
 * ``collections``: the collections alone (the frame files not written, so that
   60,001 frames need no 800 MB of ``.vtp``), flushed every F frames, F the
   frames the ``series`` case writes in half a second: what the collections cost
   a run of that length; ``estimated_total_s`` adds the frame files' measured
-  cost per frame.
+  cost per frame (the ``series`` case's wall time less its collections').
 
     python solvers/vtp_series_cost.py [--quick | --smoke] [--out DIR]
 """
@@ -84,21 +87,39 @@ def small_run(frames):
     return run
 
 
-def write_series(policy, result, folder, flush_every=None):
-    """Write ``result``'s frames with ``policy`` (the writer class) into ``folder``; returns
-    (seconds, writer). ``flush_every``: flush every so many frames instead of every half second."""
-    interval = 0.5 if flush_every is None else float("inf")
-    started = time.perf_counter()
-    with policy.for_result(result, folder, flush_interval=interval) as writer:
+def timed(policy):
+    """``policy`` (a writer class) that adds the time [s] spent in its collections (its flushes
+    and its close) up in ``collections_s``."""
+
+    class Timed(policy):
+        collections_s = 0.0
+
+        def flush(self):
+            started = time.perf_counter()
+            super().flush()
+            self.collections_s += time.perf_counter() - started
+
+        def close(self):
+            started = time.perf_counter()
+            super().close()
+            self.collections_s += time.perf_counter() - started
+
+    return Timed
+
+
+def write_series(policy, result, folder):
+    """Write ``result``'s frames with ``policy`` (flushing every half second) into ``folder``;
+    returns (wall [s], CPU [s], writer)."""
+    started, cpu = time.perf_counter(), time.process_time()
+    with timed(policy).for_result(result, folder) as writer:
         for k in range(len(result.t)):
             writer.write(result, k)
-            if flush_every and (k + 1) % flush_every == 0:
-                writer.flush()
-    return time.perf_counter() - started, writer
+    return time.perf_counter() - started, time.process_time() - cpu, writer
 
 
 def collections_only(policy, frames, flush_every, parts):
-    """The collections of ``frames`` frames of ``parts`` alone (no frame files): (seconds, writer)."""
+    """The collections of ``frames`` frames of ``parts`` alone (no frame files), flushed every
+    ``flush_every`` frames: (wall [s], CPU [s], writer)."""
     from rodmol.output import writers
 
     saved = writers.save_vtp, dict(writers.MESHES)
@@ -107,17 +128,24 @@ def collections_only(policy, frames, flush_every, parts):
     try:
         run = SimpleNamespace(t=0.001 * np.arange(frames), meta={})
         with tempfile.TemporaryDirectory(prefix="rodmol_pvd_") as tmp:
-            started = time.perf_counter()
+            started, cpu = time.perf_counter(), time.process_time()
             with policy(tmp, parts, flush_interval=float("inf")) as writer:
                 for k in range(frames):
                     writer.write(run, k)
                     if (k + 1) % flush_every == 0:
                         writer.flush()
-            return time.perf_counter() - started, writer
+            return time.perf_counter() - started, time.process_time() - cpu, writer
     finally:
         writers.save_vtp = saved[0]
         writers.MESHES.clear()
         writers.MESHES.update(saved[1])
+
+
+def measured(name, wall, cpu, writer, frames):
+    """One policy's columns of a row."""
+    written, whole = counts(writer)
+    return {f"{name}_s": wall, f"{name}_cpu_s": cpu, f"{name}_ms_per_frame": 1e3 * wall / frames,
+            f"{name}_pvd_mb": written / 1e6, f"{name}_whole_writes": whole}
 
 
 def main(argv=None):
@@ -130,36 +158,34 @@ def main(argv=None):
     for frames in C.pick(args, [1000, 10000], [1000, 5000], [200]):
         result = small_run(frames)
         row, best = dict(case="series", frames=frames), {}
-        for _ in range(args.reps):  # the policies in turn, the fastest of each kept: a shared machine's load
+        for _ in range(args.reps):  # the policies in turn, the least CPU of each kept: a shared machine's load
             for name, policy in policies.items():
                 with tempfile.TemporaryDirectory(prefix="rodmol_vtp_") as tmp:
-                    seconds, writer = write_series(policy, result, Path(tmp))
-                best[name] = min(best.get(name, (seconds, writer)), (seconds, writer), key=lambda pair: pair[0])
-        for name, (seconds, writer) in best.items():
-            written, whole = counts(writer)
-            row.update({f"{name}_s": seconds, f"{name}_ms_per_frame": 1e3 * seconds / frames,
-                        f"{name}_pvd_mb": written / 1e6, f"{name}_whole_writes": whole})
-            if name == "after":
-                per_frame, parts = seconds / frames, writer.parts
-        row["before_over_after"] = row["before_s"] / row["after_s"]
+                    run = write_series(policy, result, Path(tmp))
+                best[name] = min(best.get(name, run), run, key=lambda found: found[1])
+        for name, (wall, cpu, writer) in best.items():
+            row.update(measured(name, wall, cpu, writer, frames), **{f"{name}_collections_s": writer.collections_s})
+        # the frame files' own cost per frame, for the cadence and the estimates below
+        per_frame, parts = (best["after"][0] - best["after"][2].collections_s) / frames, best["after"][2].parts
+        row["collections_before_over_after"] = row["before_collections_s"] / row["after_collections_s"]
         rows.append(row)
-        print(f"series of {frames} frames: before {row['before_s']:.2f} s, after {row['after_s']:.2f} s", flush=True)
+        print(f"series of {frames} frames: in the collections before {row['before_collections_s']:.2f} s, "
+              f"after {row['after_collections_s']:.3f} s (all: {row['before_s']:.1f} s, {row['after_s']:.1f} s)",
+              flush=True)
     flush_every = max(1, round(0.5 / per_frame))  # frames a half second of writing holds
     for frames in C.pick(args, [1000, 10000, 60001], [1000, 10000, 20000], [200, 1000]):
         row = dict(case="collections", frames=frames, flush_every_frames=flush_every)
         for name, policy in policies.items():
-            seconds, writer = collections_only(policy, frames, flush_every, parts)
-            written, whole = counts(writer)
-            row.update({f"{name}_s": seconds, f"{name}_ms_per_frame": 1e3 * seconds / frames,
-                        f"{name}_pvd_mb": written / 1e6, f"{name}_whole_writes": whole,
-                        f"{name}_estimated_total_s": seconds + per_frame * frames})
-        row["before_over_after"] = row["before_s"] / row["after_s"]
+            wall, cpu, writer = collections_only(policy, frames, flush_every, parts)
+            row.update(measured(name, wall, cpu, writer, frames),
+                       **{f"{name}_estimated_total_s": wall + per_frame * frames})
+        row["collections_before_over_after"] = row["before_s"] / row["after_s"]
         rows.append(row)
         print(f"collections of {frames} frames: before {row['before_s']:.2f} s, after {row['after_s']:.3f} s",
               flush=True)
     C.write_results(args, "vtp_series_cost", "Writing a .vtp series: the .pvd collections before and after",
-                    header, rows, [("Wall time, bytes written to the collections and whole writes, by frames",
-                                    C.markdown_table(rows))])
+                    header, rows, [("Wall and CPU time, time in the collections, bytes written to them and "
+                                    "whole writes, by frames", C.markdown_table(rows))])
 
 
 if __name__ == "__main__":

@@ -255,6 +255,7 @@ def _vtp_series_cost(out):
     # bytes: before grows as frames^2, after as frames
     first, last = collections[0], collections[-1]
     assert last["before_pvd_mb"] / last["after_pvd_mb"] > 1.5 * first["before_pvd_mb"] / first["after_pvd_mb"]
+    assert all(row["after_collections_s"] >= 0 for row in table if row["case"] == "series")
 
 
 SCRIPTS = {
