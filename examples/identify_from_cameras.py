@@ -110,11 +110,12 @@ def main():
     print("\n   Table IV after identification:\n" + table([table4, after], "Test"))
     if args.figures:
         args.figures.mkdir(parents=True, exist_ok=True)
-        plot_errors([table4, after], args.figures / "calibration_errors.png",
-                    "Synthetic fetching test: errors of eq. (15)")
+        plot_errors([table4, after], args.figures / "calibration_errors.png",  # the figures made anew
+                    "Synthetic fetching test: errors of eq. (15)", overwrite=True)
         print(f"\nwrote {args.figures / 'calibration_errors.png'}")
         if study:
-            study.plot(args.figures / "calibration_table5.png", "Worsened models (Table V), synthetic fetching")
+            study.plot(args.figures / "calibration_table5.png",
+                       "Worsened models (Table V), synthetic fetching", overwrite=True)
             print(f"wrote {args.figures / 'calibration_table5.png'}")
     print(f"\ndone in {time.perf_counter() - started:.0f} s (rodmol {rodmol.__version__})")
 

@@ -71,6 +71,33 @@ def refuse_directories(paths, name=None):
                                  "remove it or choose another name")
 
 
+#: How a call asks to replace an earlier output (the command line says ``--overwrite``).
+OVERWRITE = "overwrite=True"
+
+
+def kept(what, hint=OVERWRITE, other="name"):
+    """The message of an earlier output kept: ``what`` (the output and what it holds) is kept
+    unless the caller passes ``hint``."""
+    return f"{what}: it is kept unless you pass {hint} to replace it (or choose another {other})"
+
+
+def claim(paths, overwrite, hint=OVERWRITE, remove=True):
+    """The one rule of every writer of files under names a user gave: unless ``overwrite``,
+    refuse (a :class:`ParameterError` naming the first that exists, before any work is done)
+    to replace any of ``paths``; with ``overwrite``, remove those that exist (unless not
+    ``remove``: a single file written atomically replaces its old self), so that none of an
+    earlier output is left beside the new one. A directory in the place of one is refused
+    either way. Returns the paths (as Paths)."""
+    refuse_directories(paths)
+    paths = [Path(path) for path in paths]
+    found = [path for path in paths if os.path.lexists(path)]
+    if found and not overwrite:
+        raise ParameterError(kept(f"{str(found[0])!r} exists", hint))
+    for path in found if remove else ():
+        path.unlink(missing_ok=True)
+    return paths
+
+
 def write_atomically(path, write, buffering=-1):
     """Call ``write(handle)`` on a binary file (``buffering`` as :func:`open`'s), then move it to
     ``path`` (see :func:`atomic_path`)."""

@@ -5,7 +5,7 @@ from functools import partial
 
 import numpy as np
 
-from ._files import refuse_directories, write_atomically
+from ._files import claim, refuse_directories, write_atomically
 from .discretise import centreline, physics, rotations
 from .discretise.layout import StateLayout
 
@@ -119,9 +119,11 @@ class Result:
         """(n_t, 3) tip position [m], global."""
         return self.positions[:, -1]
 
-    def save(self, path):
-        """Write the result to ``path`` (.npz); read it back with :func:`rodmol.load_result`."""
+    def save(self, path, overwrite=False):
+        """Write the result to ``path`` (.npz); read it back with :func:`rodmol.load_result`.
+        A file already there is kept unless ``overwrite`` (:func:`rodmol._files.claim`)."""
         refuse_directories([path], "path")  # before the arrays are compressed
+        claim([path], overwrite, remove=False)  # replaced atomically below
         info = dict(success=self.success, message=self.message, stats=self.stats, meta=self.meta,
                     units=ARRAYS)
         arrays = {k: getattr(self, k) for k in ARRAYS}

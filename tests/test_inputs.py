@@ -250,8 +250,10 @@ def test_save_load_round_trip(tmp_path):
     _assert_same_result(res, back)
     assert back.tip.shape == (len(res.t), 3)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["run.npz"]  # no temporary left
-    # Saving again over the same name replaces the file.
-    res.save(str(path))
+    # Saving again over the same name is refused unless asked, and then replaces the file.
+    with pytest.raises(rodmol.ParameterError, match="run.npz' exists: .*overwrite=True"):
+        res.save(path)
+    res.save(str(path), overwrite=True)
     _assert_same_result(res, rodmol.load_result(str(path)))
 
 

@@ -258,6 +258,17 @@ def _reach_scores(out):
         assert all(0.0 <= d < 1e3 for d in distances) and math.isfinite(row["mean_return"]), row
 
 
+def _vtp_series_cost(out):
+    table = rows(out / "vtp_series_cost.csv")
+    collections = sorted((row for row in table if row["case"] == "collections"), key=lambda row: row["frames"])
+    for row in table:  # after: whole writes only as the room doubles (logarithmic in frames)
+        assert row["after_whole_writes"] <= 3 * (math.log2(row["frames"]) + 2), row
+    # bytes: before grows as frames^2, after as frames
+    first, last = collections[0], collections[-1]
+    assert last["before_pvd_mb"] / last["after_pvd_mb"] > 1.5 * first["before_pvd_mb"] / first["after_pvd_mb"]
+    assert all(row["after_collections_s"] >= 0 for row in table if row["case"] == "series")
+
+
 SCRIPTS = {
     "scaling.py": (["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"], _scaling),
     "temporal.py": (["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv", "temporal_options.csv"],
@@ -291,6 +302,7 @@ SCRIPTS = {
     "body_joints.py": (["body_joints.csv", "body_joints.md"], _body_joints),
     "system_output.py": (["system_output.csv", "system_output.md"], _system_output),
     "rod_contact.py": (["rod_contact.csv", "rod_contact.md"], _rod_contact),
+    "vtp_series_cost.py": (["vtp_series_cost.csv", "vtp_series_cost.md"], _vtp_series_cost),
 }
 
 

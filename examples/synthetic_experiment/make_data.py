@@ -33,11 +33,11 @@ def main():
     spec = parse_scenario(f'name = "fetching"\narm = "paper"\nscenario = "fetching"\n'
                           f'[discretization]\nn_elements = {N_ELEMENTS}\nscheme = "{SCHEME}"\n')
     rec = synthetic.synthesize(spec, TRUTH, noise_px=1.0, tension_noise=0.02, occlusion=0.01, seed=2014)
-    for cam, uv, pixels in zip(rec.cameras, rec.control_uv, rec.pixels):
-        write_control_points(HERE / f"control_{cam.name}.csv", rec.control_xyz, uv)
-        write_pixel_tracks(HERE / f"pixels_{cam.name}.csv", pixels)
-    write_tension_log(HERE / "tensions.csv", rec.tensions)
-    write_marker_tracks(HERE / "true_markers.csv", rec.true_markers)
+    for cam, uv, pixels in zip(rec.cameras, rec.control_uv, rec.pixels):  # made anew: replaced
+        write_control_points(HERE / f"control_{cam.name}.csv", rec.control_xyz, uv, overwrite=True)
+        write_pixel_tracks(HERE / f"pixels_{cam.name}.csv", pixels, overwrite=True)
+    write_tension_log(HERE / "tensions.csv", rec.tensions, overwrite=True)
+    write_marker_tracks(HERE / "true_markers.csv", rec.true_markers, overwrite=True)
     (HERE / "truth.json").write_text(json.dumps(dict(
         scenario="fetching", n_elements=N_ELEMENTS, scheme=SCHEME, parameters=TRUTH,
         rodmol=rodmol.__version__,

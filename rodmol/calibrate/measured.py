@@ -17,12 +17,14 @@ marker); elsewhere every value is required.
 """
 
 import csv
+import io
 import math
 import os
 from dataclasses import dataclass
 
 import numpy as np
 
+from .._files import claim, write_atomically
 from ..errors import ParameterError
 from ..inputs import Knots
 
@@ -116,32 +118,43 @@ def read_control_points(path):
     return rows[:, :3], rows[:, 3:]
 
 
-def write_tension_log(path, log):
-    _write(path, ["t"] + list(log.names), np.column_stack([log.t, log.values]))
+# Each writer keeps a file already at ``path`` unless ``overwrite`` (rodmol._files.claim).
+
+def write_tension_log(path, log, overwrite=False):
+    _write(path, ["t"] + list(log.names), np.column_stack([log.t, log.values]), overwrite)
 
 
-def write_marker_tracks(path, tracks):
+def write_marker_tracks(path, tracks, overwrite=False):
     heads = [f"{n}.{c}" for n in tracks.names for c in "xyz"]
-    _write(path, ["t"] + heads, np.column_stack([tracks.t, tracks.xyz.reshape(len(tracks.t), -1)]))
+    _write(path, ["t"] + heads, np.column_stack([tracks.t, tracks.xyz.reshape(len(tracks.t), -1)]), overwrite)
 
 
-def write_pixel_tracks(path, tracks):
+def write_pixel_tracks(path, tracks, overwrite=False):
     heads = [f"{n}.{c}" for n in tracks.names for c in "uv"]
-    _write(path, ["t"] + heads, np.column_stack([tracks.t, tracks.uv.reshape(len(tracks.t), -1)]))
+    _write(path, ["t"] + heads, np.column_stack([tracks.t, tracks.uv.reshape(len(tracks.t), -1)]), overwrite)
 
 
-def write_control_points(path, xyz, uv):
-    _write(path, ["x", "y", "z", "u", "v"], np.column_stack([xyz, uv]))
+def write_control_points(path, xyz, uv, overwrite=False):
+    _write(path, ["x", "y", "z", "u", "v"], np.column_stack([xyz, uv]), overwrite)
 
 
 # --------------------------------------------------------------------------- CSV engine
 
-def _write(path, header, rows):
-    with open(path, "w", newline="", encoding="utf-8") as handle:
-        out = csv.writer(handle)
+def _write(path, header, rows, overwrite):
+    """Write a CSV file (under a temporary name, renamed when complete), unless one is there
+    and not ``overwrite``."""
+    claim([path], overwrite, remove=False)
+
+    def write(handle):
+        text = io.TextIOWrapper(handle, encoding="utf-8", newline="")
+        out = csv.writer(text)
         out.writerow(header)
         for row in rows:
             out.writerow(["" if math.isnan(x) else f"{x:.10g}" for x in row])
+        text.flush()
+        text.detach()
+
+    write_atomically(path, write)
 
 
 def _names(header, count, group, default):

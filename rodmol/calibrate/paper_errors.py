@@ -6,6 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._files import claim
 from ..analysis import marker_errors
 from ..errors import ParameterError
 from .measured import MarkerTracks, read_marker_tracks
@@ -129,9 +130,11 @@ def table(rows, title="Model"):
     return "\n".join(lines)
 
 
-def plot_errors(tables, path, title=None):
+def plot_errors(tables, path, title=None, overwrite=False):
     """Mean and tip errors [% of L] against time, one line per ErrorTable
-    (Fig. 8 style for one run, Fig. 9 style for the worsened models); PNG."""
+    (Fig. 8 style for one run, Fig. 9 style for the worsened models); PNG. A file
+    already at ``path`` is kept unless ``overwrite`` (:func:`rodmol._files.claim`)."""
+    claim([path], overwrite)
     import matplotlib
 
     matplotlib.use("Agg")

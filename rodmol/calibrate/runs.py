@@ -111,17 +111,26 @@ class Summary:
         return row
 
 
+#: Where a batch's run ``i`` is saved in its directory: ``run_<i>/result.npz`` (a glob of them all).
+RUN_FILES = "run_[0-9][0-9][0-9][0-9]*/result.npz"
+
+
+def run_file(out, index):
+    """The path of run ``index``'s result in the directory ``out`` (one of :data:`RUN_FILES`)."""
+    return Path(out) / f"run_{index:04d}" / "result.npz"
+
+
 def run_indexed(task, item):
     """``task(overrides)`` for ``item = (index, overrides, out)``; saves the result
     to ``out/run_<index>/result.npz`` when ``out`` is set (module level so it pickles)."""
     index, overrides, out = item
     outcome = (task if out is None else replace(task, keep=True))(overrides)
     if out is not None and outcome.result is not None:
-        folder = Path(out) / f"run_{index:04d}"
-        folder.mkdir(parents=True, exist_ok=True)
+        path = run_file(out, index)
+        path.parent.mkdir(parents=True, exist_ok=True)
         outcome.result.meta.update(overrides={k: repr(v) for k, v in overrides.items()})
-        outcome.result.save(folder / "result.npz")
-        outcome.value = dict(outcome.value or {}, path=str(folder / "result.npz"))
+        outcome.result.save(path)  # the sweep claimed its directory (rodmol.calibrate.sweep)
+        outcome.value = dict(outcome.value or {}, path=str(path))
         if not task.keep:
             outcome.result = None  # read back from the file when needed
     return outcome

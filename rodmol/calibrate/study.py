@@ -31,9 +31,10 @@ class Study:
         """Table V as Markdown (errors in % of the arm length)."""
         return table(self.errors.values(), title="Model")
 
-    def plot(self, path, title="Worsened models"):
-        """Fig. 9 style: mean and tip errors against time for every variant (PNG)."""
-        return plot_errors(list(self.errors.values()), path, title)
+    def plot(self, path, title="Worsened models", overwrite=False):
+        """Fig. 9 style: mean and tip errors against time for every variant (PNG); a file
+        already at ``path`` is kept unless ``overwrite``."""
+        return plot_errors(list(self.errors.values()), path, title, overwrite)
 
 
 def worsened_models(spec, measured, *, client=None, variants=None, progress=None, n_workers=None):

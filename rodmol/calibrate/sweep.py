@@ -1,15 +1,17 @@
 """Batch runs of one scenario over a list or a grid of dotted overrides."""
 
+import contextlib
 import csv
 import itertools
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
 
+from .._files import OVERWRITE, claim, output_directory
 from ..errors import ParameterError
 from .paper_errors import as_tracks
 from .parallel import SERIAL, check_picklable, executor
-from .runs import Summary, Task, failed_item, run_indexed
+from .runs import RUN_FILES, Summary, Task, failed_item, run_indexed
 from .variants import apply, as_spec
 
 
@@ -60,10 +62,11 @@ class Sweep:
         lines += ["| " + " | ".join(_cell(r.get(c, "")) for c in columns) + " |" for r in rows]
         return "\n".join(lines)
 
-    def write(self, directory):
-        """Write summary.csv and summary.md to ``directory``; returns their paths."""
-        directory = Path(directory)
-        directory.mkdir(parents=True, exist_ok=True)
+    def write(self, directory, overwrite=False):
+        """Write summary.csv and summary.md to ``directory``; returns their paths. Earlier
+        ones there are kept unless ``overwrite`` (:func:`rodmol._files.claim`)."""
+        directory = output_directory(directory, "directory")
+        claim([directory / name for name in SUMMARY], overwrite)
         rows = self.rows()
         columns = list(dict.fromkeys(k for r in rows for k in r))
         with open(directory / "summary.csv", "w", newline="", encoding="utf-8") as handle:
@@ -74,19 +77,41 @@ class Sweep:
         return directory / "summary.csv", directory / "summary.md"
 
 
+#: The files of a sweep's summary in its directory.
+SUMMARY = ("summary.csv", "summary.md")
+
+
+def outputs(directory):
+    """The files a sweep wrote in ``directory``: its summary and every run's result."""
+    directory = Path(directory)
+    return [directory / name for name in SUMMARY] + sorted(directory.glob(RUN_FILES))
+
+
+def claim_outputs(directory, overwrite, hint=OVERWRITE):
+    """Before a sweep into ``directory``: refuse an earlier sweep's files there unless
+    ``overwrite``, which removes them (and the runs' folders they leave empty)."""
+    directory = output_directory(directory, "out")
+    for path in claim(outputs(directory), overwrite, hint):
+        if path.name not in SUMMARY:
+            with contextlib.suppress(OSError):  # holds files not the sweep's
+                path.parent.rmdir()
+
+
 def _cell(value):
     return f"{value:.6g}" if isinstance(value, float) else str(value)
 
 
 def sweep(spec, overrides, *, client=None, out=None, measured=None, keep=None, progress=None,
-          n_workers=None):
+          n_workers=None, overwrite=False):
     """Run ``spec`` once per set of ``overrides`` (a list of {dotted key: value}
     dicts, e.g. from :func:`grid`), in parallel on dask (see
     :mod:`rodmol.calibrate.parallel` for ``client``).
 
     Every override is checked before any run. With ``out``, each run's result
     goes to ``out/run_<i>/result.npz`` and the summary to ``out/summary.csv``
-    and ``summary.md``. ``measured`` (marker tracks) adds the averages of
+    and ``summary.md``; an earlier sweep's files there (:func:`outputs`) are kept:
+    refused before any run unless ``overwrite=True``, which removes them all
+    first. ``measured`` (marker tracks) adds the averages of
     eq. (15) to the summary. ``keep`` brings every Result back to this process
     (default: only without ``out``; a Result ships its raw states, about
     size x n_t x 8 bytes). ``progress(done, total)`` is called as runs end.
@@ -101,6 +126,10 @@ def sweep(spec, overrides, *, client=None, out=None, measured=None, keep=None, p
     if client != SERIAL:
         check_picklable(spec)
     tracks = as_tracks(measured) if measured is not None else None
+    if out is None and overwrite:
+        raise ParameterError("`overwrite=True` needs `out`, the directory of the sweep")
+    if out is not None:
+        claim_outputs(out, overwrite)
     task = Task(spec, Summary(tracks), keep=out is None if keep is None else bool(keep))
     folder = None if out is None else str(Path(out).resolve())
     items = [(i, o, folder) for i, o in enumerate(overrides)]

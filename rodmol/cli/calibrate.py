@@ -8,7 +8,8 @@
 Every command takes ``--example NAME`` instead of a file, the run options of
 ``rodmol run`` and ``--workers N`` (a LocalCluster of N processes, default
 one per core), ``--scheduler ADDRESS`` (a running dask cluster) or
-``--serial``. See ``docs/calibration.md``.
+``--serial``. Outputs already in ``--out`` are kept unless ``--overwrite``
+(refused before any run). See ``docs/calibration.md``.
 """
 
 import csv
@@ -17,6 +18,9 @@ import sys
 from pathlib import Path
 
 from ..errors import ParameterError
+
+#: How the command line asks to replace earlier outputs.
+OVERWRITE = "`--overwrite`"
 
 
 def add_commands(commands):
@@ -82,11 +86,17 @@ def _progress(args, label):
     return None if args.quiet else ProgressLine(label)
 
 
-def _out(args, spec, kind):
-    out = args.out or Path("out") / f"{spec.name}-{kind}"
-    from .._files import output_directory
+#: The files ``rodmol study`` and ``rodmol identify`` write in ``--out``.
+STUDY, IDENTIFY = ("study.md", "errors.png"), ("fit.md", "fit.json", "errors.png")
 
-    output_directory(out, "--out")
+
+def _out(args, spec, kind, names=()):
+    """The output directory (made), its files ``names`` refused before any run unless
+    ``--overwrite`` (then removed: :func:`rodmol._files.claim`)."""
+    from .._files import claim, output_directory
+
+    out = output_directory(args.out or Path("out") / f"{spec.name}-{kind}", "--out")
+    claim([out / name for name in names], args.overwrite, OVERWRITE)
     return out
 
 
@@ -94,11 +104,11 @@ def _study(args):
     from ..calibrate import worsened_models
 
     spec, client, say = _setup(args)
-    out = _out(args, spec, "study")
+    out = _out(args, spec, "study", STUDY)
     study = worsened_models(spec, args.measured, client=client, n_workers=args.workers,
                             progress=_progress(args, "rodmol study"))
     (out / "study.md").write_text(study.table() + "\n", encoding="utf-8")
-    study.plot(out / "errors.png", f"{spec.name}: errors of eq. (15)")
+    study.plot(out / "errors.png", f"{spec.name}: errors of eq. (15)", overwrite=args.overwrite)
     say(study.table())
     say(f"rodmol: wrote {out / 'study.md'} and {out / 'errors.png'}")
     return 0
@@ -114,7 +124,7 @@ def _identify(args):
         low, _, high = values.partition(":")
         bounds[key] = (_value(low, "--fit"), _value(high, "--fit"))
     start = {key: _value(v, "--start") for key, v in (_split(t, "--start") for t in args.start)}
-    out = _out(args, spec, "identify")
+    out = _out(args, spec, "identify", IDENTIFY)
     fit = identify(spec, args.measured, bounds, start=start, client=client, n_workers=args.workers,
                    progress=None if args.quiet else lambda i, cost: print(f"rodmol identify: iteration {i}, "
                                                                            f"cost {cost:.6g}", file=sys.stderr))
@@ -124,7 +134,8 @@ def _identify(args):
         residual_m=fit.residual, runs=fit.runs, success=fit.success, message=fit.message,
         mean_error=[fit.errors_before.mean_average, fit.errors_after.mean_average],
         tip_error=[fit.errors_before.tip_average, fit.errors_after.tip_average]), indent=2), encoding="utf-8")
-    plot_errors([fit.errors_before, fit.errors_after], out / "errors.png", f"{spec.name}: before and after the fit")
+    plot_errors([fit.errors_before, fit.errors_after], out / "errors.png",
+                f"{spec.name}: before and after the fit", overwrite=args.overwrite)
     say(fit.table())
     say(f"rodmol: wrote {out / 'fit.md'}, {out / 'fit.json'} and {out / 'errors.png'}")
     return 0 if fit.success else 1
@@ -144,9 +155,12 @@ def _sweep(args):
         overrides = grid(axes)
     else:
         overrides = _read_runs(args.runs)
+    from ..calibrate.sweep import claim_outputs
+
     out = _out(args, spec, "sweep")
+    claim_outputs(out, args.overwrite, OVERWRITE)
     runs = sweep(spec, overrides, client=client, out=out, measured=args.measured, n_workers=args.workers,
-                 progress=_progress(args, "rodmol sweep"))
+                 progress=_progress(args, "rodmol sweep"), overwrite=args.overwrite)
     say(runs.table())
     say(f"rodmol: wrote {len(runs.runs)} results and {out / 'summary.csv'}")
     return 0 if all(r.success for r in runs.runs) else 1

@@ -86,16 +86,23 @@ def _parser():
     render.add_argument("directory", type=Path, help="output directory of `rodmol run` (or its result file)")
     render.add_argument("--frames", type=int, default=60, help="animation frames (default 60; 0: none)")
     render.add_argument("--size", default="960x720", help="picture size in pixels, WxH (default 960x720)")
+    _overwrite_option(render, "pictures")
     render.set_defaults(command=_render)
 
     plot = commands.add_parser("plot", help="plot tip path, markers and tensions vs time (PNG)")
     plot.add_argument("directory", type=Path, help="output directory of `rodmol run` (or its result file)")
+    _overwrite_option(plot, "plots")
     plot.set_defaults(command=_plot)
 
     from .calibrate import add_commands
 
     add_commands(commands)
     return parser
+
+
+def _overwrite_option(parser, what):
+    parser.add_argument("--overwrite", action="store_true", help=f"replace the {what} drawn there earlier "
+                        "(without it they are kept and the command refused)")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -337,6 +344,18 @@ def _result_in(directory):
         raise ParameterError(f"cannot read {str(path)!r} (another rodmol version?): {exc}") from None
 
 
+def _folder(directory):
+    """Where the pictures of ``directory`` (a run directory, or its result file) go."""
+    return directory if directory.is_dir() or not directory.exists() else directory.parent
+
+
+def _claim(args, names):
+    """Refuse the pictures ``names`` drawn earlier, before the result is read, unless ``--overwrite``."""
+    from .._files import claim
+
+    claim([_folder(args.directory) / name for name in names], args.overwrite, "`--overwrite`")
+
+
 def _render(args):
     try:
         size = tuple(int(x) for x in args.size.lower().split("x"))
@@ -347,17 +366,22 @@ def _render(args):
     if args.frames < 0:
         raise ParameterError(f"`--frames` must be >= 0, got {args.frames!r}")
     from ..output.pictures import render
+    from ..output.run_files import RENDERED
 
+    _claim(args, RENDERED)
     result = _result_in(args.directory)
-    for path in render(result, args.directory, size, args.frames, Progress(stream=sys.stdout)):
+    for path in render(result, _folder(args.directory), size, args.frames, Progress(stream=sys.stdout),
+                       overwrite=args.overwrite):
         print(f"rodmol: wrote {path}")
     return 0
 
 
 def _plot(args):
     from ..output.pictures import plot
+    from ..output.run_files import PLOTTED
 
-    for path in plot(_result_in(args.directory), args.directory):
+    _claim(args, PLOTTED)
+    for path in plot(_result_in(args.directory), _folder(args.directory), overwrite=args.overwrite):
         print(f"rodmol: wrote {path}")
     return 0
 

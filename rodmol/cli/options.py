@@ -30,9 +30,10 @@ def add_run_options(parser):
     parser.add_argument("--resume-anyway", action="store_true", help="--resume even if the scenario or the "
                         "options changed a setting (rtol, scheme, backend, the model, ...): the run goes on "
                         "with the new ones (the grid and the output times cannot change)")
-    parser.add_argument("--overwrite", action="store_true", help="replace the run in the output directory "
-                        "(finished or not): all of its files, pictures included, are removed first; "
-                        "without it an earlier run there is kept and the command refused")
+    parser.add_argument("--overwrite", action="store_true", help="replace the outputs in the output directory "
+                        "(a run, finished or not, with all of its files and pictures; a study's, fit's or "
+                        "sweep's files): they are removed first; without it they are kept and the command "
+                        "refused before any run")
     parser.add_argument("--quiet", action="store_true", help="print nothing but errors")
 
 

@@ -13,6 +13,7 @@ module::
 rodmol itself never imports this module, so it works without gymnasium.
 """
 
+import contextlib
 import functools
 import os
 from pathlib import Path
@@ -129,7 +130,8 @@ class ReachEnv(gymnasium.Env):
         Stream every episode into ``record/episode_NNNN`` (``result.h5`` and
         ParaView's ``rod.xdmf``), through the Simulator's ``out``.
     overwrite : bool
-        With ``record``: replace episodes recorded there earlier (otherwise refused).
+        With ``record``: replace the episodes recorded there earlier, all of them (otherwise
+        refused when the environment is made).
     """
 
     metadata = {"render_modes": []}
@@ -142,6 +144,8 @@ class ReachEnv(gymnasium.Env):
         self.period, self.episode_steps = options["period"], options["episode_steps"]
         self.max_tension, self.effort_weight = options["max_tension"], options["effort_weight"]
         self.record, self._overwrite, self._episodes = options["record"], options["overwrite"], 0
+        if self.record is not None:  # before any work: the episodes recorded there earlier
+            _claim_record(self.record, self._overwrite)
         self.model = paper_arm(n_elements, medium="water")
         self.sim = Simulator(self.model)
         self._start, self._y0 = self.sim.copy(), self.sim.y
@@ -252,3 +256,17 @@ def vector_env(num_envs, **kwargs):
     """``num_envs`` :class:`ReachEnv` (keyword arguments ``kwargs``), each in its own process
     (``gymnasium.vector.AsyncVectorEnv``)."""
     return gymnasium.vector.AsyncVectorEnv([functools.partial(ReachEnv, **kwargs)] * int(num_envs))
+
+
+def _claim_record(record, overwrite):
+    """Refuse the episodes recorded in ``record`` earlier unless ``overwrite``, which removes them
+    all (a shorter recording would leave the later ones): :func:`rodmol.output.run_files.claim`."""
+    from ..output import run_files
+
+    episodes = sorted(record.glob("episode_[0-9][0-9][0-9][0-9]*")) if record.is_dir() else []
+    for folder in episodes:
+        run_files.refuse_replacing(folder, overwrite)
+    for folder in episodes:
+        run_files.claim(folder, True)
+        with contextlib.suppress(OSError):  # holds files not rodmol's
+            folder.rmdir()

@@ -46,8 +46,9 @@ class Format:
     read : callable
         ``read(path)``: the :class:`rodmol.Result` of that file.
     write : callable
-        ``write(result, directory, every)``: write a finished Result; returns the
-        path to open in ParaView.
+        ``write(result, directory, every)``: write a finished Result into ``directory``,
+        which :func:`write_series` has cleared (or found free); returns the path to open
+        in ParaView.
     sink : callable or None
         Streams while the run goes: ``sink(directory, views=, every=, chunk_frames=,
         resume=, meta=)`` gives the frame sink of :func:`rodmol.simulate` (its
@@ -86,7 +87,7 @@ def get_format(name, what="format"):
     return FORMATS[name]
 
 
-def write_series(result, directory, every=None, format=DEFAULT):
+def write_series(result, directory, every=None, format=DEFAULT, overwrite=False):
     """Write a finished :class:`rodmol.Result` (or a system's ``SystemResult``:
     :func:`rodmol.output.system_stream.write_system`) for ParaView into ``directory``.
 
@@ -97,13 +98,19 @@ def write_series(result, directory, every=None, format=DEFAULT):
     :func:`rodmol.load_result`, ``rodmol render`` and ``rodmol plot``.
     ``every``: show every n-th output frame (and the last); by default all
     of them up to :data:`rodmol.output.parts.MAX_SHOWN` frames.
+    An earlier run in ``directory`` (a rod's or a system's, any format) is kept: refused
+    with a ParameterError unless ``overwrite=True``, which removes all of its files first
+    (:func:`rodmol.output.run_files.claim`).
     """
     entry = get_format(format)
-    if isinstance(result, SystemResult):  # each rod's files as a single rod's, the bodies', the index
-        if entry.name != "xdmf":
-            raise ParameterError(f"a system's result is written as 'xdmf' only, got `format` {format!r}")
+    system = isinstance(result, SystemResult)
+    if system and entry.name != "xdmf":
+        raise ParameterError(f"a system's result is written as 'xdmf' only, got `format` {format!r}")
+    directory = output_directory(directory, "directory")
+    run_files.claim(directory, overwrite)
+    if system:  # each rod's files as a single rod's, the bodies', the index
         return system_stream.write_system(result, directory, every)
-    return entry.write(result, output_directory(directory, "directory"), every)
+    return entry.write(result, directory, every)
 
 
 def result_file(path):

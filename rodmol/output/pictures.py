@@ -4,10 +4,11 @@ from pathlib import Path
 
 import numpy as np
 
+from .._files import claim, output_directory
 from .run_files import PLOTTED, RENDERED
 
 
-def render(result, directory, size=(960, 720), frames=60, progress=None):
+def render(result, directory, size=(960, 720), frames=60, progress=None, overwrite=False):
     """Render ``last_frame.png`` and (``frames`` > 0) ``animation.gif`` into ``directory``.
 
     Off-screen pyvista: the body as a tube of the true radius coloured by the
@@ -15,7 +16,11 @@ def render(result, directory, size=(960, 720), frames=60, progress=None):
     of a SystemResult, every rod so and every rigid body as its surface
     (:func:`rodmol.output.system_files.body_surface`).
     ``progress``: a ``rodmol._progress.Progress`` showing the frames drawn.
+    Earlier pictures there are kept unless ``overwrite`` (:func:`rodmol._files.claim`:
+    refused before anything is drawn; with ``overwrite`` both are removed first).
     """
+    directory = output_directory(directory, "directory")
+    claim([directory / name for name in RENDERED], overwrite)
     import pyvista as pv
     from PIL import Image
 
@@ -102,9 +107,12 @@ def _quiet_vtk():
     vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_ERROR)
 
 
-def plot(result, directory):
+def plot(result, directory, overwrite=False):
     """Tip and marker paths, marker positions vs time and tensions vs time, as PNGs in
-    ``directory`` (like the paper's Figs. 7-8); returns their paths."""
+    ``directory`` (like the paper's Figs. 7-8); returns their paths. Earlier plots there are
+    kept unless ``overwrite`` (:func:`rodmol._files.claim`)."""
+    directory = output_directory(directory, "directory")
+    claim([directory / name for name in PLOTTED], overwrite)
     import matplotlib
 
     matplotlib.use("Agg")

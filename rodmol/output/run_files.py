@@ -7,14 +7,15 @@ pictures of ``rodmol render`` and ``rodmol plot``. :data:`TOP` and
 :data:`NUMBERED` name them all; :func:`clear` removes exactly those (and
 their half-written temporaries), never another file, so a replaced run leaves
 nothing of itself behind. :func:`refuse_replacing` keeps an earlier run from
-being replaced by accident.
+being replaced by accident (:func:`claim`: both, before a writer's first file).
 """
 
 import contextlib
+import json
 import re
 from pathlib import Path
 
-from .._files import leftover_temporaries, refuse_directories
+from .._files import OVERWRITE, kept, leftover_temporaries, refuse_directories
 from ..errors import ParameterError
 from . import h5result, xdmf
 from .parts import PARTS
@@ -64,7 +65,8 @@ def run_files(directory):
 
 
 def clear(directory):
-    """Remove every file of :func:`run_files` (and the run's folders, if that empties them);
+    """Remove every file of :func:`run_files` (and the run's folders, if that empties them),
+    and a system's run's rod folders (:func:`system_rods`) so;
     first refuse a directory where the run writes a file, or a file where it writes a folder."""
     directory = Path(directory)
     refuse_directories([directory / name for name in TOP])
@@ -72,11 +74,30 @@ def clear(directory):
         if (directory / folder).exists() and not (directory / folder).is_dir():
             raise ParameterError(f"{str(directory / folder)!r} is a file, where rodmol writes a folder of its "
                                  "output; remove it or choose another output directory")
+    rods = [folder for folder in system_rods(directory) if (directory / folder).is_dir()]
+    for folder in rods:  # before the index that names them
+        clear(directory / folder)
     for file in run_files(directory):
         file.unlink(missing_ok=True)
-    for folder in NUMBERED:
+    for folder in [*NUMBERED, *rods]:
         with contextlib.suppress(OSError):  # absent, or holds files not rodmol's
             (directory / folder).rmdir()
+
+
+def system_rods(directory):
+    """The folders of the rods of a system's run in ``directory`` (each a run directory, named
+    in its index ``system.h5``; :mod:`rodmol.output.system_files`), else none."""
+    import h5py
+
+    index = Path(directory) / SYSTEM[0]
+    if not index.is_file():
+        return []
+    try:
+        with h5py.File(index, "r") as handle:
+            rods = json.loads(handle.attrs["info"])["rods"]
+    except (OSError, KeyError, ValueError, TypeError):  # not rodmol's, or damaged: its folders unknown
+        return []
+    return [key for key in rods.values() if isinstance(key, str) and Path(key).name == key]
 
 
 def earlier_run(directory):
@@ -101,18 +122,27 @@ def earlier_run(directory):
     return None
 
 
-def refuse_replacing(directory, overwrite, resume_hint, overwrite_hint):
+def refuse_replacing(directory, overwrite, resume_hint=None, overwrite_hint=OVERWRITE):
     """Unless ``overwrite``, raise a ParameterError if ``directory`` holds an earlier run; the
-    message suggests ``resume_hint`` for an unfinished run, ``overwrite_hint`` for any."""
+    message suggests ``resume_hint`` for an unfinished run (None: a writer that cannot resume),
+    ``overwrite_hint`` for any (:func:`rodmol._files.kept`, the rule of every writer)."""
     found = None if overwrite else earlier_run(directory)
     if found is None:
         return
     finished, what = found
-    if finished:
-        raise ParameterError(f"the output directory {str(directory)!r} holds {what}: it is kept unless "
-                             f"you pass {overwrite_hint} to replace it (or choose another output directory)")
+    if finished or resume_hint is None:
+        raise ParameterError(kept(f"the output directory {str(directory)!r} holds {what}", overwrite_hint,
+                                  "output directory"))
     raise ParameterError(f"the output directory {str(directory)!r} holds {what}: continue it with "
                          f"{resume_hint}, or replace it with {overwrite_hint}")
+
+
+def claim(directory, overwrite, resume_hint=None, overwrite_hint=OVERWRITE):
+    """Refuse to replace an earlier run in ``directory`` unless ``overwrite``
+    (:func:`refuse_replacing`), then :func:`clear` it: what every writer of a run directory
+    does before its first file."""
+    refuse_replacing(directory, overwrite, resume_hint, overwrite_hint)
+    clear(directory)
 
 
 def refuse_resuming_nothing(directory, restart):

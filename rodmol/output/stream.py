@@ -86,9 +86,7 @@ class RunWriter:
             for file in run_files.temporaries(self.directory):
                 file.unlink(missing_ok=True)
         else:
-            if not overwrite:
-                run_files.refuse_replacing(self.directory, False, "resume=True", "overwrite=True")
-            run_files.clear(self.directory)
+            run_files.claim(self.directory, overwrite, "resume=True")
 
     # ----------------------------------------------------------------- the sink protocol
 
@@ -386,9 +384,11 @@ def _load_once():
                       {"cables": [{"anchor": 1.0, "offset": [0.0, 0.0]}]}, VIEW)
 
 
-def write_xdmf(result, directory, every=None):
+def write_xdmf(result, directory, every=None, overwrite=False):
     """The ``"xdmf"`` format of :func:`rodmol.write_series`: ``result.h5`` and the XDMF
-    views of a finished Result, replacing an earlier run there; returns the path of ``rod.xdmf``."""
+    views of a finished Result; an earlier run there is kept unless ``overwrite``
+    (:func:`rodmol.output.run_files.claim`); returns the path of ``rod.xdmf``."""
+    run_files.claim(output_directory(directory, "directory"), overwrite)
     return RunWriter(directory, every=every, overwrite=True).write_result(result)
 
 

@@ -26,7 +26,7 @@ run, and the writer keeps no frames of the chunks before (only their times).
 import numpy as np
 
 from .. import _settings, run_sinks
-from .._files import output_directory
+from .._files import kept, output_directory
 from ..errors import ParameterError
 from ..system_result import SystemResult
 from . import h5result, run_files, stream
@@ -232,8 +232,9 @@ class SystemRunWriter:
             return
         info = read_info(self.directory)["info"]
         if info.get("complete", True) and info["success"]:
-            raise ParameterError(f"the output directory {str(self.directory)!r} holds a finished system run: "
-                                 "it is kept unless you pass overwrite=True (`--overwrite`) to replace it")
+            where = f"the output directory {str(self.directory)!r}"
+            raise ParameterError(kept(f"{where} holds a finished system run", "overwrite=True (`--overwrite`)",
+                                      "output directory"))
         raise ParameterError(f"the output directory {str(self.directory)!r} holds an unfinished system run: "
                              "continue it with resume=True (`--resume`), or replace it with overwrite=True")
 
@@ -273,10 +274,11 @@ def _layout(assembly):
     return [[name, part.start, part.stop] for name, part in assembly.parts.items()]
 
 
-def write_system(result, directory, every=None):
-    """Write a finished :class:`SystemResult` into ``directory`` (see :mod:`rodmol.output.system_files`),
-    replacing an earlier run there; returns the path of ``system.h5``.
-    ``every``: show every n-th frame in the views (and the last)."""
+def write_system(result, directory, every=None, overwrite=False):
+    """Write a finished :class:`SystemResult` into ``directory`` (see :mod:`rodmol.output.system_files`);
+    an earlier run there is kept unless ``overwrite`` (:func:`rodmol.output.run_files.claim`);
+    returns the path of ``system.h5``. ``every``: show every n-th frame in the views (and the last)."""
+    run_files.claim(output_directory(directory, "directory"), overwrite)
     return SystemRunWriter(directory, every=every, overwrite=True).write_result(result)
 
 

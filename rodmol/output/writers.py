@@ -11,8 +11,9 @@ A series directory holds
 * ``vtk/``: the frame files (``rod_000012.vtp``, ...).
 
 Each frame file is written completely before the ``.pvd`` that lists it is
-replaced (atomically), so an interrupted run leaves valid series of the frames
-done. Vectors carry the Result's frames: strains, velocities and stresses in
+extended (:mod:`rodmol.output.pvd`: valid at every moment, at a cost
+proportional to the frames added), so an interrupted run leaves valid series
+of the frames done. Vectors carry the Result's frames: strains, velocities and stresses in
 local (material) components; positions, the frame vectors and the external
 load densities (``external force [N/m]``, ``external moment [N m/m]``: point
 and distributed loads and contact, see :mod:`rodmol.loads`) in global ones;
@@ -20,16 +21,16 @@ and distributed loads and contact, see :mod:`rodmol.loads`) in global ones;
 """
 
 import time
-import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
 
-from .._files import refuse_directories, write_atomically
+from .._files import claim, output_directory, refuse_directories
 from ..discretise.rotations import rotate
 from ..errors import ParameterError
 from . import run_files
 from .parts import PARTS, ROD_ARRAYS, cable_points, view_step
+from .pvd import Collection, read_pvd, write_pvd  # noqa: F401  (read_pvd, write_pvd: of the series)
 
 SUBDIRECTORY = run_files.SERIES
 
@@ -147,25 +148,6 @@ def save_vtp(mesh, path):
 MESHES = {"rod": rod_mesh, "cables": cables_mesh, "markers": markers_mesh}
 
 
-def write_pvd(path, entries):
-    """Write a ParaView collection listing ``(time [s], file)`` entries, atomically."""
-    root = ET.Element("VTKFile", type="Collection", version="0.1", byte_order="LittleEndian")
-    collection = ET.SubElement(root, "Collection")
-    for t, file in entries:
-        ET.SubElement(collection, "DataSet", timestep=repr(float(t)), group="", part="0",
-                      file=str(file))
-    ET.indent(root)
-    write_atomically(path, lambda handle: ET.ElementTree(root).write(handle, encoding="utf-8",
-                                                                     xml_declaration=True))
-
-
-def read_pvd(path):
-    """``(time [s], absolute path)`` entries of a ``.pvd`` collection."""
-    root = ET.parse(path).getroot()
-    folder = Path(path).parent
-    return [(float(d.get("timestep")), folder / d.get("file")) for d in root.iter("DataSet")]
-
-
 class SeriesWriter:
     """Writes frames of results into ParaView series, one frame at a time.
 
@@ -173,36 +155,35 @@ class SeriesWriter:
     ----------
     directory : path
         Created if needed. Series files of an earlier run there
-        (``rod.pvd``, ``vtk/rod_*.vtp``, ...) are replaced.
+        (``rod.pvd``, ``vtk/rod_*.vtp``, ...) are kept: refused unless
+        ``overwrite``, which removes them first (:func:`rodmol._files.claim`).
     parts : sequence of str
         Which series to write: any of ``"rod"``, ``"cables"``, ``"markers"``.
     flush_interval : float
-        The collections are rewritten after a frame if this many seconds
-        [s, wall time] have passed since the last rewrite (0: after every
-        frame), and by :meth:`flush` / :meth:`close`. They only ever list
-        frames whose files are complete.
+        The frames written are added to the collections after a frame if
+        this many seconds [s, wall time] have passed since the last time (0:
+        after every frame), and by :meth:`flush` / :meth:`close`; each time
+        costs what it adds (:class:`rodmol.output.pvd.Collection`), so a long
+        series is written in O(frames). The collections only ever list frames
+        whose files are complete, and are valid at every moment.
+    overwrite : bool
+        Replace an earlier series in ``directory`` (False: refuse it).
 
     Every part starts as an empty collection; :meth:`write` adds one frame.
     Use it as a context manager, or call :meth:`close` at the end.
     """
 
-    def __init__(self, directory, parts=PARTS, flush_interval=0.5):
+    def __init__(self, directory, parts=PARTS, flush_interval=0.5, overwrite=False):
         unknown = [p for p in parts if p not in MESHES]
         if unknown:
             raise ParameterError(f"unknown `parts` {unknown}; valid are {list(PARTS)}")
-        self.directory = Path(directory)
+        self.directory = output_directory(directory, "directory")
         self.parts = tuple(parts)
-        (self.directory / SUBDIRECTORY).mkdir(parents=True, exist_ok=True)
-        self.entries = {part: [] for part in self.parts}
+        series = [self.pvd(part) for part in PARTS] + run_files.numbered(self.directory, SUBDIRECTORY)
+        claim(series, overwrite)
+        (self.directory / SUBDIRECTORY).mkdir(exist_ok=True)
         self.frames, self.flush_interval = 0, float(flush_interval)
-        for file in run_files.numbered(self.directory, SUBDIRECTORY):
-            file.unlink()
-        for part in PARTS:
-            pvd = self.pvd(part)
-            if part in self.parts:
-                write_pvd(pvd, [])
-            elif pvd.exists():
-                pvd.unlink()
+        self.collections = {part: Collection(self.pvd(part)) for part in self.parts}
         self.flushed = time.monotonic()
 
     def __enter__(self):
@@ -230,18 +211,21 @@ class SeriesWriter:
             save_vtp(MESHES[part](result, k), self.directory / relative)
             files[part] = relative
         for part in self.parts:
-            self.entries[part].append((float(result.t[k]), files[part].as_posix()))
+            self.collections[part].add(result.t[k], files[part].as_posix())
         self.frames += 1
         if time.monotonic() - self.flushed >= self.flush_interval:
             self.flush()
 
     def flush(self):
-        """Rewrite the collections so they list every frame written so far."""
-        for part in self.parts:
-            write_pvd(self.pvd(part), self.entries[part])
+        """Add every frame written so far to the collections."""
+        for collection in self.collections.values():
+            collection.flush()
         self.flushed = time.monotonic()
 
-    close = flush
+    def close(self):
+        """Flush, and leave the collections without the room kept for more frames."""
+        for collection in self.collections.values():
+            collection.close()
 
 
 def frame_indices(n_frames, every=None):
@@ -251,11 +235,12 @@ def frame_indices(n_frames, every=None):
     return sorted(set(range(0, n_frames, view_step(n_frames, every))) | {n_frames - 1})
 
 
-def write_vtp(result, directory, every=None):
+def write_vtp(result, directory, every=None, overwrite=False):
     """The ``"vtp"`` format of :func:`rodmol.write_series`: ``result.npz`` and the
-    ``.pvd``/``.vtp`` series of a finished Result; returns the path of ``rod.pvd``."""
-    refuse_directories([directory / run_files.NPZ, *(directory / f"{part}.pvd" for part in PARTS)])
-    run_files.clear(directory)  # load_result would read a stale result.h5 first
+    ``.pvd``/``.vtp`` series of a finished Result; an earlier run there is kept unless
+    ``overwrite`` (:func:`rodmol.output.run_files.claim`); returns the path of ``rod.pvd``."""
+    directory = output_directory(directory, "directory")
+    run_files.claim(directory, overwrite)  # all of it: load_result would read a stale result.h5 first
     result.save(directory / run_files.NPZ)
     with SeriesWriter.for_result(result, directory) as writer:
         for k in frame_indices(len(result.t), every):

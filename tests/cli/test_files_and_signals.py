@@ -159,7 +159,7 @@ def test_full_disk_while_saving_keeps_the_previous_result(tmp_path, monkeypatch)
 
     monkeypatch.setattr(np, "savez_compressed", savez_half)
     with pytest.raises(OSError, match="No space left"):
-        first.save(tmp_path / "result.npz")
+        first.save(tmp_path / "result.npz", overwrite=True)
     monkeypatch.undo()
     back = rodmol.load_result(tmp_path / "result.npz")
     assert np.array_equal(back.positions, first.positions)
@@ -175,7 +175,7 @@ def test_concurrent_saves_never_share_a_temporary(tmp_path):
     def save(result):
         try:
             for _ in range(5):
-                result.save(target)
+                result.save(target, overwrite=True)
         except Exception as exc:  # noqa: BLE001 (reported below)
             errors.append(exc)
 

@@ -87,8 +87,11 @@ def test_incremental_writer_lists_only_complete_frames(result, tmp_path):
     writer.write(result, 1)
     assert [t for t, _ in read_pvd(writer.pvd())] == list(result.t[:2])
     assert not list(tmp_path.glob("*.part"))
-    # A new run in the same directory replaces the old series.
-    again = SeriesWriter.for_result(result, tmp_path)
+    # A new writer in the same directory keeps the old series unless asked to replace it.
+    with pytest.raises(rodmol.ParameterError, match="rod.pvd' exists: .* overwrite=True"):
+        SeriesWriter.for_result(result, tmp_path)
+    assert [t for t, _ in read_pvd(writer.pvd())] == list(result.t[:2])
+    again = SeriesWriter.for_result(result, tmp_path, overwrite=True)
     assert read_pvd(again.pvd()) == [] and not list((tmp_path / "vtk").glob("*.vtp"))
 
 
