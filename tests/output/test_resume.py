@@ -203,7 +203,11 @@ def test_signal_then_resume_ends_in_the_uninterrupted_state(uninterrupted, tmp_p
     assert not stopped.success and 30 <= len(stopped.t) < 201
     assert sig == signal.SIGKILL or "interrupted" in stopped.message
     if sig == signal.SIGKILL:  # after Ctrl-C the views are checked by tests/cli/test_cli.py
-        assert assert_valid_views(out) == pytest.approx(stopped.t)
+        # A chunk's views are written before the index that lists it: a kill between the two
+        # leaves the views one whole chunk ahead of the run (every file they name complete).
+        views = assert_valid_views(out)
+        assert views[:len(stopped.t)] == pytest.approx(stopped.t)
+        assert len(views) - len(stopped.t) <= max(h5result.read_index(out / "result.h5")["chunks"].values())
     resumed = subprocess.run([*SIGNALLED_RUN, "--out", str(out), "--resume"], capture_output=True, text=True,
                              timeout=300)
     assert resumed.returncode == 0, resumed.stderr
