@@ -7,9 +7,9 @@ from functools import partial
 from pathlib import Path
 
 from ..errors import ParameterError
-from .paper_errors import as_tracks
 from .parallel import SERIAL, check_picklable, executor
 from .runs import Summary, Task, failed_item, run_indexed
+from .targets import of_spec
 from .variants import apply, as_spec
 
 
@@ -85,9 +85,11 @@ def sweep(spec, overrides, *, client=None, out=None, measured=None, keep=None, p
     :mod:`rodmol.calibrate.parallel` for ``client``).
 
     Every override is checked before any run. With ``out``, each run's result
-    goes to ``out/run_<i>/result.npz`` and the summary to ``out/summary.csv``
-    and ``summary.md``. ``measured`` (marker tracks) adds the averages of
-    eq. (15) to the summary. ``keep`` brings every Result back to this process
+    goes to ``out/run_<i>/result.npz`` (a system's: its run directory
+    ``out/run_<i>/``, with ``overrides.json``) and the summary to
+    ``out/summary.csv`` and ``summary.md``. ``measured`` (marker tracks; a
+    system's name their parts, :mod:`rodmol.calibrate.targets`) adds the
+    averages of eq. (15) to the summary. ``keep`` brings every Result back to this process
     (default: only without ``out``; a Result ships its raw states, about
     size x n_t x 8 bytes). ``progress(done, total)`` is called as runs end.
     Returns a :class:`Sweep`.
@@ -100,8 +102,8 @@ def sweep(spec, overrides, *, client=None, out=None, measured=None, keep=None, p
         apply(spec, o)  # checks every key and value before the first run
     if client != SERIAL:
         check_picklable(spec)
-    tracks = as_tracks(measured) if measured is not None else None
-    task = Task(spec, Summary(tracks), keep=out is None if keep is None else bool(keep))
+    tracks, targets = of_spec(spec, measured) if measured is not None else (None, None)
+    task = Task(spec, Summary(tracks, targets), keep=out is None if keep is None else bool(keep))
     folder = None if out is None else str(Path(out).resolve())
     items = [(i, o, folder) for i, o in enumerate(overrides)]
     with executor(client, n_workers) as ex:
