@@ -100,7 +100,7 @@ class Errors:
 
 @dataclass(frozen=True)
 class Summary:
-    """A sweep run's summary row: end time, steps, final tip position [m]
+    """A sweep run's summary row: end time, steps (if counted), final tip position [m]
     (global) and the tip's largest travel [m] (a system's: of each rod,
     ``<rod>.tip_x`` ..., and each body's origin, ``<body>.x`` ...); with
     ``measured`` (MarkerTracks of the parts ``targets``), the time averages
@@ -110,8 +110,9 @@ class Summary:
     targets: object = None
 
     def __call__(self, result, spec):
-        row = dict(t_end=float(result.t[-1]) if len(result.t) else 0.0,
-                   steps=int(result.stats.get("steps", 0)))
+        row = dict(t_end=float(result.t[-1]) if len(result.t) else 0.0)
+        if "steps" in result.stats:  # (a system's CVODE run does not count them)
+            row["steps"] = int(result.stats["steps"])
         if len(result.t):
             if isinstance(result, Result):
                 row.update(_travel(result.tip, "tip_"))
