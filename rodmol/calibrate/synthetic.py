@@ -12,8 +12,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .dlt import Camera
 from ..model import Model
+from .dlt import Camera
 from .measured import MarkerTracks, PixelTracks, TensionLog
 from .runs import MarkersAt
 from .targets import of_part

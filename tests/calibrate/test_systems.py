@@ -207,3 +207,20 @@ def test_system_file_from_the_command_line(tmp_path, capsys):
     code = main(["identify", str(scenario), "--serial", "--measured", str(tmp_path / "tip.csv"),
                  "--fit", "rods.right.material.E=3e4:5e5", "--out", str(tmp_path / "bad")])
     assert code == 2 and "`--measured` of a system takes PART=CSV" in capsys.readouterr().err
+
+
+def test_a_system_built_in_python_takes_keys_through_spec_of():
+    arm = rodmol.Model(rodmol.Rod(0.2, radius=0.01, material=rodmol.Material(E=1e5, nu=0.5, mu=300.0, rho=1080.0)),
+                       6, cables=[rodmol.Cable((0.005, 0.0), 0.2, name="c", tension=[(0.0, 0.0), (0.1, 0.2)])],
+                       markers=[rodmol.Marker(0.2, name="tip")])
+    head = rodmol.RigidBody(0.2, (1e-4, 1e-4, 1e-4), volume=1e-4)
+    system = rodmol.System({"arm": arm}, {"head": head}, [rodmol.Joint(("head", (0.0, 0.0, 0.0)), ("arm", "base"))],
+                           medium="water")
+    spec = rodmol.calibrate.spec_of(system, 0.2, output_dt=0.05)
+    runs = sweep(spec, [{"rods.arm.tension.c.scale": 2.0, "bodies.head.volume": 2e-4}], client="serial", keep=True)
+    doubled = arm.replace(cables=[rodmol.Cable((0.005, 0.0), 0.2, name="c", tension=[(0.0, 0.0), (0.1, 0.4)])])
+    lighter = rodmol.RigidBody(0.2, (1e-4, 1e-4, 1e-4), volume=2e-4)
+    direct = rodmol.simulate(system.replace(rods={"arm": doubled}, bodies={"head": lighter}), 0.2, output_dt=0.05)
+    assert runs.runs[0].success
+    np.testing.assert_allclose(runs.runs[0].result["arm"].markers, direct["arm"].markers, rtol=0.0, atol=1e-12)
+    np.testing.assert_allclose(runs.runs[0].result["head"].position, direct["head"].position, rtol=0.0, atol=1e-12)
