@@ -88,6 +88,11 @@ class SystemResult:
         self.success, self.message, self.stats, self.error = success, message, stats, error
         self._parts, self._saved = {}, saved
 
+    def __getstate__(self):
+        # The parts built on access are left behind (a rod's replays its body's recorded
+        # base motion, which does not pickle); the receiver builds them again.
+        return {**self.__dict__, "_parts": {}}
+
     @property
     def rods(self):
         """Names of the rods."""

@@ -64,6 +64,8 @@ class System:
     ----------
     rods, bodies : dict
         As given (the rods rebuilt with the system's gravity and medium).
+    given_rods, given_bodies : dict
+        The rods and bodies exactly as given (:meth:`replace` rebuilds from them).
     clamps : dict of str to (body_name or None, point (3,), rotation (3, 3))
         Where each rod's base is held: a body (or None for the world), the
         point [m] and the rotation (base to body frame; to global for the world).
@@ -103,6 +105,7 @@ class System:
         if "world" in rods or "world" in bodies:
             raise ParameterError(f"`{'rods' if 'world' in rods else 'bodies'}`: the name 'world' is reserved (a "
                                  "joint's end \"world\" is the fixed frame)")
+        self.given_rods, self.given_bodies = dict(rods), dict(bodies)  # what replace() rebuilds from
         self.gravity = _checks.vector3("gravity", gravity)
         probe = next(iter(rods.values())).replace(medium=medium)  # Model checks the medium
         self.medium = probe.medium
@@ -116,6 +119,19 @@ class System:
         self.clamps, self.penalty_joints = self._joints()
         self.contacts = _checks.items("contacts", contacts, Contact, "a rodmol.Contact")
         self.rods, self.rod_contacts = attach(self.contacts, self.rods, self.bodies)
+
+    def replace(self, *, rods=None, bodies=None, **changes):
+        """A new System with ``changes`` (``joints``, ``medium``, ``gravity``,
+        ``contacts``) and the parts named in ``rods`` and ``bodies`` ({name:
+        Model} and {name: RigidBody}) in place of those given; the others as given."""
+        for what, new, given in (("rods", rods, self.given_rods), ("bodies", bodies, self.given_bodies)):
+            unknown = sorted(set(new or {}) - set(given))
+            if unknown:
+                raise ParameterError(f"`{what}`: the system has no part named {unknown[0]!r}"
+                                     f"{_checks.did_you_mean(unknown[0], given)} ({what}: {list(given)})")
+        arguments = dict(joints=self.joints, medium=self.medium, gravity=tuple(self.gravity), contacts=self.contacts)
+        return System({**self.given_rods, **(rods or {})}, {**self.given_bodies, **(bodies or {})},
+                      **{**arguments, **changes})
 
     def _joints(self):
         """Each base-jointed rod's clamp: (body or None, point, rotation), and

@@ -3,8 +3,8 @@ marker tracks by bounded least squares, the model runs of each Jacobian
 fanned out in parallel.
 
 The residual is the difference between simulated and measured marker
-positions at every measured sample, divided by the arm length L (so its
-mean norm per marker is eq. (15)'s error). Missing samples are left out. The
+positions at every measured sample, divided by the arm length L (a system's:
+its longest rod's; so its mean norm per marker is eq. (15)'s error). Missing samples are left out. The
 Jacobian is built from forward differences, one model run per parameter,
 all at once on the executor; scipy's trust-region reflective method
 (``least_squares(method="trf")``) keeps the parameters within their bounds.
@@ -16,9 +16,10 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..errors import ParameterError
-from .paper_errors import ErrorTable, as_tracks
+from .paper_errors import ErrorTable
 from .parallel import SERIAL, check_picklable, executor
 from .runs import MarkersAt, Task, failed_run
+from .targets import of_spec
 from .variants import apply, as_spec, current, split_key
 
 #: Residual entry [-] (a fraction of L) for a sample after a run stopped early.
@@ -83,12 +84,16 @@ def identify(spec, measured, parameters, *, start=None, client=None, rel_step=1e
     Parameters
     ----------
     spec : RunSpec or scenario path
-        The run (its tensions should be the measured ones).
+        The run (its tensions should be the measured ones): a rod's or a system's.
     measured : MarkerTracks, CSV path
-        Measured markers [m], global frame, in the order of the model's markers.
+        Measured markers [m], global frame, in the order of the model's
+        markers. A system's: MarkerTracks whose ``part`` names what they see
+        (a rod's markers, ``"<rod>.tip"``, a body), or {part: tracks or CSV
+        path} for several parts of one recording (:mod:`rodmol.calibrate.targets`).
     parameters : {dotted key: (lower, upper)}
         The parameters to fit and their bounds (e.g. ``{"material.E": (50e3,
-        300e3), "medium.Cy,Cz": (0.5, 5)}``; see :mod:`rodmol.calibrate.variants`).
+        300e3), "medium.Cy,Cz": (0.5, 5)}``; a system's ``{"rods.arm1.material.E":
+        ..., "bodies.head.mass": ...}``; see :mod:`rodmol.calibrate.variants`).
     start : {dotted key: value}, optional
         Starting values; default: the values in ``spec``.
     client : see :mod:`rodmol.calibrate.parallel` (None: a LocalCluster)
@@ -104,18 +109,15 @@ def identify(spec, measured, parameters, *, start=None, client=None, rel_step=1e
     Fit
     """
     spec = as_spec(spec)
-    tracks = as_tracks(measured)
+    tracks, targets = of_spec(spec, measured)
     names, lower, upper, x0, scale = _parameters(spec, parameters, start or {})
-    if spec.model.markers and tracks.xyz.shape[1] != len(spec.model.markers):
-        raise ParameterError(f"the measurement has {tracks.xyz.shape[1]} markers, the model "
-                             f"{len(spec.model.markers)}")
     if tracks.t[-1] > spec.t_end + 1e-12:
         spec = apply(spec, {"solver.t_end": float(tracks.t[-1])})
     if client != SERIAL:
         check_picklable(spec)
-    length = spec.model.rod.length
+    length = targets.length
     seen = np.isfinite(tracks.xyz)
-    task = Task(spec, MarkersAt(tracks.t), keep=False)
+    task = Task(spec, MarkersAt(tracks.t, targets), keep=False)
     cache = {}
 
     def overrides(x):

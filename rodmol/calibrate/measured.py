@@ -32,11 +32,16 @@ from ..inputs import Knots
 @dataclass(frozen=True)
 class MarkerTracks:
     """Marker positions ``xyz`` (n_t, n_markers, 3) [m], global frame, at times
-    ``t`` (n_t,) [s]; NaN where a marker was not seen."""
+    ``t`` (n_t,) [s]; NaN where a marker was not seen.
+
+    ``part`` says what they are in a system's run (:mod:`rodmol.calibrate.targets`):
+    the markers of a rod (its name, ``"arm1"``), a rod's tip (``"arm1.tip"``)
+    or a body's origin (its name, ``"head"``); None: a single rod's markers."""
 
     t: np.ndarray
     xyz: np.ndarray
     names: tuple
+    part: str | None = None
 
     def until(self, t_end):
         """The samples at times up to ``t_end`` [s] (inclusive): e.g. to fit
@@ -44,7 +49,7 @@ class MarkerTracks:
         keep = self.t <= t_end
         if not keep.any():
             raise ParameterError(f"`t_end` = {t_end!r} s is before the first sample (t = {self.t[0]} s)")
-        return MarkerTracks(self.t[keep], self.xyz[keep], self.names)
+        return MarkerTracks(self.t[keep], self.xyz[keep], self.names, self.part)
 
 
 @dataclass(frozen=True)
@@ -71,9 +76,24 @@ class TensionLog:
         return {name: Knots(self.t, self.values[:, i], source=f"tension log column {name!r}")
                 for i, name in enumerate(self.names)}
 
-    def overrides(self):
-        """Dotted overrides (``tension.<cable>``) that drive a scenario's cables by this log."""
-        return {f"tension.{name}": value for name, value in self.inputs().items()}
+    def overrides(self, rod=None):
+        """Dotted overrides (``tension.<cable>``) that drive a scenario's cables by
+        this log; a system's rod ``rod``'s (``rods.<rod>.tension.<cable>``)."""
+        prefix = "tension." if rod is None else f"rods.{rod}.tension."
+        return {prefix + name: value for name, value in self.inputs().items()}
+
+
+def as_tracks(measured, times=None):
+    """MarkerTracks from MarkerTracks, a CSV path or an array (n_t, n_markers, 3) with ``times``."""
+    if isinstance(measured, MarkerTracks):
+        return measured
+    if isinstance(measured, (str, os.PathLike)):
+        return read_marker_tracks(measured)
+    xyz = np.asarray(measured, dtype=float)
+    if times is None or xyz.ndim != 3 or xyz.shape[-1] != 3 or len(times) != len(xyz):
+        raise ParameterError("measured markers must be MarkerTracks, a CSV path, or an array "
+                             "(n_t, n_markers, 3) with `times` (n_t,)")
+    return MarkerTracks(np.asarray(times, dtype=float), xyz, tuple(f"marker {i + 1}" for i in range(xyz.shape[1])))
 
 
 def read_tension_log(path, clip_negative=False):
@@ -93,12 +113,13 @@ def read_tension_log(path, clip_negative=False):
     return TensionLog(rows[:, 0], np.maximum(values, 0.0), names)
 
 
-def read_marker_tracks(path):
-    """Read 3-D marker tracks (see the module docstring)."""
+def read_marker_tracks(path, part=None):
+    """Read 3-D marker tracks (see the module docstring); ``part``: what they
+    are in a system's run (see :class:`MarkerTracks`)."""
     header, rows, _ = _read(path, "marker position", group=3, time=True, missing=True)
     n = (rows.shape[1] - 1) // 3
     return MarkerTracks(rows[:, 0], rows[:, 1:].reshape(len(rows), n, 3),
-                        _names(header, n, 3, lambda i: f"marker {i + 1}"))
+                        _names(header, n, 3, lambda i: f"marker {i + 1}"), part)
 
 
 def read_pixel_tracks(path):

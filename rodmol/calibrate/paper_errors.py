@@ -1,7 +1,6 @@
 """The paper's evaluation: the errors of eq. (15) over time, their time
 averages (Table IV, with the actuated phase) and the Fig. 8/9-style plots."""
 
-import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -9,7 +8,8 @@ import numpy as np
 from .._files import claim
 from ..analysis import marker_errors
 from ..errors import ParameterError
-from .measured import MarkerTracks, read_marker_tracks
+from .measured import as_tracks  # noqa: F401 (its home before measured)
+from .targets import of_result
 
 #: A sample belongs to the actuated phase when the total cable tension
 #: exceeds this fraction of its maximum (the paper's "actuated part" of the
@@ -65,34 +65,30 @@ def _average(values):
     return float(np.mean(values)) if len(values) else float("nan")
 
 
-def as_tracks(measured, times=None):
-    """MarkerTracks from MarkerTracks, a CSV path or an array (n_t, n_markers, 3) with ``times``."""
-    if isinstance(measured, MarkerTracks):
-        return measured
-    if isinstance(measured, (str, os.PathLike)):
-        return read_marker_tracks(measured)
-    xyz = np.asarray(measured, dtype=float)
-    if times is None or xyz.ndim != 3 or xyz.shape[-1] != 3 or len(times) != len(xyz):
-        raise ParameterError("measured markers must be MarkerTracks, a CSV path, or an array "
-                             "(n_t, n_markers, 3) with `times` (n_t,)")
-    return MarkerTracks(np.asarray(times, dtype=float), xyz, tuple(f"marker {i + 1}" for i in range(xyz.shape[1])))
-
-
 def paper_errors(result, measured, times=None, actuated=None, name=""):
     """eq. (15) over time and its time averages (Table IV).
 
     Parameters
     ----------
-    result : Result
+    result : Result or SystemResult
         Its markers, in order, are compared with the measured ones; the
-        last is the tip (the paper's order L1, L2, L3, L).
-    measured : MarkerTracks, CSV path or array (n_t, n_markers, 3) [m], global
+        last is the tip (the paper's order L1, L2, L3, L). A system's: the
+        parts the measurement names (:mod:`rodmol.calibrate.targets`),
+        distances in fractions of its longest rod.
+    measured : MarkerTracks, CSV path or array (n_t, n_markers, 3) [m], global;
+        a system's: MarkerTracks with their ``part``, or {part: tracks or path}
     times : (n_t,) [s], for an array ``measured``.
     actuated : None, (t_start, t_end) [s] or a boolean array (n_t,)
         The actuated phase; None: where the run's total cable tension exceeds
         ``ACTUATED_FRACTION`` of its maximum.
     """
-    tracks = as_tracks(measured, times)
+    tracks, targets = of_result(result, measured, times)
+    return errors_of(targets.view(result), tracks, actuated, name)
+
+
+def errors_of(result, tracks, actuated=None, name=""):
+    """:func:`paper_errors` of ``result`` (a Result, or a view of the parts
+    measured: :meth:`rodmol.calibrate.targets.Targets.view`) against ``tracks``."""
     if tracks.xyz.shape[1] != result.markers.shape[1]:
         raise ParameterError(f"the measurement has {tracks.xyz.shape[1]} markers, the run "
                              f"{result.markers.shape[1]}")

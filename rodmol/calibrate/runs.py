@@ -2,6 +2,7 @@
 what it sends back (:class:`Outcome`). Everything here pickles: the task and
 its extractors are module-level classes holding plain data."""
 
+import json
 import time
 import warnings
 from dataclasses import dataclass, field, replace
@@ -9,7 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .paper_errors import paper_errors
+from ..result import Result
+from .paper_errors import errors_of
 from .variants import apply
 
 
@@ -64,49 +66,63 @@ def failed_run(overrides, exc, wall=0.0):
 @dataclass(frozen=True)
 class MarkersAt:
     """The simulated markers (n_t, n_markers, 3) [m] at ``times`` [s], linearly
-    interpolated; NaN after the end of a run that stopped early."""
+    interpolated; NaN after the end of a run that stopped early. ``targets``
+    (:class:`rodmol.calibrate.targets.Targets`) picks them: a system's parts;
+    None, a single rod's markers."""
 
     times: np.ndarray
+    targets: object = None
 
     def __call__(self, result, spec):
-        out = np.full((len(self.times),) + result.markers.shape[1:], np.nan)
+        markers = result.markers if self.targets is None else self.targets.markers(result)
+        out = np.full((len(self.times),) + markers.shape[1:], np.nan)
         if len(result.t) < 2:
             return out
         inside = self.times <= result.t[-1] + 1e-12
-        flat = result.markers.reshape(len(result.t), -1)
+        flat = markers.reshape(len(result.t), -1)
         sim = np.stack([np.interp(self.times[inside], result.t, col) for col in flat.T], axis=1)
-        out[inside] = sim.reshape((int(np.sum(inside)),) + result.markers.shape[1:])
+        out[inside] = sim.reshape((int(np.sum(inside)),) + markers.shape[1:])
         return out
 
 
 @dataclass(frozen=True)
 class Errors:
-    """The errors of eq. (15) against ``measured`` (MarkerTracks), named ``name``."""
+    """The errors of eq. (15) against ``measured`` (MarkerTracks of the parts
+    ``targets``, :func:`rodmol.calibrate.targets.of_spec`), named ``name``."""
 
     measured: object
+    targets: object
     name: str = ""
 
     def __call__(self, result, spec):
-        return paper_errors(result, self.measured, name=self.name)
+        return errors_of(self.targets.view(result), self.measured, name=self.name)
 
 
 @dataclass(frozen=True)
 class Summary:
-    """A sweep run's summary row: end time, steps, final tip position [m]
-    (global) and the tip's largest travel [m]; with ``measured``
-    (MarkerTracks), the time averages of eq. (15)."""
+    """A sweep run's summary row: end time, steps (if counted), final tip position [m]
+    (global) and the tip's largest travel [m] (a system's: of each rod,
+    ``<rod>.tip_x`` ..., and each body's origin, ``<body>.x`` ...); with
+    ``measured`` (MarkerTracks of the parts ``targets``), the time averages
+    of eq. (15)."""
 
     measured: object = None
+    targets: object = None
 
     def __call__(self, result, spec):
-        row = dict(t_end=float(result.t[-1]) if len(result.t) else 0.0,
-                   steps=int(result.stats.get("steps", 0)))
+        row = dict(t_end=float(result.t[-1]) if len(result.t) else 0.0)
+        if "steps" in result.stats:  # (a system's CVODE run does not count them)
+            row["steps"] = int(result.stats["steps"])
         if len(result.t):
-            tip = result.tip
-            row.update(tip_x=float(tip[-1, 0]), tip_y=float(tip[-1, 1]), tip_z=float(tip[-1, 2]),
-                       tip_travel=float(np.max(np.linalg.norm(tip - tip[0], axis=1))))
+            if isinstance(result, Result):
+                row.update(_travel(result.tip, "tip_"))
+            else:
+                for name in spec.model.given_rods:
+                    row.update(_travel(result[name].tip, f"{name}.tip_"))
+                for name in spec.model.given_bodies:
+                    row.update(_travel(result[name].position, f"{name}."))
         if self.measured is not None:
-            errors = paper_errors(result, self.measured)
+            errors = errors_of(self.targets.view(result), self.measured)
             row.update(mean_error=errors.mean_average, tip_error=errors.tip_average)
         return row
 
@@ -118,6 +134,14 @@ RUN_FILES = "run_[0-9][0-9][0-9][0-9]*/result.npz"
 def run_file(out, index):
     """The path of run ``index``'s result in the directory ``out`` (one of :data:`RUN_FILES`)."""
     return Path(out) / f"run_{index:04d}" / "result.npz"
+#: Beside a system's run in a batch's directory (``run_<i>/``, a run directory): its overrides.
+OVERRIDES = "overrides.json"
+
+
+def _travel(path, prefix):
+    """The final position of a path (n_t, 3) [m] and its largest distance from the start, named ``prefix`` + x ..."""
+    return {f"{prefix}x": float(path[-1, 0]), f"{prefix}y": float(path[-1, 1]), f"{prefix}z": float(path[-1, 2]),
+            f"{prefix}travel": float(np.max(np.linalg.norm(path - path[0], axis=1)))}
 
 
 def run_indexed(task, item):
@@ -128,8 +152,16 @@ def run_indexed(task, item):
     if out is not None and outcome.result is not None:
         path = run_file(out, index)
         path.parent.mkdir(parents=True, exist_ok=True)
-        outcome.result.meta.update(overrides={k: repr(v) for k, v in overrides.items()})
-        outcome.result.save(path)  # the sweep claimed its directory (rodmol.calibrate.sweep)
+        given = {k: repr(v) for k, v in overrides.items()}
+        if isinstance(outcome.result, Result):
+            outcome.result.meta.update(overrides=given)
+            outcome.result.save(path)  # the sweep claimed its directory (rodmol.calibrate.sweep)
+        else:  # a system's run directory (rodmol.load_result reads it), its overrides beside it
+            from ..output.formats import write_series
+
+            write_series(outcome.result, path.parent)
+            (path.parent / OVERRIDES).write_text(json.dumps(given, indent=1), encoding="utf-8")
+            path = path.parent
         outcome.value = dict(outcome.value or {}, path=str(path))
         if not task.keep:
             outcome.result = None  # read back from the file when needed

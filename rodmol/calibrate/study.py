@@ -4,13 +4,15 @@ measured markers."""
 
 from dataclasses import dataclass
 
-from .paper_errors import ErrorTable, as_tracks, plot_errors, table
+from .paper_errors import ErrorTable, plot_errors, table
 from .parallel import SERIAL, check_picklable, executor
 from .runs import Errors, Task
+from .targets import of_spec
 from .variants import apply, as_spec
 
 #: Table V's models as overrides of the full one: mu = 0 in eq. (5), no
-#: added mass (By = Bz = 0 in eq. 9), no drag (Cx = Cy = Cz = 0 in eq. 8).
+#: added mass (By = Bz = 0 in eq. 9), no drag (Cx = Cy = Cz = 0 in eq. 8);
+#: in a system, of every rod.
 VARIANTS = {
     "full model": {},
     "linear elastic": {"material.mu": 0.0},
@@ -42,20 +44,22 @@ def worsened_models(spec, measured, *, client=None, variants=None, progress=None
 
     Parameters
     ----------
-    spec : RunSpec or scenario path (its tensions should be the measured ones,
-        e.g. ``apply(spec, log.overrides())`` for a tension log)
-    measured : MarkerTracks or CSV path of the measured markers (global frame)
+    spec : RunSpec or scenario path, a rod's or a system's (its tensions
+        should be the measured ones, e.g. ``apply(spec, log.overrides())`` for
+        a tension log); a system's variants change every rod
+    measured : MarkerTracks or CSV path of the measured markers (global frame);
+        a system's name their parts (:func:`rodmol.calibrate.identify.identify`)
     client : see :mod:`rodmol.calibrate.parallel` (None: a LocalCluster)
     variants : {name: overrides}; default :data:`VARIANTS`.
     """
     spec = as_spec(spec)
-    tracks = as_tracks(measured)
+    tracks, targets = of_spec(spec, measured)
     variants = dict(VARIANTS if variants is None else variants)
     for overrides in variants.values():
         apply(spec, overrides)
     if client != SERIAL:
         check_picklable(spec)
-    tasks = [(name, Task(spec, Errors(tracks, name), keep=True)) for name in variants]
+    tasks = [(name, Task(spec, Errors(tracks, targets, name), keep=True)) for name in variants]
     with executor(client, n_workers) as ex:
         outcomes = ex.map(_run_variant, [(task, variants[name]) for name, task in tasks], progress)
     named = dict(zip(variants, outcomes))

@@ -9,9 +9,10 @@ from pathlib import Path
 
 from .._files import OVERWRITE, claim, output_directory
 from ..errors import ParameterError
-from .paper_errors import as_tracks
+from ..output import run_files
 from .parallel import SERIAL, check_picklable, executor
-from .runs import RUN_FILES, Summary, Task, failed_item, run_indexed
+from .runs import OVERRIDES, RUN_FILES, Summary, Task, failed_item, run_indexed
+from .targets import of_spec
 from .variants import apply, as_spec
 
 
@@ -84,7 +85,8 @@ SUMMARY = ("summary.csv", "summary.md")
 def outputs(directory):
     """The files a sweep wrote in ``directory``: its summary and every run's result."""
     directory = Path(directory)
-    return [directory / name for name in SUMMARY] + sorted(directory.glob(RUN_FILES))
+    systems = sorted(directory.glob(str(Path(RUN_FILES).parent / OVERRIDES)))  # a system's run each
+    return [directory / name for name in SUMMARY] + sorted(directory.glob(RUN_FILES)) + systems
 
 
 def claim_outputs(directory, overwrite, hint=OVERWRITE):
@@ -92,6 +94,8 @@ def claim_outputs(directory, overwrite, hint=OVERWRITE):
     ``overwrite``, which removes them (and the runs' folders they leave empty)."""
     directory = output_directory(directory, "out")
     for path in claim(outputs(directory), overwrite, hint):
+        if path.name == OVERRIDES:  # beside a system's run
+            run_files.clear(path.parent)
         if path.name not in SUMMARY:
             with contextlib.suppress(OSError):  # holds files not the sweep's
                 path.parent.rmdir()
@@ -108,10 +112,12 @@ def sweep(spec, overrides, *, client=None, out=None, measured=None, keep=None, p
     :mod:`rodmol.calibrate.parallel` for ``client``).
 
     Every override is checked before any run. With ``out``, each run's result
-    goes to ``out/run_<i>/result.npz`` and the summary to ``out/summary.csv``
-    and ``summary.md``; an earlier sweep's files there (:func:`outputs`) are kept:
-    refused before any run unless ``overwrite=True``, which removes them all
-    first. ``measured`` (marker tracks) adds the averages of
+    goes to ``out/run_<i>/result.npz`` (a system's: its run directory
+    ``out/run_<i>/``, with ``overrides.json``) and the summary to
+    ``out/summary.csv`` and ``summary.md``; an earlier sweep's files there
+    (:func:`outputs`) are kept: refused before any run unless ``overwrite=True``,
+    which removes them all first. ``measured`` (marker tracks; a system's name
+    their parts, :mod:`rodmol.calibrate.targets`) adds the averages of
     eq. (15) to the summary. ``keep`` brings every Result back to this process
     (default: only without ``out``; a Result ships its raw states, about
     size x n_t x 8 bytes). ``progress(done, total)`` is called as runs end.
@@ -125,12 +131,12 @@ def sweep(spec, overrides, *, client=None, out=None, measured=None, keep=None, p
         apply(spec, o)  # checks every key and value before the first run
     if client != SERIAL:
         check_picklable(spec)
-    tracks = as_tracks(measured) if measured is not None else None
+    tracks, targets = of_spec(spec, measured) if measured is not None else (None, None)
     if out is None and overwrite:
         raise ParameterError("`overwrite=True` needs `out`, the directory of the sweep")
     if out is not None:
         claim_outputs(out, overwrite)
-    task = Task(spec, Summary(tracks), keep=out is None if keep is None else bool(keep))
+    task = Task(spec, Summary(tracks, targets), keep=out is None if keep is None else bool(keep))
     folder = None if out is None else str(Path(out).resolve())
     items = [(i, o, folder) for i, o in enumerate(overrides)]
     with executor(client, n_workers) as ex:

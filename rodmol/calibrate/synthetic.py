@@ -12,8 +12,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model import Model
 from .dlt import Camera
 from .measured import MarkerTracks, PixelTracks, TensionLog
+from .runs import MarkersAt
+from .targets import of_part
 from .variants import apply, as_spec
 
 #: The image size of the paper's cameras [px] (1240 x 1000, 100 frames/s).
@@ -58,7 +61,8 @@ class Experiment:
     """A synthetic recording: the ``truth`` (overrides of the generating run),
     its exact markers ``true_markers``, the true ``cameras``, the measured
     control points (``control_xyz`` and ``control_uv``, one (8, 2) array per
-    camera), the cameras' ``pixels`` (PixelTracks) and the ``tensions`` log."""
+    camera), the cameras' ``pixels`` (PixelTracks) and the ``tensions`` log
+    (a system's: {rod: TensionLog})."""
 
     truth: dict
     true_markers: MarkerTracks
@@ -70,8 +74,13 @@ class Experiment:
 
 
 def synthesize(spec, truth=None, *, noise_px=1.0, control_noise_px=None, tension_noise=0.0, occlusion=0.0,
-               rate=FRAME_RATE, seed=0):
+               rate=FRAME_RATE, seed=0, part=None):
     """Record ``spec`` run with the overrides ``truth`` through :func:`cameras`.
+
+    ``part`` is what a system's recording sees (:mod:`rodmol.calibrate.targets`:
+    a rod's markers ``"arm1"``, its tip ``"arm1.tip"``, a body ``"head"``);
+    its markers' tracks carry it. A system's ``tensions`` are one log per
+    rod, {rod: TensionLog} (``log.overrides(rod)`` drives the rod's cables).
 
     ``noise_px`` is the standard deviation [px] of the markers' image
     coordinates, ``control_noise_px`` that of the control points (default
@@ -83,12 +92,12 @@ def synthesize(spec, truth=None, *, noise_px=1.0, control_noise_px=None, tension
     spec = apply(as_spec(spec), dict(truth or {}))
     rng = np.random.default_rng(seed)
     times = np.arange(int(np.floor(spec.t_end * rate + 1e-9)) + 1) / rate
+    targets = of_part(spec, part)
     result = spec.simulate()
     if not result.success:
         raise RuntimeError(f"the generating run failed: {result.message}")
-    flat = result.markers.reshape(len(result.t), -1)
-    xyz = np.stack([np.interp(times, result.t, c) for c in flat.T], axis=1).reshape(len(times), -1, 3)
-    names = tuple(m.name for m in spec.model.markers)
+    xyz = MarkersAt(times, targets)(result, spec)
+    names = _names(spec.model, targets.parts[0])
     cams = cameras()
     ctrl = control_points()
     control_noise = noise_px / 10.0 if control_noise_px is None else control_noise_px
@@ -98,9 +107,25 @@ def synthesize(spec, truth=None, *, noise_px=1.0, control_noise_px=None, tension
         uv = cam.project(xyz) + noise_px * rng.standard_normal(xyz.shape[:2] + (2,))
         uv[rng.random(xyz.shape[:2]) < occlusion] = np.nan
         pixels.append(PixelTracks(times, uv, names))
-    tension = np.stack([[c.tension_at(t) for c in spec.model.cables] for t in times])
-    used = np.flatnonzero(np.any(tension > 0.0, axis=0))
-    logged = np.maximum(tension[:, used] + tension_noise * rng.standard_normal((len(times), len(used))), 0.0)
-    log = TensionLog(times, logged, tuple(spec.model.cables[i].name for i in used))
-    return Experiment(dict(truth or {}), MarkerTracks(times, xyz, names), cams, ctrl, control_uv,
+    if isinstance(spec.model, Model):
+        log = _log(spec.model.cables, times, tension_noise, rng)
+    else:
+        log = {rod: _log(m.cables, times, tension_noise, rng) for rod, m in spec.model.given_rods.items()}
+    return Experiment(dict(truth or {}), MarkerTracks(times, xyz, names, part), cams, ctrl, control_uv,
                       tuple(pixels), log)
+
+
+def _log(cables, times, noise, rng):
+    """The TensionLog of the ``cables`` that pull, read at ``times`` [s] with sensor ``noise`` [N]."""
+    tension = np.stack([[c.tension_at(t) for c in cables] for t in times]).reshape(len(times), len(cables))
+    used = np.flatnonzero(np.any(tension > 0.0, axis=0))
+    logged = np.maximum(tension[:, used] + noise * rng.standard_normal((len(times), len(used))), 0.0)
+    return TensionLog(times, logged, tuple(cables[i].name for i in used))
+
+
+def _names(model, target):
+    """The names of the markers of ``target`` ((name, kind, count))."""
+    name, kind, _ = target
+    if kind == "markers":
+        return tuple(m.name for m in (model if name is None else model.given_rods[name]).markers)
+    return (name or kind,) if kind == "body" or name is None else (f"{name}.{kind}",)

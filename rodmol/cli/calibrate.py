@@ -4,6 +4,12 @@
     rodmol identify SCENARIO.toml --measured MARKERS.csv --fit material.E=50e3:300e3 ... [--out DIR]
     rodmol sweep    SCENARIO.toml --set material.E=80e3,110e3 --set medium.Cy,Cz=2,3 --out DIR
     rodmol sweep    SCENARIO.toml --runs RUNS.csv --out DIR   # one run per row, dotted keys in the header
+    rodmol identify SYSTEM.toml --measured arm1=MARKERS.csv --tensions arm1=LOG.csv \
+                    --fit rods.arm1.material.E=50e3:300e3 --fit bodies.head.mass=0.1:1
+
+A system's file names the part a measurement sees (``--measured PART=CSV``:
+a rod's markers, ``<rod>.tip`` or a body; repeat for several parts of one
+recording) and the rod a tension log drives (``--tensions ROD=CSV``, repeat).
 
 Every command takes ``--example NAME`` instead of a file, the run options of
 ``rodmol run`` and ``--workers N`` (a LocalCluster of N processes, default
@@ -42,7 +48,8 @@ def add_commands(commands):
     batch.add_argument("--set", action="append", default=[], metavar="KEY=V1,V2,...",
                        help="a grid axis: a dotted key and its values (repeat: every combination)")
     batch.add_argument("--runs", type=Path, metavar="CSV", help="one run per row; dotted keys in the header")
-    batch.add_argument("--measured", type=Path, metavar="CSV", help="add eq. (15) averages to the summary")
+    batch.add_argument("--measured", action="append", metavar="[PART=]CSV",
+                       help="add eq. (15) averages to the summary (a system's: PART=CSV, repeat)")
     batch.set_defaults(command=_sweep)
 
 
@@ -52,10 +59,12 @@ def _common(parser, measured):
     parser.add_argument("scenario", nargs="?", help="TOML scenario file")
     parser.add_argument("--example", choices=EXAMPLES, metavar="NAME", help="one of the paper's tests instead")
     if measured:
-        parser.add_argument("--measured", type=Path, required=True, metavar="CSV",
-                            help="measured marker tracks: t, then x, y, z of each marker [s, m]")
-    parser.add_argument("--tensions", type=Path, metavar="CSV", help="drive the cables by a tension log "
-                                                                      "(t, one column per cable) [s, N]")
+        parser.add_argument("--measured", action="append", required=True, metavar="[PART=]CSV",
+                            help="measured marker tracks: t, then x, y, z of each marker [s, m]; a system's "
+                                 "name the part they see: PART=CSV (a rod, ROD.tip or a body; repeat)")
+    parser.add_argument("--tensions", action="append", metavar="[ROD=]CSV",
+                        help="drive the cables by a tension log (t, one column per cable) [s, N]; a "
+                             "system's name the rod: ROD=CSV (repeat)")
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--workers", type=int, metavar="N", help="LocalCluster worker processes (default: cores)")
     where.add_argument("--scheduler", metavar="ADDRESS", help="a running dask scheduler, e.g. tcp://host:8786")
@@ -71,13 +80,43 @@ def _setup(args):
     from .options import load_spec
 
     spec = load_spec(args)
-    if args.tensions:
-        spec = apply(spec, read_tension_log(args.tensions, clip_negative=True).overrides())
+    for rod, path in _named(spec, args.tensions, "--tensions", "ROD").items():
+        spec = apply(spec, read_tension_log(path, clip_negative=True).overrides(rod))
     if args.workers is not None and args.workers < 1:
         raise ParameterError(f"`--workers` must be >= 1, got {args.workers}")
     client = SERIAL if args.serial else args.scheduler
     say = (lambda *a, **k: None) if args.quiet else print
     return spec, client, say
+
+
+def _named(spec, texts, option, what):
+    """{name or None: Path} of the ``option``'s ``texts``: one plain CSV for a
+    single rod, ``NAME=CSV`` each for a system (``what``: what NAME is)."""
+    from ..systems import System
+
+    texts = list(texts or [])
+    if not isinstance(spec.model, System):
+        if len(texts) > 1:
+            raise ParameterError(f"`{option}` is given {len(texts)} times: a single rod's scenario takes one")
+        return {None: Path(t) for t in texts}
+    named = {}
+    for text in texts:
+        name, sep, path = text.partition("=")
+        if not sep or not name.strip() or not path.strip():
+            raise ParameterError(f"`{option}` of a system takes {what}=CSV (e.g. {option} "
+                                 f"{next(iter(spec.model.given_rods))}=file.csv), got {text!r}")
+        if name.strip() in named:
+            raise ParameterError(f"`{option}` names {name.strip()!r} twice")
+        named[name.strip()] = Path(path.strip())
+    return named
+
+
+def _measured(spec, texts):
+    """The ``--measured`` tracks: a CSV path (a single rod), {part: CSV path} (a system) or None."""
+    named = _named(spec, texts, "--measured", "PART")
+    if not named:
+        return None
+    return named[None] if None in named else named
 
 
 def _progress(args, label):
@@ -105,7 +144,7 @@ def _study(args):
 
     spec, client, say = _setup(args)
     out = _out(args, spec, "study", STUDY)
-    study = worsened_models(spec, args.measured, client=client, n_workers=args.workers,
+    study = worsened_models(spec, _measured(spec, args.measured), client=client, n_workers=args.workers,
                             progress=_progress(args, "rodmol study"))
     (out / "study.md").write_text(study.table() + "\n", encoding="utf-8")
     study.plot(out / "errors.png", f"{spec.name}: errors of eq. (15)", overwrite=args.overwrite)
@@ -125,7 +164,7 @@ def _identify(args):
         bounds[key] = (_value(low, "--fit"), _value(high, "--fit"))
     start = {key: _value(v, "--start") for key, v in (_split(t, "--start") for t in args.start)}
     out = _out(args, spec, "identify", IDENTIFY)
-    fit = identify(spec, args.measured, bounds, start=start, client=client, n_workers=args.workers,
+    fit = identify(spec, _measured(spec, args.measured), bounds, start=start, client=client, n_workers=args.workers,
                    progress=None if args.quiet else lambda i, cost: print(f"rodmol identify: iteration {i}, "
                                                                            f"cost {cost:.6g}", file=sys.stderr))
     (out / "fit.md").write_text(fit.table() + "\n", encoding="utf-8")
@@ -159,8 +198,8 @@ def _sweep(args):
 
     out = _out(args, spec, "sweep")
     claim_outputs(out, args.overwrite, OVERWRITE)
-    runs = sweep(spec, overrides, client=client, out=out, measured=args.measured, n_workers=args.workers,
-                 progress=_progress(args, "rodmol sweep"), overwrite=args.overwrite)
+    runs = sweep(spec, overrides, client=client, out=out, measured=_measured(spec, args.measured),
+                 n_workers=args.workers, progress=_progress(args, "rodmol sweep"), overwrite=args.overwrite)
     say(runs.table())
     say(f"rodmol: wrote {len(runs.runs)} results and {out / 'summary.csv'}")
     return 0 if all(r.success for r in runs.runs) else 1
