@@ -98,7 +98,7 @@ def _named(spec, texts, option, what):
     if not isinstance(spec.model, System):
         if len(texts) > 1:
             raise ParameterError(f"`{option}` is given {len(texts)} times: a single rod's scenario takes one")
-        return {None: Path(t) for t in texts}
+        return {None: Path(texts[0])} if texts else {}
     named = {}
     for text in texts:
         name, sep, path = text.partition("=")
@@ -116,7 +116,7 @@ def _measured(spec, texts):
     named = _named(spec, texts, "--measured", "PART")
     if not named:
         return None
-    return named[None] if None in named else named
+    return named.get(None, named)
 
 
 def _progress(args, label):
