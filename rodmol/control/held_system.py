@@ -122,7 +122,7 @@ def _per_part(arg, given, what, valid, others=()):
         raise ParameterError(f"`{arg}` of a System must be a dict {{{what} name: ...}}, got {_checks.short(given)}")
     for key in given:
         if key not in valid:
-            exists = f" (it is not driven: its motion is not held)" if key in others else _checks.did_you_mean(key, valid)
+            exists = " (it is not driven: its motion is not held)" if key in others else _checks.did_you_mean(key, valid)
             listed = ", ".join(map(repr, valid)) or "none"
             raise ParameterError(f"`{arg}`: unknown {what} {_checks.short(key)}{exists}; valid: {listed}")
     return list(given.items())

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import rodmol
-from rodmol.system_result import SystemResult
 from rodmol.control import Simulator
+from rodmol.system_result import SystemResult
 
 N = 6
 DT = 0.02  # control period [s]
