@@ -11,7 +11,6 @@ import numpy as np
 from . import _checks, _settings
 from .discretise.schemes import DEFAULT_SCHEME, get_scheme
 from .errors import ParameterError
-from .model import Model
 from .run_kinds import KINDS, run_kind
 from .solve import kernels, options
 from .solve.backends import get_backend
@@ -224,12 +223,6 @@ class RunArguments:
     backend_options: dict
     kind: object  # the model's RunKind (rodmol.run_kinds)
     asked_atol: object = None  # after fit: the checked array the call gave, or None for the default
-
-
-def check_model(model):
-    """Refuse anything but a :class:`rodmol.Model` (what the stepping simulator takes)."""
-    if not isinstance(model, Model):
-        raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
 
 
 def check_run(*, initial, t0, scheme, backend, rtol, atol, progress, max_wall_time, backend_options,

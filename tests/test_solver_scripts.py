@@ -177,6 +177,13 @@ def _octopus(out):
     assert octopus == 8 * one + 13  # eight arms and a free head's block
 
 
+def _system_stepping(out):
+    table = {row["method"]: row for row in rows(out / "system_stepping.csv")}
+    stepped = table["Simulator(System), 50 Hz"]
+    assert stepped["head_gap_m"] < 1e-5  # the same equations as the table's simulate, to rtol
+    assert stepped["restarts"] >= 1
+
+
 def _octopus_stats(out):
     table = rows(out / "octopus_stats.csv")  # CVODE's counters read and checked against the run's count
     assert all(row["success"] is True for row in table), table
@@ -293,6 +300,7 @@ SCRIPTS = {
     "quaternion_norm.py": (["quaternion_norm.csv", "quaternion_norm.md"], _quaternion_norm),
     "octopus.py": (["octopus.csv", "octopus.md"], _octopus),
     "octopus_stats.py": (["octopus_stats.csv", "octopus_stats.md"], _octopus_stats),
+    "system_stepping.py": (["system_stepping.csv", "system_stepping.md"], _system_stepping),
     "system_equilibrium_speed.py": (["system_equilibrium_speed.csv", "system_equilibrium_speed.md"],
                                     _system_equilibrium_speed),
     "rest_strains_speed.py": (["rest_strains_speed.csv", "rest_strains_speed.md"], _rest_strains_speed),

@@ -224,16 +224,7 @@ class ReachEnv(gymnasium.Env):
     # ----------------------------------------------------------------- internals
 
     def _tensions(self, action):
-        """The tensions [N] ``action`` asks for, within [0, max_tension] (a NaN: 0 N, an
-        infinite one: the bound it points to), and how many of its entries were not finite."""
-        tensions = _checks.floats(action)
-        n = self.action_space.shape[0]
-        if tensions is None or tensions.shape != (n,):
-            raise ParameterError(f"`action` must be {n} numbers, the tensions [N] of cables 1-{n}, "
-                                 f"got {_checks.short(action)}")
-        non_finite = int(np.count_nonzero(~np.isfinite(tensions)))
-        tensions = np.nan_to_num(tensions, nan=0.0, posinf=self.max_tension, neginf=0.0)
-        return np.clip(tensions, 0.0, self.max_tension), non_finite
+        return action_tensions(action, self.action_space.shape[0], self.max_tension, "cables 1-12")
 
     def _observation(self, state):
         tip_velocity = state.rotations[-1] @ state.v[-1]  # local to global
@@ -252,10 +243,23 @@ class ReachEnv(gymnasium.Env):
         return rng.uniform(*TARGET_REACH) * self.model.rod.length * direction
 
 
-def vector_env(num_envs, **kwargs):
-    """``num_envs`` :class:`ReachEnv` (keyword arguments ``kwargs``), each in its own process
-    (``gymnasium.vector.AsyncVectorEnv``)."""
-    return gymnasium.vector.AsyncVectorEnv([functools.partial(ReachEnv, **kwargs)] * int(num_envs))
+def action_tensions(action, n, max_tension, what):
+    """The ``n`` tensions [N] ``action`` asks for (of ``what``, for the message), within
+    [0, ``max_tension``] (a NaN: 0 N, an infinite one: the bound it points to), and how many
+    of its entries were not finite: the rule of every environment's actions."""
+    tensions = _checks.floats(action)
+    if tensions is None or tensions.shape != (n,):
+        raise ParameterError(f"`action` must be {n} numbers, the tensions [N] of {what}, "
+                             f"got {_checks.short(action)}")
+    non_finite = int(np.count_nonzero(~np.isfinite(tensions)))
+    tensions = np.nan_to_num(tensions, nan=0.0, posinf=max_tension, neginf=0.0)
+    return np.clip(tensions, 0.0, max_tension), non_finite
+
+
+def vector_env(num_envs, env=ReachEnv, **kwargs):
+    """``num_envs`` environments ``env`` (default :class:`ReachEnv`; keyword arguments
+    ``kwargs``), each in its own process (``gymnasium.vector.AsyncVectorEnv``)."""
+    return gymnasium.vector.AsyncVectorEnv([functools.partial(env, **kwargs)] * int(num_envs))
 
 
 def _claim_record(record, overwrite):

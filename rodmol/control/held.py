@@ -23,6 +23,8 @@ from ..loads import PointForce, PointMoment
 
 #: The point loads whose vector a simulator holds.
 HELD_LOADS = (PointForce, PointMoment)
+#: Components of each kind of held input (a cable's one number, a vector's three).
+WIDTHS = {"tension": 1, "displacement": 1, "load": 3, "velocity": 3, "angular_velocity": 3}
 
 
 class Held(TimeInput):
@@ -127,21 +129,34 @@ class HeldInputs:
     def constant(self, row):
         """The model holding ``row`` for all time (constant inputs), as ``rodmol.linearize``
         and ``rodmol.equilibrium`` take it."""
-        return self.model_with([Constant(np.atleast_1d(value), 3 if kind == "load" else 1)
+        return self.model_with([Constant(np.atleast_1d(value), WIDTHS[kind])
                                 for kind, value in zip(self.kinds, row)])
 
     def live(self, row):
         """(model, its :class:`Held` inputs) holding ``row``."""
-        held = [Held(value, 3 if kind == "load" else 1) for kind, value in zip(self.kinds, row)]
+        held = [Held(value, WIDTHS[kind]) for kind, value in zip(self.kinds, row)]
         return self.model_with(held), held
 
     def recorded(self, times, rows):
         """The model whose inputs are the record ``rows`` at frame ``times`` (:class:`ZeroOrderHold`)."""
-        return self.model_with([ZeroOrderHold(times, rows, j, 3 if kind == "load" else 1)
+        return self.model_with([ZeroOrderHold(times, rows, j, WIDTHS[kind])
                                 for j, kind in enumerate(self.kinds)])
 
-    def command(self, row, tensions=None, displacements=None, loads=None):
-        """``row`` with the commanded values put in, checked (names, indices, values)."""
+    def by_name(self, row):
+        """The held values of ``row`` by name: ``{"tensions": {cable: N}, "displacements":
+        {cable: m}, "loads": {load: (3,)}}``."""
+        out = {"tensions": {}, "displacements": {}, "loads": {}}
+        for kind, i, value in zip(self.kinds, self.targets, row):
+            pool = self.model.loads if kind == "load" else self.model.cables
+            out[f"{kind}s"][pool[i].name] = value.copy() if kind == "load" else value
+        return out
+
+    def command(self, row, tensions=None, displacements=None, loads=None, motions=None):
+        """``row`` with the commanded values put in, checked (names, indices, values);
+        ``motions`` (a System's driven bodies') are refused: a Model has none."""
+        if motions is not None:
+            raise ParameterError(f"`motions` {_checks.short(motions)}: they drive the driven bodies of a "
+                                 "rodmol.System; a Model has none")
         row = list(row)
         for what, given in (("tension", tensions), ("displacement", displacements), ("load", loads)):
             if given is None:

@@ -8,7 +8,8 @@ gymnasium's own import costs about 20-40 ms after rodmol's (numpy is shared).
 """
 
 #: Each environment's id -> its entry point (gymnasium's ``"module:Class"``).
-ENVIRONMENTS = {"rodmol/Reach-v0": "rodmol.control.envs:ReachEnv"}
+ENVIRONMENTS = {"rodmol/Reach-v0": "rodmol.control.envs:ReachEnv",
+                "rodmol/OctopusCrawl-v0": "rodmol.control.crawl:OctopusCrawlEnv"}
 
 
 def register_environments():

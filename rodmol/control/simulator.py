@@ -12,12 +12,13 @@ import numpy as np
 
 from .. import _checks
 from ..discretise.schemes import DEFAULT_SCHEME
-from ..discretise.system import SemiDiscrete
 from ..errors import IntegrationError, ParameterError
-from ..result import from_states
-from ..simulate import _sink, check_model, check_run, fit, prepare_run
+from ..model import Model
+from ..run_kinds import run_kind
+from ..simulate import _sink, check_run, fit, prepare_run
 from ..solve.stepping import Stepper
 from .held import HeldInputs
+from .held_system import SystemHeld
 
 
 @dataclass(frozen=True, eq=False)
@@ -36,7 +37,8 @@ class Snapshot:
 
 
 class Simulator:
-    """A model advanced by :meth:`step`, with its inputs held over each step.
+    """A model (one rod, or a System of rods and bodies) advanced by :meth:`step`, with its
+    inputs held over each step.
 
     The system, the compiled kernels, the checks and the integrator (CVODE)
     are built once; every :meth:`step` integrates over ``dt`` with the held
@@ -52,12 +54,21 @@ class Simulator:
     :func:`rodmol.simulate` (functions of time, not held). Feedback tensions
     ``T(t, state)`` are refused: the controller is the caller.
 
+    A :class:`rodmol.System`: each rod's inputs are held as a single rod's, and
+    each driven body's velocity and angular velocity (body frame, as its
+    :class:`rodmol.BaseMotion` gives them at ``t0``); :meth:`step` takes them
+    by part (``tensions={"arm1": {"cable 2": 1.5}}``, ``motions={"platform":
+    {"velocity": (3,)}}``), :attr:`state` is a view per part
+    (``sim.state["arm1"].tip``, ``sim.state["head"].position``) and
+    :attr:`result` a :class:`rodmol.SystemResult`.
+
     Parameters
     ----------
-    model : Model
+    model : Model or System
     initial, scheme, rtol, atol, t0 :
         As for :func:`rodmol.simulate` (``initial="equilibrium"`` is the rest
-        state under the inputs held at ``t0``).
+        state under the inputs held at ``t0``; None is simulate's default: a
+        rod's equilibrium, a System's "straight", at rest).
     progress : bool or callable, optional
         True announces the preparation (compiled kernels, initial
         equilibrium) on standard error; a callable ``progress(t, t_step_end)``
@@ -66,8 +77,8 @@ class Simulator:
         Wall-time budget [s] of each step.
     out : path or sink, optional
         Stream the frames (one at the end of each step) into this directory
-        (``result.h5`` and ParaView's ``rod.xdmf``, see ``docs/paraview.md``)
-        as :func:`rodmol.simulate` does; call :meth:`close` (or use the
+        (``result.h5`` and ParaView's ``rod.xdmf``, see ``docs/paraview.md``;
+        a System's ``system.h5`` and a folder per rod) as :func:`rodmol.simulate` does; call :meth:`close` (or use the
         simulator in a ``with`` block) to finish the files. A streamed
         simulator cannot be :meth:`reset` to an earlier time.
     overwrite : bool
@@ -80,20 +91,21 @@ class Simulator:
         ``max_step``, ``max_nonlin_iters``), checked as by simulate.
     """
 
-    def __init__(self, model, initial="equilibrium", *, scheme=DEFAULT_SCHEME, rtol=None, atol=None,
+    def __init__(self, model, initial=None, *, scheme=DEFAULT_SCHEME, rtol=None, atol=None,
                  t0=None, progress=None, max_wall_time=None, out=None, overwrite=False, backend="cvode",
                  **backend_options):
         if backend != "cvode":
             raise ParameterError(f"`backend` {_checks.short(backend)}: the Simulator keeps CVODE alive "
                                  "between steps and has no other backend")
-        check_model(model)
+        kind = run_kind(model)
         args = check_run(initial=initial, t0=t0, scheme=scheme, backend=backend, rtol=rtol, atol=atol,
-                         progress=progress, max_wall_time=max_wall_time, backend_options=backend_options)
-        self._inputs = HeldInputs.of(model)
+                         progress=progress, max_wall_time=max_wall_time, backend_options=backend_options,
+                         kind=kind)
+        self._inputs = (HeldInputs if isinstance(model, Model) else SystemHeld).of(model)
         self._row = self._inputs.initial_row(args.t0)
         live, self._held = self._inputs.live(self._row)
-        self.max_wall_time, self._scheme = args.max_wall_time, args.scheme
-        self._system = SemiDiscrete(live, args.scheme)
+        self.max_wall_time, self._scheme, self._kind = args.max_wall_time, args.scheme, kind
+        self._system = kind.discretise(live, args.scheme)
         args = fit(args, self._system)
         self._sink = _sink(args.kind, out, False, overwrite)  # after every check: `overwrite` clears the earlier run
         announce = args.progress
@@ -115,7 +127,7 @@ class Simulator:
         if self._sink is not None:
             # The writer derives each chunk's arrays from the record so far (only ever appended to).
             record = self._inputs.recorded(self._times, self._rows)
-            self._sink.begin(SemiDiscrete(record, self._scheme), None)  # no planned end
+            self._sink.begin(kind.discretise(record, self._scheme), None)  # no planned end
 
     # ----------------------------------------------------------------- stepping
 
@@ -132,19 +144,16 @@ class Simulator:
     @property
     def state(self):
         """The current state as a :class:`rodmol.StateView` (tip, positions, markers,
-        cable lengths, strains, velocities)."""
+        cable lengths, strains, velocities); a System's by part
+        (:class:`rodmol.discretise.system_state_view.SystemStateView`)."""
         return self._system.state_view(self.t, self._stepper.y)
 
     @property
     def held(self):
         """The held inputs by name: ``{"tensions": {cable: N}, "displacements": {cable: m},
-        "loads": {load: (3,)}}``."""
-        out = {"tensions": {}, "displacements": {}, "loads": {}}
-        model = self._inputs.model
-        for kind, i, value in zip(self._inputs.kinds, self._inputs.targets, self._row):
-            pool = model.loads if kind == "load" else model.cables
-            out[f"{kind}s"][pool[i].name] = value.copy() if kind == "load" else value
-        return out
+        "loads": {load: (3,)}}``; a System's by part, ``{rod: that, driven body:
+        {"velocity": (3,), "angular_velocity": (3,)}}``."""
+        return self._inputs.by_name(self._row)
 
     def held_model(self):
         """The model with the inputs held now as constants (a tension schedule of the model
@@ -152,13 +161,16 @@ class Simulator:
         model-based controller linearises about, ``rodmol.linearize(sim.held_model(), sim.y, sim.t)``."""
         return self._inputs.constant(self._row)
 
-    def step(self, dt, tensions=None, *, displacements=None, loads=None):
+    def step(self, dt, tensions=None, *, displacements=None, loads=None, motions=None):
         """Advance by ``dt`` [s] with the inputs held; returns the new :attr:`state`.
 
         ``tensions`` [N]: a dict {cable name or index: tension}, or one number
         per cable; ``displacements`` [m]: a dict {cable: actuator position} for
         displacement-controlled cables; ``loads``: a dict {point load name or
         index: (3,) vector} [N or N m]. Inputs not given keep their value.
+        A System's by rod, each as a rod's: ``tensions={"arm1": {"cable 2": 1.5}}``;
+        ``motions`` sets its driven bodies' velocities, ``{body: {"velocity": (3,)
+        [m/s], "angular_velocity": (3,) [rad/s]}}``, body frame.
 
         Raises
         ------
@@ -172,7 +184,7 @@ class Simulator:
         if self._closed:
             raise ParameterError("this Simulator's output is closed: make a new one to go on")
         dt = _checks.positive("dt", dt, " s")
-        row = self._inputs.command(self._row, tensions, displacements, loads)
+        row = self._inputs.command(self._row, tensions, displacements, loads, motions)
         t_start = self.t
         t_end = t_start + dt
         if not t_end > t_start:
@@ -241,8 +253,8 @@ class Simulator:
 
     @property
     def result(self):
-        """A :class:`rodmol.Result` of the frames stepped (the initial one and one per step),
-        as :func:`rodmol.simulate` returns; a frame's tensions, actuator positions and loads
+        """A :class:`rodmol.Result` (a System's: a :class:`rodmol.SystemResult`) of the frames
+        stepped (the initial one and one per step), as :func:`rodmol.simulate` returns; a frame's tensions, actuator positions and loads
         are the inputs held over the step that ended there. Streaming, the Result reads
         the files (the frames not yet written are stored first)."""
         if self._sink is not None:
@@ -250,9 +262,9 @@ class Simulator:
             self._sink.flush()
             return self._sink.result()
         times, rows = list(self._times), list(self._rows)
-        system = SemiDiscrete(self._inputs.recorded(times, rows), self._scheme)
-        return from_states(system, np.array(times), np.array(self._states), True,
-                           f"stepped to t = {self.t:.6g} s", self.stats)
+        system = self._kind.discretise(self._inputs.recorded(times, rows), self._scheme)
+        return self._kind.result(system, np.array(times), np.array(self._states), True,
+                                 f"stepped to t = {self.t:.6g} s", self.stats)
 
     def _stream(self, force=False):
         """Hand the frames not yet stored to the sink, a chunk at a time (all if ``force``)."""

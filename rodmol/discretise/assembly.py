@@ -72,6 +72,7 @@ from .rotations import from_matrix, matrices
 from .state_checks import LIMITS, OK, describe, least_stretch, scan_parts
 from .stencil import WORK_TOTAL
 from .system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE, SemiDiscrete, field_scales
+from .system_state_view import SystemStateView
 
 
 class Assembly:
@@ -231,6 +232,15 @@ class Assembly:
         for part in self.bodies.values():
             q = y[:, part.fields["Q"]]
             y[:, part.fields["Q"]] = q / np.linalg.norm(q, axis=-1, keepdims=True)
+
+    def state_view(self, t, y):
+        """The state ``y`` at ``t`` [s] by part (:class:`SystemStateView`)."""
+        return SystemStateView(self, t, y)
+
+    def read_held(self, t):
+        """Read every rod's held tensions at ``t`` [s] (:meth:`SemiDiscrete.read_held`)."""
+        for sd in self.rods.values():
+            sd.read_held(t)
 
     # ------------------------------------------------------------------ evaluation
 

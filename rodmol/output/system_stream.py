@@ -91,13 +91,13 @@ class SystemRunWriter:
         self._clear()
         assembly = getattr(system, "assembly", system)
         self.assembly = assembly
-        if self.t_out is None:
+        if self.t_out is None and t_out is not None:  # None: no planned end (a stepping simulator's run)
             self.t_out = np.asarray(t_out, dtype=float)
         keys = _keys(assembly.rods, "rod")
         if self._resumed is not None:
             self.check(assembly)
         self._plan(SystemResult(assembly, np.empty(0), np.empty((0, assembly.size)), True, "", {}),
-                   len(self.t_out))
+                   0 if self.t_out is None else len(self.t_out))
         if self._resumed is not None:
             # First list only the chunks kept: the rods roll back to them next, and a new chunk may
             # replace a dropped one of the same name.
@@ -224,7 +224,8 @@ class SystemRunWriter:
             info["parts"] = layout
         if self.forced:
             info["forced"] = self.forced
-        write_index(self.directory, self.t_out, self.t, dict(self.chunks), info, surfaces, bodies)
+        planned = self.t if self.t_out is None else self.t_out  # no planned end: the times reached
+        write_index(self.directory, planned, self.t, dict(self.chunks), info, surfaces, bodies)
 
     def _refuse_replacing(self, overwrite):
         if overwrite or not (self.directory / INDEX).is_file():

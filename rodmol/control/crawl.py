@@ -1,0 +1,159 @@
+"""``rodmol/OctopusCrawl-v0``: the octopus of ``examples/octopus.py`` crawling on the
+sea floor (``pip install rodmol[rl]``). ``import rodmol`` registers it with gymnasium
+(:mod:`rodmol.control.registration`), whose ``make`` imports this module::
+
+    import gymnasium
+    import rodmol
+
+    env = gymnasium.make("rodmol/OctopusCrawl-v0")
+    envs = rodmol.control.crawl.vector_env(4)  # in parallel processes (after importing it)
+"""
+
+import functools
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+
+from .. import _checks
+from ..errors import IntegrationError, ParameterError
+from . import envs
+from .envs import ResetNeeded, action_tensions
+from .octopus import ARMS, octopus
+from .simulator import Simulator
+
+CRAWL_ID = "rodmol/OctopusCrawl-v0"  # registered by rodmol.control.registration
+#: The cables each arm's actions pull: 2 (below the centreline: the arm curls down onto the
+#: floor) and 4 (above it: the arm curls up), Table II's numbering.
+CABLES = (2, 4)
+ARM_NAMES = tuple(f"arm{i + 1}" for i in range(ARMS))
+#: Observation size: the head's position (3), quaternion (4), velocity and angular velocity
+#: (3 + 3, global frame) and each arm's tip relative to the head (3 per arm).
+OBSERVATION_SIZE = 13 + 3 * ARMS
+
+#: Each option of :class:`OctopusCrawlEnv` -> its check ``(name, value)`` -> the value, naming
+#: the option and the value it refuses; all run at construction, before any work.
+OPTIONS = {
+    "n_elements": lambda name, value: _checks.integer_at_least(name, value, 2),
+    "period": lambda name, value: _checks.positive(name, value, " s"),
+    "episode_steps": lambda name, value: _checks.integer_at_least(name, value, 1),
+    "max_tension": envs._max_tension,
+    "effort_weight": lambda name, value: _checks.non_negative(name, value, " m/(s N^2)"),
+    "settle": lambda name, value: _checks.positive(name, value, " s"),
+}
+
+
+@functools.lru_cache(maxsize=4)
+def settled(n_elements, settle):
+    """The octopus's state (N = ``n_elements`` per arm) after ``settle`` seconds on the floor
+    from rest without tension, computed once per process (each environment starts from it)."""
+    sim = Simulator(octopus(n_elements))
+    sim.step(settle)
+    return sim.y
+
+
+class OctopusCrawlEnv(gymnasium.Env):
+    """Crawl forward (+x) with the octopus of ``examples/octopus.py``, pulling two cables of each arm.
+
+    Every ``period`` seconds the agent sets 16 tensions (held over the period,
+    :class:`rodmol.Simulator` of the System). Every episode starts from the same state, the
+    octopus settled on the floor (``settle`` seconds from rest, computed once per process
+    and restored bitwise at each reset), and lasts ``episode_steps`` periods (truncated
+    then); it ends early (terminated) only if a step fails (``info["failure"]``). The
+    environment draws nothing at random: the same actions give the same observations.
+
+    Spaces
+    ------
+    action : Box(0, max_tension, (16,)) [N]: arm 1's cables 2 and 4, arm 2's, ... arm 8's
+        (arm k leaves the head at 45 (k - 1) degrees from +x; cable 2 curls the arm down,
+        cable 4 up; Table II's numbering).
+    observation : Box (37,) float32, global frame [m, m/s, rad/s]: the head's position (3),
+        quaternion (4, scalar first), velocity and angular velocity (3 + 3), and each arm's
+        tip relative to the head's position (8 x 3).
+
+    Reward
+    ------
+    ``dx / period - effort_weight * |T|^2`` per step [m/s]: the head's forward speed over
+    the period (dx its displacement along +x) less the effort, T the action [N].
+
+    Actions outside [0, ``max_tension``], NaN or infinite ones are handled as by
+    ``rodmol/Reach-v0`` (clipped; ``info["non_finite"]`` counts them); ``step`` before the
+    first ``reset`` or after the episode ended raises :class:`ResetNeeded`.
+
+    Parameters
+    ----------
+    n_elements : int
+        Elements N of each arm (6: faster than real time on one core).
+    period : float
+        Control period [s], > 0.
+    episode_steps : int
+        Periods per episode, >= 1 (60 x 0.05 s: 3 s).
+    max_tension : float
+        Upper bound of each tension [N], > 0 and finite.
+    effort_weight : float
+        Weight of the effort in the reward [m/(s N^2)], >= 0.
+    settle : float
+        Time [s] the octopus settles on the floor before the episodes' start state.
+    """
+
+    metadata = {"render_modes": []}
+
+    def __init__(self, n_elements=6, period=0.05, episode_steps=60, max_tension=2.0, effort_weight=1e-3,
+                 settle=1.0):
+        given = dict(n_elements=n_elements, period=period, episode_steps=episode_steps, max_tension=max_tension,
+                     effort_weight=effort_weight, settle=settle)
+        options = {name: check(name, given[name]) for name, check in OPTIONS.items()}
+        self.n_elements, self.period = options["n_elements"], options["period"]
+        self.episode_steps, self.max_tension = options["episode_steps"], options["max_tension"]
+        self.effort_weight, self.settle = options["effort_weight"], options["settle"]
+        self.system = octopus(self.n_elements)
+        self.sim = Simulator(self.system, initial=settled(self.n_elements, self.settle))
+        self._start = self.sim.copy()
+        self.action_space = spaces.Box(0.0, self.max_tension, (ARMS * len(CABLES),), np.float32)
+        self.observation_space = spaces.Box(-np.inf, np.inf, (OBSERVATION_SIZE,), np.float32)
+        self._steps, self._ended = 0, "before the first reset()"
+
+    def reset(self, *, seed=None, options=None):
+        if not (options is None or (isinstance(options, dict) and not options)):  # none is read: not ignored
+            raise ParameterError(f"`options` {_checks.short(options)}: {type(self).__name__}.reset "
+                                 "takes none (None or {})")
+        super().reset(seed=seed)
+        state = self.sim.reset(self._start)
+        self._steps, self._ended = 0, None
+        return self._observation(state), {}
+
+    def step(self, action):
+        if self._ended is not None:
+            raise ResetNeeded(f"step() {self._ended}: call reset() to start an episode")
+        tensions, non_finite = action_tensions(action, self.action_space.shape[0], self.max_tension,
+                                               "cables 2 and 4 of arms 1-8")
+        commands = {arm: {f"cable {c}": float(tensions[len(CABLES) * i + j]) for j, c in enumerate(CABLES)}
+                    for i, arm in enumerate(ARM_NAMES)}
+        self._steps += 1
+        info, terminated = {"non_finite": non_finite}, False
+        x_before = float(self.sim.state["head"].position[0])
+        try:
+            self.sim.step(self.period, commands)
+        except IntegrationError as exc:
+            terminated, info["failure"] = True, str(exc)
+        state = self.sim.state
+        speed = (float(state["head"].position[0]) - x_before) / self.period
+        reward = speed - self.effort_weight * float(tensions @ tensions)
+        info["speed"] = speed
+        truncated = self._steps >= self.episode_steps and not terminated
+        if terminated or truncated:
+            self._ended = (f"after the episode was {'terminated' if terminated else 'truncated'} "
+                           f"at step {self._steps}")
+        return self._observation(state), reward, terminated, truncated, info
+
+    def _observation(self, state):
+        head = state["head"]
+        rotation = head.rotation
+        tips = [state[arm].tip - head.position for arm in ARM_NAMES]
+        return np.concatenate([head.position, head.quaternion, rotation @ head.velocity,
+                               rotation @ head.angular_velocity, *tips]).astype(np.float32)
+
+
+def vector_env(num_envs, **kwargs):
+    """``num_envs`` :class:`OctopusCrawlEnv` (keyword arguments ``kwargs``), each in its own process."""
+    return envs.vector_env(num_envs, env=OctopusCrawlEnv, **kwargs)

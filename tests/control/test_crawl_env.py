@@ -1,0 +1,106 @@
+"""The gymnasium environment rodmol/OctopusCrawl-v0: gymnasium's checks, determinism, reward,
+the option checks, vectorised form."""
+
+import warnings
+
+import numpy as np
+import pytest
+
+gymnasium = pytest.importorskip("gymnasium")
+crawl = pytest.importorskip("rodmol.control.crawl")
+
+import rodmol  # noqa: E402, F401 (registers the environments)
+from rodmol.errors import ParameterError  # noqa: E402
+
+SMALL = dict(n_elements=3, settle=0.05, episode_steps=3)  # the tests check the interface, not the physics
+
+
+@pytest.fixture(scope="module")
+def env():
+    made = gymnasium.make("rodmol/OctopusCrawl-v0", **SMALL)
+    yield made
+    made.close()
+
+
+def test_passes_gymnasiums_checker(env):
+    from gymnasium.utils.env_checker import check_env
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)  # its advice (bounded boxes) is not an error
+        check_env(env.unwrapped, skip_render_check=True)
+
+
+def rollout(env, seed, steps=3):
+    obs, _ = env.reset(seed=seed)
+    actions = np.random.default_rng(seed).uniform(0.0, 1.0, (steps, 16)).astype(np.float32)
+    trace = [obs]
+    for action in actions:
+        obs, reward, terminated, truncated, info = env.step(action)
+        trace.append(np.append(obs, [reward, terminated, truncated]))
+    return trace, actions, info
+
+
+def test_same_seed_same_trajectory_and_reward_as_documented(env):
+    first, actions, info = rollout(env, seed=3)
+    rollout(env, seed=4)
+    again, _, _ = rollout(env, seed=3)
+    for a, b in zip(first, again):
+        np.testing.assert_array_equal(a, b)
+    assert first[-1][-1] == 1.0  # truncated after episode_steps
+    sim = env.unwrapped.sim
+    head = sim.result["head"].position
+    effort = env.unwrapped.effort_weight * float(actions[-1].astype(float) @ actions[-1].astype(float))
+    speed = (head[-1, 0] - head[-2, 0]) / env.unwrapped.period
+    assert info["speed"] == pytest.approx(speed, rel=1e-12)
+    assert first[-1][crawl.OBSERVATION_SIZE] == pytest.approx(speed - effort, rel=1e-6)
+    # the observation: the head's pose, then the tips relative to it
+    np.testing.assert_allclose(first[-1][:3], head[-1], rtol=1e-6)
+    tip = sim.state["arm3"].tip - sim.state["head"].position
+    np.testing.assert_allclose(first[-1][13 + 6:13 + 9], tip, rtol=1e-5, atol=1e-7)
+    # the actions reached the cables: arm 1's cables 2 and 4 held as the last action asked
+    held = sim.held["arm1"]["tensions"]
+    assert (held["cable 2"], held["cable 4"]) == pytest.approx(tuple(actions[-1][:2].astype(float)))
+
+
+@pytest.mark.parametrize("option, value", [
+    ("n_elements", 1), ("n_elements", 2.5), ("period", 0.0), ("period", float("nan")), ("episode_steps", 0),
+    ("max_tension", -1.0), ("max_tension", float("inf")), ("effort_weight", -1.0), ("settle", 0.0),
+])
+def test_every_option_is_checked_at_construction_naming_it(monkeypatch, option, value):
+    def no_work(*args, **kwargs):
+        raise AssertionError("the octopus was built before the options were checked")
+
+    monkeypatch.setattr(crawl, "octopus", no_work)
+    with pytest.raises(ParameterError, match=f"`{option}`") as info:
+        crawl.OctopusCrawlEnv(**{option: value})
+    assert repr(value) in str(info.value) or str(value) in str(info.value)
+
+
+def test_non_finite_actions_and_steps_after_the_end(env):
+    env.reset(seed=0)
+    action = np.full(16, np.nan, dtype=np.float32)
+    action[0] = np.inf
+    _, _, _, _, info = env.step(action)
+    assert info["non_finite"] == 16
+    held = env.unwrapped.sim.held["arm1"]["tensions"]
+    assert held["cable 2"] == env.unwrapped.max_tension and held["cable 4"] == 0.0
+    with pytest.raises(ParameterError, match="`action` must be 16 numbers"):
+        env.step(np.zeros(12, dtype=np.float32))
+    env.step(np.zeros(16, dtype=np.float32))
+    env.step(np.zeros(16, dtype=np.float32))
+    with pytest.raises(crawl.ResetNeeded, match="truncated at step 3"):
+        env.step(np.zeros(16, dtype=np.float32))
+
+
+@pytest.mark.subprocess
+def test_vectorised_in_parallel_processes():
+    vec = crawl.vector_env(2, **SMALL)
+    try:
+        obs, _ = vec.reset(seed=[0, 1])
+        assert obs.shape == (2, crawl.OBSERVATION_SIZE)
+        np.testing.assert_array_equal(obs[0], obs[1])  # one settled start
+        for _ in range(3):
+            obs, reward, terminated, truncated, _ = vec.step(np.full((2, 16), 0.5, dtype=np.float32))
+        assert np.all(np.isfinite(reward)) and truncated.all()
+    finally:
+        vec.close()
