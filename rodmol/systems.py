@@ -116,6 +116,8 @@ class System:
         self.clamps, self.penalty_joints = self._joints()
         self.contacts = _checks.items("contacts", contacts, Contact, "a rodmol.Contact")
         self.rods, self.rod_contacts = attach(self.contacts, self.rods, self.bodies)
+        self._given = dict(rods=dict(rods), bodies=dict(bodies), joints=self.joints, medium=medium,
+                           gravity=self.gravity, contacts=self.contacts)
 
     def _joints(self):
         """Each base-jointed rod's clamp: (body or None, point, rotation), and
@@ -301,6 +303,35 @@ class System:
                                       position=position, rotation=rotation)
         self.base_bodies[rod] = name
         return name, (name, np.zeros(3), np.eye(3))
+
+    @property
+    def given_rods(self):
+        """The rods' Models as given (before the system's gravity, medium, joints' holds and
+        contacts were added): what :meth:`replace` takes a changed rod from."""
+        return dict(self._given["rods"])
+
+    def replace(self, *, rods=None, bodies=None, **changes):
+        """A new System from this one's arguments, checked as any: ``rods`` and ``bodies``
+        ({name: Model or RigidBody}) replace the ones of those names (a changed rod is best
+        made from :attr:`given_rods`), ``changes`` the other arguments (``joints``,
+        ``medium``, ``gravity``, ``contacts``)."""
+        arguments = dict(self._given)
+        for what, given in (("rods", rods), ("bodies", bodies)):
+            if given is None:
+                continue
+            if not isinstance(given, dict):
+                raise ParameterError(f"`{what}` must be a dict of names, got {_checks.short(given)}")
+            unknown = [name for name in given if name not in arguments[what]]
+            if unknown:
+                raise ParameterError(f"`{what}`: no {what[:-1]} named {unknown[0]!r} in the system"
+                                     + _checks.did_you_mean(unknown[0], arguments[what]))
+            arguments[what] = {**arguments[what], **given}
+        unknown = sorted(set(changes) - set(arguments))
+        if unknown:
+            raise ParameterError(f"System.replace: unknown argument {unknown[0]!r}"
+                                 + _checks.did_you_mean(unknown[0], arguments))
+        arguments.update(changes)
+        return System(**arguments)
 
     def rods_on(self, body):
         """Names of the rods whose base is clamped to ``body``, in ``rods`` order."""
