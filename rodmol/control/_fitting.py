@@ -33,8 +33,11 @@ def levenberg_marquardt(problem, target, inputs, tol, max_iter):
     problem.equilibria = 0
     y = problem.rest(inputs)
     r = problem.values(y) - target
+    if max_iter == 0:  # the forward statics
+        return inputs, y, r, 0
     jac = problem.jacobian(y, inputs)
     mu = 1e-6 * max(np.max(np.sum(jac**2, axis=0)), 1e-30)
+    growth = 2.0  # Nielsen's: each rejection in a row grows the damping twice as fast
     accepted, n = 0, len(inputs)
     for _ in range(max_iter):
         cost = r @ r
@@ -45,8 +48,9 @@ def levenberg_marquardt(problem, target, inputs, tol, max_iter):
                           bounds=(problem.low - inputs, problem.high - inputs), method="bvls").x
         linear = r + jac @ step
         predicted = cost - linear @ linear
-        if predicted <= 1e-12 * cost or np.max(np.abs(step)) <= 1e-12 * (1.0 + np.max(np.abs(inputs))):
-            break  # a bounded minimum: no step within the bounds reduces the residual
+        if (predicted <= 1e-12 * cost or np.max(np.abs(step)) <= 1e-12 * (1.0 + np.max(np.abs(inputs)))
+                or np.sqrt(cost) - np.sqrt(cost - predicted) <= PRECISION * tol):
+            break  # a bounded minimum: no step within the bounds lowers the residual by the precision asked
         trial = np.clip(inputs + step, problem.low, problem.high)
         try:
             y_new = problem.rest(trial)
@@ -59,9 +63,10 @@ def levenberg_marquardt(problem, target, inputs, tol, max_iter):
             inputs, y, r = trial, y_new, r_new
             jac = problem.jacobian(y, inputs)
             accepted += 1
+            mu, growth = mu / 3.0 if ratio > 0.75 else mu * 4.0 if ratio < 0.25 else mu, 2.0
         else:
             problem.warm = y  # the next trial starts from the accepted state
-        mu = mu / 3.0 if ratio > 0.75 else mu * 4.0 if ratio < 0.25 else mu
+            mu, growth = mu * 2.0 * growth, 2.0 * growth
     return inputs, y, r, accepted
 
 
@@ -168,4 +173,4 @@ def out_of_reach(what, base, target, length):
     distance = float(np.linalg.norm(np.asarray(target) - np.asarray(base)))
     if distance <= length:
         return None
-    return f"{what} target is {distance:.3g} m from its base, farther than the rod's length {length:.3g} m"
+    return f"{what} is aimed {distance:.3g} m from its base, farther than the rod's length {length:.3g} m"

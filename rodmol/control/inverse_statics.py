@@ -132,7 +132,8 @@ def inverse_statics(model, tip=None, *, direction=None, markers=None, pose=None,
     scheme : str
         The spatial scheme (``rodmol.SCHEMES``).
     max_iter : int
-        Most trial steps.
+        Most trial steps (0: the equilibrium under ``start``, reported against
+        the target: the forward statics).
 
     Returns
     -------
@@ -163,7 +164,7 @@ def inverse_statics(model, tip=None, *, direction=None, markers=None, pose=None,
                                  f"{_checks.short(value)} for a Model")
     tip, direction, names, positions = check_aims(model, tip, direction, markers)
     tol = _checks.positive("tol", tol, " m")
-    max_iter = _checks.integer_at_least("max_iter", max_iter, 1)
+    max_iter = _checks.integer_at_least("max_iter", max_iter, 0)
     problem = _Problem(model, cables, bounds, t, scheme, (tip is not None, direction is not None, names),
                        direction_weight, marker_weight)
     return problem.fit(problem.targets.aim(tip, direction, positions), problem.start(start), tol, max_iter)

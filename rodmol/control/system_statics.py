@@ -202,7 +202,7 @@ def fit_system(system, tip=None, *, direction=None, markers=None, pose=None, bou
     SystemFit
     """
     tol = _checks.positive("tol", tol, " m")
-    max_iter = _checks.integer_at_least("max_iter", max_iter, 1)
+    max_iter = _checks.integer_at_least("max_iter", max_iter, 0)
     problem = _SystemProblem(system, cables, insertions, driven, bounds, travel, t, scheme)
     problem.targets = targets = _SystemTargets(system, problem.assembly, tip, direction, markers, pose,
                                                direction_weight, marker_weight)
@@ -238,6 +238,9 @@ class _SystemProblem:
         self.driven = self._driven(driven)
         n_cables = sum(len(index) for index in self.cables.values())
         low, high = check_bounds("bounds", bounds, n_cables, "actuated cable", "N", lowest=0.0)
+        if travel is not None and not self.inserted:
+            raise ParameterError(f"`travel` bounds the insertions, but none is asked for: give `insertions`, got "
+                                 f"travel={_checks.short(travel)}")
         travel = (-np.inf, np.inf) if travel is None else travel
         t_low, t_high = check_bounds("travel", travel, len(self.inserted), "inserted rod", "m")
         free = np.full(6 * len(self.driven), np.inf)
@@ -332,7 +335,7 @@ class _SystemProblem:
         tensions, k = {}, 0
         for rod, held in self.tensions.items():
             tensions[rod] = held.copy()
-            index = self.cables.get(rod, ())
+            index = self.cables.get(rod, np.zeros(0, dtype=int))
             tensions[rod][index] = p[k:k + len(index)]
             k += len(index)
         insertions = p[k:k + len(self.inserted)]
