@@ -48,9 +48,9 @@ class CoupledDifferences:
     :class:`FreeRestEquations`, in few evaluations: within a rod the column
     groups of its :class:`BandedDifferences`, all rods' g-th groups perturbed
     together (a rod's rows read no other rod's unknowns but through the
-    joints); the columns that reach other rows (the first block of each rod on
-    a free body, whose strains make the clamp's wrench, the blocks of its joint
-    nodes, and the bodies' poses) one at a time. Increments as the banded ones',
+    joints); the columns that reach other rows (each rod's first block, whose
+    strains make the clamp's wrench, the blocks of its joint nodes, and the
+    bodies' poses) one at a time. Increments as the banded ones',
     1.5e-8 max(|z_j|, 1)."""
 
     bands = None
@@ -64,12 +64,11 @@ class CoupledDifferences:
                     [(joint.joint.partner, joint.partner_node)] if isinstance(joint, RodJointPart) else []):
                 nodes.setdefault(rod, set()).add((node - assembly.parts[rod].start - equations.rods[rod].system.
                                                   layout.header) // equations.rods[rod].system.layout.block)
-        on_free = {rod for part in assembly.free for rod in part.rods}  # their first blocks make a clamp's wrench
         grouped = []  # per rod: (columns, rows, cols) of each group, columns shifted to the unknowns
         for name, eq in equations.rods.items():
             start, block = equations.slices[name].start, eq.static.block
-            blocks = ({0} if name in on_free else set()) | nodes.get(name, set())
-            alone = np.concatenate([start + b * block + np.arange(block) for b in sorted(blocks)] or [[]]).astype(int)
+            blocks = {0} | nodes.get(name, set())
+            alone = np.concatenate([start + b * block + np.arange(block) for b in sorted(blocks)])
             coupled.append(alone)
             groups = []
             for members, rows, cols, _ in eq.differences.groups:
