@@ -18,8 +18,8 @@ from ..discretise.system import SemiDiscrete, tensions_by_hand
 from ..errors import ParameterError
 from ..loads import PointForce, PointMoment
 from ..model import Model
-from ..systems import System
 from ..simulate import check_state, check_word, initial_state
+from ..systems import System
 from .linear_model import LinearModel
 
 #: Step [-] of the central differences of the cables' path lengths in the

@@ -25,10 +25,19 @@ from ..errors import ParameterError
 from ..model import Model
 from ..solve.tension_statics import rest_state, tension_sensitivity
 from ..systems import System
-from ._fitting import (REACH_TOLERANCE, actuated, at_bounds, cable_displacements, check_bounds,
-                       levenberg_marquardt, out_of_reach, verdict, with_cables)
-from .system_statics import fit_system
+from ._fitting import (
+    REACH_TOLERANCE,
+    actuated,
+    at_bounds,
+    cable_displacements,
+    check_bounds,
+    levenberg_marquardt,
+    out_of_reach,
+    verdict,
+    with_cables,
+)
 from ._targets import Targets, check_aims
+from .system_statics import fit_system
 
 
 @dataclass(frozen=True)

@@ -30,8 +30,17 @@ from ..errors import ParameterError
 from ..solve.rest_equations import continuation, damped_newton
 from ..solve.system_equilibrium import CoupledDifferences, FreeRestEquations, floating
 from ..systems import System
-from ._fitting import (REACH_TOLERANCE, actuated, at_bounds, cable_displacements, check_bounds,
-                       levenberg_marquardt, out_of_reach, verdict, with_cables)
+from ._fitting import (
+    REACH_TOLERANCE,
+    actuated,
+    at_bounds,
+    cable_displacements,
+    check_bounds,
+    levenberg_marquardt,
+    out_of_reach,
+    verdict,
+    with_cables,
+)
 from ._targets import Targets, check_aims
 
 #: The equilibria's tolerance and Newton iterations (as ``rodmol.equilibrium``'s defaults).
@@ -40,6 +49,7 @@ _TOL, _MAX_ITER = 1e-10, 40
 _TANGENT_STEP = 1e-6
 #: The pose inputs of a driven body: its origin's offset [m] and a rotation vector [rad], global.
 POSE_AXES = ("x [m]", "y [m]", "z [m]", "rx [rad]", "ry [rad]", "rz [rad]")
+POSE_UNITS = ("m",) * 3 + ("rad",) * 3
 
 
 @dataclass(frozen=True)
@@ -204,11 +214,11 @@ def fit_system(system, tip=None, *, direction=None, markers=None, pose=None, bou
     tol = _checks.positive("tol", tol, " m")
     max_iter = _checks.integer_at_least("max_iter", max_iter, 0)
     problem = _SystemProblem(system, cables, insertions, driven, bounds, travel, t, scheme)
-    problem.targets = targets = _SystemTargets(system, problem.assembly, tip, direction, markers, pose,
-                                               direction_weight, marker_weight)
+    problem.targets = _SystemTargets(system, problem.assembly, tip, direction, markers, pose, direction_weight,
+                                     marker_weight)
     inputs = problem.start(start)
     problem.check_held()
-    values, rest, r, accepted = levenberg_marquardt(problem, targets.aim, inputs, tol, max_iter)
+    values, rest, r, accepted = levenberg_marquardt(problem, problem.targets.aim, inputs, tol, max_iter)
     return problem.report(values, rest, r, tol, accepted)
 
 
@@ -249,8 +259,7 @@ class _SystemProblem:
                       for rod, index in self.cables.items() for i in index]
         self.names += [f"{rod} insertion [m]" for rod in self.inserted]
         self.names += [f"{body} {axis}" for body in self.driven for axis in POSE_AXES]
-        self.units = ["N"] * n_cables + ["m"] * len(self.inserted) + [a.split()[-1][1:-1] for a in POSE_AXES] * len(
-            self.driven)
+        self.units = ["N"] * n_cables + ["m"] * len(self.inserted) + list(POSE_UNITS) * len(self.driven)
         held = system.replace(rods={name: tensions_by_hand(model) for name, model in system.given_rods.items()})
         self.assembly = Assembly(held, scheme)
         self.tensions = {name: np.array([c.tension_at(self.t) if not c.tension.feedback else 0.0
@@ -271,35 +280,22 @@ class _SystemProblem:
                 for name, m in rods.items() if name in cables}
 
     def _insertions(self, insertions):
-        if insertions is None:
-            return []
-        names = [insertions] if isinstance(insertions, str) else list(insertions)
         system = self.system
-        if len(set(names)) != len(names):
-            raise ParameterError(f"`insertions` must name distinct rods, got {_checks.short(insertions)}")
+        names = _distinct("insertions", insertions, system.rods, "rod")
         for name in names:
-            if name not in system.rods:
-                raise ParameterError(f"`insertions`: no rod named {name!r} in the system"
-                                     + _checks.did_you_mean(name, system.rods))
             body = system.clamps.get(name, (None,))[0]
-            if body is not None or name in system.base_bodies or not system.rods[name].base.fixed:
-                where = (f"on body {body!r}" if body is not None and name not in system.base_bodies
-                         else "pinned or joined to another rod" if body is not None else "moving")
+            where = ("pinned or joined to another rod" if name in system.base_bodies else
+                     f"on body {body!r}" if body is not None else
+                     None if system.rods[name].base.fixed else "moving (its Model's base moves)")
+            if where:
                 raise ParameterError(f"`insertions`: rod {name!r}'s base is {where}; an insertion slides a base "
                                      "clamped to the world (move a body by `driven`)")
         return names
 
     def _driven(self, driven):
-        if driven is None:
-            return []
-        names = [driven] if isinstance(driven, str) else list(driven)
         bodies = self.system.bodies
-        if len(set(names)) != len(names):
-            raise ParameterError(f"`driven` must name distinct bodies, got {_checks.short(driven)}")
+        names = _distinct("driven", driven, bodies, "body")
         for name in names:
-            if name not in bodies:
-                raise ParameterError(f"`driven`: no body named {name!r} in the system"
-                                     + _checks.did_you_mean(name, bodies))
             if not bodies[name].driven:
                 raise ParameterError(f"`driven`: body {name!r} is {bodies[name].motion!r}, not driven (a "
                                      "BaseMotion): only a driven body's pose is an input")
@@ -460,6 +456,19 @@ class _SystemProblem:
                          displacements, dict(zip(self.inserted, insertions.tolist())),
                          {name: poses[name] for name in self.driven}, y, tips, poses, residual,
                          *errors, residual <= tol, active, message, iterations, self.equilibria)
+
+
+def _distinct(what, value, pool, kind):
+    """The names ``value`` gives (a name or names; None: none), each in ``pool``, distinct."""
+    if value is None:
+        return []
+    names = [value] if isinstance(value, str) else list(value)
+    if len(set(names)) != len(names):
+        raise ParameterError(f"`{what}` must name distinct {kind}s, got {_checks.short(value)}")
+    for name in names:
+        if name not in pool:
+            raise ParameterError(f"`{what}`: no {kind} named {name!r} in the system" + _checks.did_you_mean(name, pool))
+    return names
 
 
 class _SystemTargets:

@@ -175,15 +175,14 @@ def test_a_floating_head_and_system_words_for_a_rod_are_refused(tmp_path):
         rodmol.inverse_statics_path(free, [(0.2, 0.0, 0.0)])
 
 
-@pytest.mark.slow
 def test_the_inserted_robot_settles_where_the_statics_put_it(robot):
     """fit.apply slides the legs' bases in over a ramp; simulate settles the platform
-    where the statics say (to the integration's drift, 10 um of a 3 mm move)."""
+    where the statics say (3 um of a 29 mm move: the integration's drift)."""
     made = forward(robot, [0.01, -0.005, 0.003])
     result = rodmol.simulate(made.apply(robot, ramp=0.3), 1.5, output_dt=0.1)
     assert result.success
     moved = made.poses["platform"][0] - (0.0, 0.0, 0.2)
-    assert np.linalg.norm(moved) > 2e-3
+    assert np.linalg.norm(moved) > 0.02
     assert np.linalg.norm(result["platform"].position[-1] - made.poses["platform"][0]) < 2e-5
     with pytest.raises(rodmol.ParameterError, match="give `ramp`"):
         made.apply(robot)
