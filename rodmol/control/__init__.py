@@ -9,5 +9,6 @@ environment (``rodmol.control.envs``, needs ``gymnasium``) is imported on demand
 
 from .inverse_statics import StaticFit, inverse_statics, inverse_statics_path
 from .simulator import Simulator, Snapshot
+from .system_statics import SystemFit
 
-__all__ = ["Simulator", "Snapshot", "StaticFit", "inverse_statics", "inverse_statics_path"]
+__all__ = ["Simulator", "Snapshot", "StaticFit", "SystemFit", "inverse_statics", "inverse_statics_path"]
