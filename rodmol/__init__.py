@@ -33,7 +33,7 @@ from .calibrate import (
     worsened_models,
 )
 from .contacts import Contact
-from .control import Simulator, StaticFit, inverse_statics, inverse_statics_path
+from .control import Simulator, StaticFit, SystemFit, inverse_statics, inverse_statics_path
 from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
 from .discretise.system import SemiDiscrete, StateView, straight_state, undeformed_state
@@ -79,5 +79,5 @@ __all__ = [
     "LinearModel", "calibrate_dlt", "identify", "linearize", "paper_errors", "sweep", "triangulate",
     "worsened_models",
     # rodmol.control: questions a controller asks
-    "StaticFit", "inverse_statics", "inverse_statics_path",
+    "StaticFit", "SystemFit", "inverse_statics", "inverse_statics_path",
 ]

@@ -118,12 +118,14 @@ class LinearModel:
     def output(self, output="tip"):
         """The same model with output ``output``: ``"tip"``, the tip position
         [m] (global frame, rebuilt from the orientations and strains as
-        ``Result.tip``), or a (p, n) matrix C, the output C times the model's
-        state vector (``y0 = C @ state``; of a reduced model C x, ``y0 = 0``)."""
+        ``Result.tip``), a system's ``"<rod>/tip"`` or ``"<body>/position"``,
+        or a (p, n) matrix C, the output C times the model's state vector
+        (``y0 = C @ state``; of a reduced model C x, ``y0 = 0``)."""
         if isinstance(output, str):
-            if output not in OUTPUTS:
-                raise ParameterError(f"`output` must be one of {OUTPUTS} or a matrix, got {output!r}"
-                                     + _checks.did_you_mean(output, OUTPUTS))
+            names = tuple(self._named) or OUTPUTS  # a system's: "<rod>/tip", "<body>/position"
+            if output not in names:
+                raise ParameterError(f"`output` must be one of {names} or a matrix, got {output!r}"
+                                     + _checks.did_you_mean(output, names))
             if output not in self._named or self.projection is not None:
                 raise ParameterError(f"`output` {output!r} needs a model over the whole state (from linearize)")
             c, names, values = self._named[output]

@@ -12,12 +12,14 @@ import numpy as np
 from .. import _checks
 from .._differences import central_columns
 from ..discretise import load_entries, stencil
+from ..discretise.layout import HEADER
 from ..discretise.schemes import DEFAULT_SCHEME
 from ..discretise.system import SemiDiscrete, tensions_by_hand
 from ..errors import ParameterError
 from ..loads import PointForce, PointMoment
 from ..model import Model
 from ..simulate import check_state, check_word, initial_state
+from ..systems import System
 from .linear_model import LinearModel
 
 #: Step [-] of the central differences of the cables' path lengths in the
@@ -30,7 +32,9 @@ def linearize(model, state, t=0.0, scheme=DEFAULT_SCHEME):
 
     Parameters
     ----------
-    model : Model
+    model : Model or System
+        A :class:`rodmol.System`: see
+        :func:`rodmol.calibrate.system_linearize.linearize_system`.
     state : (size,) state vector, ``"equilibrium"`` or ``"straight"``
         A state (e.g. ``rodmol.equilibrium(model, t)``, ``Result.states[k]``),
         checked as ``simulate`` checks its ``initial`` (finite, each element
@@ -77,8 +81,12 @@ def linearize(model, state, t=0.0, scheme=DEFAULT_SCHEME):
         A bad ``state`` (named, before any work), or rates that are not finite
         about it (A, B or the tip's C would hold non-finite entries).
     """
+    if isinstance(model, System):
+        from .system_linearize import linearize_system  # it builds on this module's parts
+
+        return linearize_system(model, state, t, scheme)
     if not isinstance(model, Model):
-        raise ParameterError(f"`model` must be a rodmol.Model, got {model!r}")
+        raise ParameterError(f"`model` must be a rodmol.Model or a rodmol.System, got {model!r}")
     t = _checks.finite("t", t)
     check_word("state", state)
     probe = SemiDiscrete(model, scheme)
@@ -136,18 +144,22 @@ def _tip_rows(system, t, y):
     """d tip / d y (3, size): the tip rebuilt from the orientations and strains
     as ``Result.tip`` and ``StateView.tip`` give it (not the integrated position
     u(L), which differs from it by the time discretisation's drift), by central
-    differences of that geometric function over the entries it reads."""
+    differences of that geometric function over the entries it reads: the base
+    pose (which moves with a moving base or a system's free body) and the
+    orientations and strains."""
     layout = system.layout
-    entries = np.concatenate([_field_rows(layout, f).ravel() for f in ("Q", "q", "k")])
+    entries = np.concatenate([np.arange(HEADER)] + [_field_rows(layout, f).ravel() for f in ("Q", "q", "k")])
     h = _STRAIN_STEP * np.maximum(np.abs(y[entries]), system.atol_scale()[entries])
     rows = np.zeros((3, layout.size))
     rows[:, entries] = central_columns(lambda state: system.state_view(t, state).tip, y, entries, h)
     return rows
 
 
-def _tendons(model, system, t, y, a, b):
+def _tendons(model, system, t, y, a, b, offset=0):
     """The displacement-controlled cables: their tendon law's dependence on the
-    path length is added to ``a`` in place; returns their (name, d f / d z, z [m]) columns."""
+    path length is added to ``a`` in place; returns their (name, d f / d z, z [m]) columns.
+    ``y`` is the rod's state, whose entries start at column ``offset`` of ``a`` (a
+    rod in a system); ``b`` holds the rod's tension columns over ``a``'s rows."""
     motors = [(j, c) for j, c in enumerate(model.cables) if c.actuated]
     if not motors:
         return []
@@ -165,7 +177,7 @@ def _tendons(model, system, t, y, a, b):
         moved = system.routing.lengths(both[..., :3], both[..., 3:])
         d_length[element, c] = (moved[0] - moved[1]) / (2 * h[element, c])
     d_length = d_length.reshape(6 * n, -1)
-    rows = np.hstack([_field_rows(layout, "q"), _field_rows(layout, "k")]).ravel()
+    rows = offset + np.hstack([_field_rows(layout, "q"), _field_rows(layout, "k")]).ravel()
     out = []
     for j, cable in motors:
         stiffness, gain = cable.tension.slopes(t, lengths[j])

@@ -12,7 +12,8 @@ by ``gymnasium.make``.
 from .inverse_statics import StaticFit, inverse_statics, inverse_statics_path
 from .registration import register_environments
 from .simulator import Simulator, Snapshot
+from .system_statics import SystemFit
 
 register_environments()
 
-__all__ = ["Simulator", "Snapshot", "StaticFit", "inverse_statics", "inverse_statics_path"]
+__all__ = ["Simulator", "Snapshot", "StaticFit", "SystemFit", "inverse_statics", "inverse_statics_path"]

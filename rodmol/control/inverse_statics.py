@@ -13,24 +13,31 @@ position that holds it follows exactly from the path length
 (:meth:`rodmol.cables.ActuatorTension.position_for`).
 """
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import lsq_linear
 
 from .. import _checks
 from ..discretise.layout import StateLayout
 from ..discretise.schemes import DEFAULT_SCHEME
 from ..discretise.system import SemiDiscrete, tensions_by_hand
-from ..errors import EquilibriumError, ParameterError
+from ..errors import ParameterError
 from ..model import Model
 from ..solve.tension_statics import rest_state, tension_sensitivity
+from ..systems import System
+from ._fitting import (
+    REACH_TOLERANCE,
+    actuated,
+    at_bounds,
+    cable_displacements,
+    check_bounds,
+    levenberg_marquardt,
+    out_of_reach,
+    verdict,
+    with_cables,
+)
 from ._targets import Targets, check_aims
-
-#: Default reach tolerance [m] on the weighted tip residual.
-REACH_TOLERANCE = 1e-4
-#: The loop stops once the residual is this fraction of the reach tolerance.
-_PRECISION = 1e-3
+from .system_statics import fit_system
 
 
 @dataclass(frozen=True)
@@ -86,27 +93,24 @@ class StaticFit:
     def apply(self, model):
         """``model`` with the found inputs: each actuated cable pulls with its
         found tension, or its actuator sits at its found displacement."""
-        cables = []
-        for c in model.cables:
-            if c.name in self.displacements:
-                c = replace(c, tension=None, displacement=self.displacements[c.name])
-            elif c.name in self.tensions and c.tension.constant != self.tensions[c.name]:
-                c = replace(c, tension=float(self.tensions[c.name]))
-            cables.append(c)
-        return model.replace(cables=cables)
+        return with_cables(model, self.tensions, self.displacements)
 
 
-def inverse_statics(model, tip=None, *, direction=None, markers=None, bounds=(0.0, np.inf), cables=None,
-                    t=0.0, tol=REACH_TOLERANCE, direction_weight=None, marker_weight=1.0, start=None,
-                    scheme=DEFAULT_SCHEME, max_iter=50):
+def inverse_statics(model, tip=None, *, direction=None, markers=None, pose=None, bounds=(0.0, np.inf),
+                    cables=None, insertions=None, driven=None, travel=None, t=0.0, tol=REACH_TOLERANCE,
+                    direction_weight=None, marker_weight=1.0, start=None, scheme=DEFAULT_SCHEME, max_iter=50):
     """The cable tensions, within bounds, whose static equilibrium puts the tip at
     ``tip`` (its tangent along ``direction``, markers at ``markers``).
 
     Parameters
     ----------
-    model : Model
+    model : Model or System
         Its loads (gravity, buoyancy, external loads, contact at ``t``) act;
-        the cables not in ``cables`` keep their tensions.
+        the cables not in ``cables`` keep their tensions. A
+        :class:`rodmol.System` takes its targets and inputs by rod and body
+        name (``pose``, ``insertions``, ``driven`` and ``travel`` are for a
+        System only): see :func:`rodmol.control.system_statics.fit_system`,
+        which returns a :class:`~rodmol.control.system_statics.SystemFit`.
     tip : (3,) array, optional
         Target tip position [m], global frame.
     direction : (3,) array, optional
@@ -137,7 +141,8 @@ def inverse_statics(model, tip=None, *, direction=None, markers=None, bounds=(0.
     scheme : str
         The spatial scheme (``rodmol.SCHEMES``).
     max_iter : int
-        Most trial steps.
+        Most trial steps (0: the equilibrium under ``start``, reported against
+        the target: the forward statics).
 
     Returns
     -------
@@ -156,10 +161,19 @@ def inverse_statics(model, tip=None, *, direction=None, markers=None, bounds=(0.
     EquilibriumError
         No equilibrium under the initial tensions.
     """
+    if isinstance(model, System):
+        return fit_system(model, tip, direction=direction, markers=markers, pose=pose, bounds=bounds,
+                          cables=cables, insertions=insertions, driven=driven, travel=travel, t=t, tol=tol,
+                          direction_weight=direction_weight, marker_weight=marker_weight, start=start,
+                          scheme=scheme, max_iter=max_iter)
     _check_model(model)
+    for name, value in (("pose", pose), ("insertions", insertions), ("driven", driven), ("travel", travel)):
+        if value is not None:
+            raise ParameterError(f"`{name}` is for a rodmol.System (its bodies and rods' bases), got "
+                                 f"{_checks.short(value)} for a Model")
     tip, direction, names, positions = check_aims(model, tip, direction, markers)
     tol = _checks.positive("tol", tol, " m")
-    max_iter = _checks.integer_at_least("max_iter", max_iter, 1)
+    max_iter = _checks.integer_at_least("max_iter", max_iter, 0)
     problem = _Problem(model, cables, bounds, t, scheme, (tip is not None, direction is not None, names),
                        direction_weight, marker_weight)
     return problem.fit(problem.targets.aim(tip, direction, positions), problem.start(start), tol, max_iter)
@@ -190,6 +204,9 @@ def inverse_statics_path(model, tips, *, directions=None, **options):
         if len(directions) != len(tips):
             raise ParameterError(f"`directions` must have one row per target ({len(tips)}), got {len(directions)}")
     unknown = set(options) - {"bounds", "cables", "t", "tol", "direction_weight", "start", "scheme", "max_iter"}
+    if isinstance(model, System):
+        raise ParameterError("inverse_statics_path takes a rodmol.Model; for a System, call inverse_statics "
+                             "per target (its `start` the last fit's `values`)")
     _check_model(model)
     if unknown:
         raise ParameterError(f"unknown options {sorted(unknown)} for inverse_statics_path")
@@ -221,7 +238,7 @@ def _targets(name, value):
 
 def _check_model(model):
     if not isinstance(model, Model):
-        raise ParameterError(f"`model` must be a rodmol.Model, got {_checks.short(model)}")
+        raise ParameterError(f"`model` must be a rodmol.Model or a rodmol.System, got {_checks.short(model)}")
 
 
 class _Problem:
@@ -230,8 +247,10 @@ class _Problem:
     def __init__(self, model, cables, bounds, t, scheme, aims, direction_weight, marker_weight):
         self.model, self.t = model, _checks.finite("t", t)
         self.names = [c.name for c in model.cables]
-        self.index = self._actuated(cables)
-        self.low, self.high = self._bounds(bounds)
+        if cables is None and not self.names:
+            raise ParameterError("the model has no cables to actuate")
+        self.index = actuated(self.names, cables)
+        self.low, self.high = check_bounds("bounds", bounds, len(self.index), "actuated cable", "N", lowest=0.0)
         weight = (model.rod.length if direction_weight is None
                   else _checks.positive("direction_weight", direction_weight, " m"))
         self.targets = Targets(model, StateLayout(model.n_elements), *aims, weight,
@@ -246,45 +265,6 @@ class _Problem:
         self.system = SemiDiscrete(tensions_by_hand(model), scheme)
         self._tip = self.system.layout.tip_slice("u")
         self.warm, self.equilibria = None, 0
-
-    def _actuated(self, cables):
-        if cables is None:
-            if not self.names:
-                raise ParameterError("the model has no cables to actuate")
-            return np.arange(len(self.names))
-        if isinstance(cables, str):
-            cables = [cables]
-        names = list(cables)
-        if not names or len(set(names)) != len(names):
-            raise ParameterError(f"`cables` must name distinct cables of the model, got {_checks.short(cables)}")
-        for name in names:
-            if name not in self.names:
-                raise ParameterError(f"`cables`: no cable named {name!r} in the model"
-                                     + _checks.did_you_mean(name, self.names))
-        return np.array([self.names.index(n) for n in names])
-
-    def _bounds(self, bounds):
-        n = len(self.index)
-        try:
-            low, high = bounds
-        except (TypeError, ValueError):
-            raise ParameterError(f"`bounds` must be (low, high) tensions [N], got {_checks.short(bounds)}") from None
-        out = []
-        for name, value in (("low", low), ("high", high)):
-            arr = _checks.floats(value)
-            if arr is None or arr.ndim > 1 or (arr.ndim == 1 and arr.shape != (n,)):
-                raise ParameterError(f"`bounds` {name} must be a number or {n} numbers (one per actuated "
-                                     f"cable), got {_checks.short(value)}")
-            if np.any(np.isnan(arr)):
-                raise ParameterError(f"`bounds` {name} must not be NaN, got {_checks.short(value)}")
-            out.append(np.broadcast_to(arr, (n,)).astype(float))
-        low, high = out
-        if np.any(~np.isfinite(low)) or np.any(low < 0.0):
-            raise ParameterError(f"`bounds` low must be finite and >= 0 N (cables only pull), got {_checks.short(bounds)}")
-        if np.any(low >= high):
-            raise ParameterError(f"`bounds` low must be < high for every cable, got {_checks.short(bounds)} "
-                                 "(to hold a cable's tension fixed, leave it out of `cables`)")
-        return low, high
 
     def start(self, start):
         if start is None:
@@ -308,78 +288,30 @@ class _Problem:
         self.warm = y
         return y
 
+    def values(self, y):
+        return self.targets.values(y)
+
     def jacobian(self, y, actuated):
         """d outputs / d actuated tensions [m/N], exact up to the equilibrium's tolerance."""
         d_y = tension_sensitivity(self.system, y, self.all_tensions(actuated), self.t)[:, self.index]
         return self.targets.rows(y) @ d_y[self.targets.entries]
 
     def fit(self, target, tensions, tol, max_iter):
-        """Levenberg-Marquardt with bounds from ``tensions``."""
-        self.equilibria = 0
-        y = self.rest(tensions)
-        r = self.targets.values(y) - target
-        jac = self.jacobian(y, tensions)
-        mu = 1e-6 * max(np.max(np.sum(jac**2, axis=0)), 1e-30)
-        accepted = 0
-        for _ in range(max_iter):
-            cost = r @ r
-            if np.sqrt(cost) <= _PRECISION * tol:
-                break
-            n = len(tensions)
-            system = np.vstack([jac, np.sqrt(mu) * np.eye(n)])
-            step = lsq_linear(system, np.concatenate([-r, np.zeros(n)]),
-                              bounds=(self.low - tensions, self.high - tensions), method="bvls").x
-            linear = r + jac @ step
-            predicted = cost - linear @ linear
-            if predicted <= 1e-12 * cost or np.max(np.abs(step)) <= 1e-12 * (1.0 + np.max(tensions)):
-                break  # a bounded minimum: no step within the bounds reduces the residual
-            trial = np.clip(tensions + step, self.low, self.high)
-            try:
-                y_new = self.rest(trial)
-            except EquilibriumError:  # e.g. buckling under the trial tensions: a shorter step
-                ratio = -np.inf
-            else:
-                r_new = self.targets.values(y_new) - target
-                ratio = (cost - r_new @ r_new) / predicted
-            if ratio > 1e-4:
-                tensions, y, r = trial, y_new, r_new
-                jac = self.jacobian(y, tensions)
-                accepted += 1
-            else:
-                self.warm = y  # the next trial starts from the accepted state
-            mu = mu / 3.0 if ratio > 0.75 else mu * 4.0 if ratio < 0.25 else mu
+        """The bounded least squares from ``tensions``, reported."""
+        tensions, y, r, accepted = levenberg_marquardt(self, target, tensions, tol, max_iter)
         return self._report(target, tensions, y, r, tol, accepted)
 
     def _report(self, target, tensions, y, r, tol, iterations):
         residual = float(np.linalg.norm(r))
         tip_error, angle, marker_errors = self.targets.errors(y, target)
-        all_tensions = self.all_tensions(tensions)
-        names = self.names
-        scale = 1e-9 * max(1.0, float(np.max(self.high[np.isfinite(self.high)], initial=1.0)))
-        active = {}
-        for j, i in enumerate(self.index):
-            if tensions[j] <= self.low[j] + scale:
-                active[names[i]] = "lower"
-            elif tensions[j] >= self.high[j] - scale:
-                active[names[i]] = "upper"
-        displacements = {}
-        view = self.system.state_view(self.t, y)
-        for j, i in enumerate(self.index):
-            cable = self.model.cables[i]
-            if cable.actuated:
-                displacements[names[i]] = float(cable.tension.position_for(view.cable_length(names[i]),
-                                                                           tensions[j]))
-        reachable = residual <= tol
-        how = f"in {iterations} step{'' if iterations == 1 else 's'} ({self.equilibria} equilibria)"
-        if reachable:
-            message = f"target met to {residual:.3g} m {how}"
-        else:
-            upper = [f"{names[i]} ({self.high[j]:.4g} N)" for j, i in enumerate(self.index)
-                     if active.get(names[i]) == "upper"]
-            why = "" if upper else " (a local minimum: another `start` may do better)"
-            message = (f"target not reached within the bounds{why}: residual {residual:.3g} m > tol {tol:.3g} m "
-                       f"{how}; at an upper bound: {', '.join(upper) or 'none'}; at the lower bound: "
-                       f"{', '.join(n for n, side in active.items() if side == 'lower') or 'none'}")
-        return StaticFit(dict(zip(names, all_tensions.tolist())), displacements, y, y[self._tip].copy(),
-                         residual, tip_error, angle, marker_errors, reachable, active, message, iterations,
-                         self.equilibria)
+        names = [self.names[i] for i in self.index]
+        active = at_bounds(tensions, self.low, self.high, names)
+        displacements = cable_displacements(self.model, self.system.state_view(self.t, y), self.index, tensions)
+        base = self.model.base
+        far = (out_of_reach("the tip", base.position, target[:3], self.model.rod.length)
+               if self.targets.tip and base.fixed else None)
+        message = verdict(residual, tol, iterations, self.equilibria, active,
+                          {n: f"{h:.4g} N" for n, h in zip(names, self.high)}, [far] if far else [])
+        return StaticFit(dict(zip(self.names, self.all_tensions(tensions).tolist())), displacements, y,
+                         y[self._tip].copy(), residual, tip_error, angle, marker_errors, residual <= tol, active,
+                         message, iterations, self.equilibria)

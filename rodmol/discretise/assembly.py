@@ -389,12 +389,16 @@ class Assembly:
         its velocity the slowest rod's speed scale, its angular velocity that
         speed over the longest rod (:func:`field_scales`)."""
         scales = [sd.atol_scale() for sd in self.rods.values()]
-        rods = [field_scales(sd.model) for sd in self.rods.values()]
-        length, speed = max(f["u"] for f in rods), min(f["v"] for f in rods)
-        per_field = {"x": length, "Q": 1.0, "v": speed, "w": speed / length}
+        per_field = self.body_scales()
         for part in self.bodies.values():
             scales.append(np.concatenate([np.full(n, per_field[f]) for f, n in part.layout.fields.items()]))
         return np.concatenate(scales)
+
+    def body_scales(self):
+        """Typical size of a body's fields {"x", "Q", "v", "w"} (see :meth:`atol_scale`)."""
+        rods = [field_scales(sd.model) for sd in self.rods.values()]
+        length, speed = max(f["u"] for f in rods), min(f["v"] for f in rods)
+        return {"x": length, "Q": 1.0, "v": speed, "w": speed / length}
 
     # ------------------------------------------------------------------ checks
 

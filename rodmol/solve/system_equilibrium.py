@@ -108,11 +108,13 @@ class FreeRestEquations:
     (see the module's docstring). ``residual(w, lam)`` is dimensionless: the
     rods' rows as :class:`RestEquations`', a body's force rows over the
     system's load scale S [N] (the rods' load scales and the bodies' net
-    weights summed), its moment rows over S times the longest rod."""
+    weights summed), its moment rows over S times the longest rod. ``tensions``
+    ({rod: (n_cables,) [N]}) replace those rods' cable inputs (see :class:`RestEquations`)."""
 
-    def __init__(self, assembly, t):
+    def __init__(self, assembly, t, tensions=None):
         self.assembly, self.t = assembly, t
-        self.rods = {name: RestEquations(sd, t) for name, sd in assembly.rods.items()}
+        tensions = {} if tensions is None else tensions
+        self.rods = {name: RestEquations(sd, t, tensions.get(name)) for name, sd in assembly.rods.items()}
         self.y = assembly.undeformed_state()  # fixed and driven bodies keep their initial poses
         self._gravity = np.asarray(assembly.system.gravity, dtype=float)
         gravity = np.linalg.norm(self._gravity)
@@ -154,6 +156,15 @@ class FreeRestEquations:
             floor = 10 * np.finfo(float).eps * max(forces, default=0.0) / self.scale
             out[self.slices[part.name]] = max(float(tol), floor)
         return out
+
+    def move(self, body, position, quaternion):
+        """Put the fixed or driven body ``body`` at ``position`` [m] with ``quaternion`` (body
+        to global), both global, instead of its initial pose: the rods clamped to it and its
+        joints follow (an input of the inverse statics)."""
+        part = self.assembly.bodies[body]
+        self.y[part.fields["x"]], self.y[part.fields["Q"]] = position, quaternion
+        for i, rod in enumerate(part.rods):
+            self._clamped[rod] = (part, i)
 
     def _place(self, z):
         """Write the bodies' poses and the rods' bases and static unknowns into ``self.y``."""

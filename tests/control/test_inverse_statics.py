@@ -120,6 +120,22 @@ def test_an_unreachable_target_says_so(arm):
     assert "not reached" in fit.message and "cable 11" in fit.message
 
 
+def test_a_target_beyond_the_rods_length_is_said_out_of_reach(arm):
+    """Farther from the base than the arm is long: the message says so, not a local minimum."""
+    fit = inverse_statics(arm, (0.3, 0.4, 0.0), cables=["cable 11", "cable 12"], bounds=(0.0, 5.0), max_iter=5)
+    assert not fit.reachable
+    assert "out of reach: the tip is aimed 0.5 m from its base, farther than the rod's length" in fit.message
+    assert "local minimum" not in fit.message
+
+
+def test_no_step_is_the_forward_statics(arm):
+    """max_iter=0: the equilibrium under ``start``, measured against the target."""
+    tip, _ = rest_pose(rodmol.paper_arm(N, tensions={11: 1.0, 12: 0.5}))
+    fit = inverse_statics(arm, (0.0, 0.0, 0.0), cables=["cable 11", "cable 12"], start=[1.0, 0.5], max_iter=0)
+    assert fit.iterations == 0 and fit.equilibria == 1 and not fit.reachable
+    assert np.allclose(fit.tip, tip, atol=1e-9) and fit.tip_error == pytest.approx(np.linalg.norm(tip))
+
+
 def test_a_path_reuses_the_previous_solution(arm):
     """Targets along the tips of a tension ramp: each met, and each after the
     first needs fewer equilibria than the first."""
