@@ -83,7 +83,7 @@ class OctopusCrawlEnv(gymnasium.Env):
     Parameters
     ----------
     n_elements : int
-        Elements N of each arm (6: faster than real time on one core).
+        Elements N of each arm (6; its speed: docs/control.md).
     period : float
         Control period [s], > 0.
     episode_steps : int
