@@ -12,7 +12,6 @@ module takes about 35 s then, 16 s with the cache).
 """
 
 import os
-import subprocess
 import sys
 
 import numpy as np
@@ -89,11 +88,9 @@ def test_refined_scheme_meets_rodmol(module):
     assert TR.rms(till, refined) > 10 * TR.rms(rodmol_x, refined)
 
 
-@pytest.mark.subprocess
 def test_study_script_smoke_run(tmp_path):
-    proc = subprocess.run([sys.executable, os.path.join(SOLVERS, "till_reference.py"), "--smoke",
-                           "--out", str(tmp_path)], capture_output=True, text=True, timeout=600)
-    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-4000:]
+    """The study's ``main`` in this process (tests/test_solver_scripts.py runs a study as a command)."""
+    TR.main(["--smoke", "--out", str(tmp_path)])
     for name in ("till_reference.csv", "till_reference_trajectories.csv", "till_reference.md",
                  "till_reference.png"):
         assert (tmp_path / name).stat().st_size > 0, name
