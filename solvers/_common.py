@@ -12,7 +12,10 @@ import csv
 import datetime
 import os
 import platform
+import shutil
+import subprocess
 import sys
+import tempfile
 import time
 
 for _var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS"):
@@ -26,7 +29,8 @@ import matplotlib.pyplot as plt  # noqa: E402,F401  (re-exported for the scripts
 import numpy as np  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))  # run from a checkout without installing
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, ROOT)  # run from a checkout without installing
 
 import rodmol  # noqa: E402
 from rodmol.discretise.layout import BLOCK, HEADER, StateLayout  # noqa: E402
@@ -55,6 +59,31 @@ def parse_args(description, argv=None):
     if args.reps is None:
         args.reps = 1 if args.smoke else 3
     return args
+
+
+def package_tree(commit):
+    """(folder, full hash): a folder holding the package ``rodmol/`` as of ``commit``, for a
+    worker subprocess to import (PYTHONPATH), the old side of a before/after study.
+
+    Extracted with ``git archive`` once and kept in the user's cache folder
+    (``$XDG_CACHE_HOME`` or ``~/.cache``, then ``rodmol/trees/<hash>``): a commit's files
+    never change, and numba caches the old kernels' machine code beside them, so the
+    next run loads it instead of compiling every kernel again (tens of seconds)."""
+    sha = subprocess.run(["git", "-C", ROOT, "rev-parse", "--verify", commit + "^{commit}"], check=True,
+                         capture_output=True, text=True).stdout.strip()
+    cache = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    folder = os.path.join(cache, "rodmol", "trees", sha)
+    if not os.path.isdir(folder):
+        os.makedirs(os.path.dirname(folder), exist_ok=True)
+        staging = tempfile.mkdtemp(prefix=f".{sha[:10]}-", dir=os.path.dirname(folder))
+        archive = subprocess.run(["git", "-C", ROOT, "archive", sha, "rodmol"], check=True,
+                                 capture_output=True).stdout
+        subprocess.run(["tar", "-x", "-C", staging], input=archive, check=True)
+        try:
+            os.rename(staging, folder)  # whole or not at all, should another run extract it too
+        except OSError:
+            shutil.rmtree(staging, ignore_errors=True)
+    return folder, sha
 
 
 def pick(args, full, quick, smoke):

@@ -1,7 +1,7 @@
 """Spatial order of rodmol's static equilibrium against an independent continuum reference.
 
 The reference solves the static Cosserat rod as a boundary value problem with
-``scipy.integrate.solve_bvp`` (relative tolerance 1e-10; 1e-8 in the smoke run). It shares no code
+``scipy.integrate.solve_bvp`` (relative tolerance 1e-10; 1e-6 in the smoke run). It shares no code
 with rodmol's discretisation: it reads only the model's parameters (radius
 profile, stiffness diagonals, densities, gravity, cable offsets, anchors and
 tensions, base pose).
@@ -315,7 +315,8 @@ def main(argv=None):
     args = C.parse_args(__doc__.splitlines()[0], argv)
     header = C.header_lines(args, SCRIPT)
     sizes = C.pick(args, [25, 50, 100, 200, 400, 800], [25, 50, 100, 200], [8, 16, 32])
-    tol = C.pick(args, 1e-10, 1e-10, 1e-8)  # the smoke run's errors are ~1e-3 L: a looser reference does
+    # The smoke run's errors are 1e-4 L and more; its reference moves by ~1e-8 L from tol 1e-6 to 1e-8.
+    tol = C.pick(args, 1e-10, 1e-10, 1e-6)
     L = rodmol.arm.LENGTH
     cases = _cases(rodmol, sizes)
     rows, summary, checks = [], [], []

@@ -3,9 +3,9 @@
 The paper's bending test (``rodmol.scenarios.get("bending").model(N)``,
 ``rodmol.simulate(model, 6.0)`` with the default options: gravity
 equilibrium, CVODE rtol 1e-6, the default linear solver) on the code of the
-last commit before the refactor (9fce6d7, checked out into a temporary
-detached ``git worktree``, removed afterwards) and on the current checkout
-(working tree as it is). Each version runs in its own long-lived
+last commit before the refactor (9fce6d7, its package extracted with
+``git archive`` into a kept folder, ``_common.package_tree``) and on the
+current checkout (working tree as it is). Each version runs in its own long-lived
 subprocess with PYTHONPATH pointing at its tree (the current virtualenv
 supplies the dependencies); both are warmed up (numba compilation) before
 anything is timed, and the repetitions alternate between the two processes
@@ -248,20 +248,18 @@ def main(argv=None):
     rounds = max(1, args.reps)
     np = C.np
 
-    old_sha = git("rev-parse", "--verify", commit + "^{commit}")
+    old_tree, old_sha = C.package_tree(commit)
     head_sha = git("rev-parse", "HEAD")
     dirty = bool(git("status", "--porcelain", "--untracked-files=no", "--", "rodmol"))
     header = C.header_lines(args, SCRIPT) + [
-        f"old: {old_sha[:10]} (git worktree); new: working tree at {head_sha[:10]}"
+        f"old: {old_sha[:10]} (git archive); new: working tree at {head_sha[:10]}"
         + (" with uncommitted changes under rodmol/" if dirty else ""),
         f"bending test, N = {n}, rodmol.simulate(model, {t_end:g}) with default options; "
         f"{args.reps} interleaved repetitions per version"]
 
     tmp = tempfile.mkdtemp(prefix="rodmol-core-speed-")
-    old_tree = os.path.join(tmp, "old")
     versions = []
     try:
-        git("worktree", "add", "--detach", old_tree, old_sha)
         for label, tree in (("old", old_tree), ("new", ROOT)):
             versions.append(Version(label, tree, os.path.join(tmp, f"{label}.stderr")))
         info = {}
@@ -297,7 +295,6 @@ def main(argv=None):
     finally:
         for v in versions:
             v.close()
-        subprocess.run(["git", "-C", ROOT, "worktree", "remove", "--force", old_tree], capture_output=True)
         shutil.rmtree(tmp, ignore_errors=True)
 
     # Tip trajectories.

@@ -7,7 +7,7 @@ with cables 11, 12, 3 and 7; the latter's tip with all twelve cables.
 Reported: the residual, the largest error of the actuated cables' tensions
 (unique in the first two cases), the steps, equilibria and wall time. A
 path: 20 targets, the tips of a tension ramp (cable 11 from 0.9 to 1.1 N,
-cable 12 from 0.6 to 0.5 N), a few mm apart, sought in turn with the four tip-section cables 9-12
+cable 12 from 0.6 to 0.5 N; 5 in the smoke run), a few mm apart, sought in turn with the four tip-section cables 9-12
 (``rodmol.inverse_statics_path``, each warm-started from the last); its wall
 time per target is compared with one forward equilibrium from the straight
 rod (``rodmol.equilibrium``, the same targets' own, timed in the same run).
@@ -22,7 +22,6 @@ from _common import np, rodmol
 
 SCRIPT = "inverse_statics.py"
 PULLED = {11: 1.0, 12: 0.5, 3: 0.4}
-N_PATH = 20
 
 
 def tip_of(model, y):
@@ -50,9 +49,9 @@ def one_target(n):
     return rows
 
 
-def path(n):
+def path(n, n_path):
     arm = rodmol.paper_arm(n)
-    ramp = np.linspace(0.0, 1.0, N_PATH)
+    ramp = np.linspace(0.0, 1.0, n_path)
     tips, forward = [], []
     for a in ramp:
         model = rodmol.paper_arm(n, tensions={11: 0.9 + 0.2 * a, 12: 0.6 - 0.1 * a})
@@ -65,10 +64,10 @@ def path(n):
     fits = rodmol.inverse_statics_path(arm, tips, cables=[f"cable {i}" for i in (9, 10, 11, 12)],
                                        bounds=(0.0, 5.0))
     wall = time.perf_counter() - start
-    per_target, per_forward = wall / N_PATH, float(np.mean(forward))
-    return [dict(N=n, case=f"path of {N_PATH} targets, cables 9-12", reachable=all(f.reachable for f in fits),
-                 residual_m=max(f.residual for f in fits), steps=sum(f.iterations for f in fits) / N_PATH,
-                 equilibria=sum(f.equilibria for f in fits) / N_PATH, wall_s=per_target,
+    per_target, per_forward = wall / n_path, float(np.mean(forward))
+    return [dict(N=n, case=f"path of {n_path} targets, cables 9-12", reachable=all(f.reachable for f in fits),
+                 residual_m=max(f.residual for f in fits), steps=sum(f.iterations for f in fits) / n_path,
+                 equilibria=sum(f.equilibria for f in fits) / n_path, wall_s=per_target,
                  forward_equilibrium_s=per_forward, ratio_to_forward=per_target / per_forward,
                  spacing_mm=float(1e3 * np.mean(np.linalg.norm(np.diff(tips, axis=0), axis=1))))]
 
@@ -76,10 +75,11 @@ def path(n):
 def main(argv=None):
     args = C.parse_args(__doc__.splitlines()[0], argv)
     sizes = C.pick(args, [10, 30], [10], [6])
+    n_path = C.pick(args, 20, 20, 5)
     rodmol.equilibrium(rodmol.paper_arm(sizes[0], tensions=PULLED))  # compile
     rows = []
     for n in sizes:
-        rows += one_target(n) + path(n)
+        rows += one_target(n) + path(n, n_path)
         print(rows[-1])
     header = C.header_lines(args, SCRIPT)
     columns = ["N", "case", "reachable", "residual_m", "tension_error_N", "steps", "equilibria", "wall_s",

@@ -5,11 +5,11 @@ The rest strains (``Rod(rest_curvature=, rest_stretch=)``) add two columns
 law of the compiled right-hand side. This measures what that costs on the
 paper's bending test at N = 100 (a straight rod, so both versions compute the
 same numbers): the tree of a base revision (default: the merge base with
-``main``, extracted with ``git archive`` into a temporary directory) and the
-current working tree run in two long-lived workers of ``core_speed.py`` (the
-same work on both sides: its settings; when the base's package files are
-the working tree's, both import the working tree), warmed up first, repetitions
-interleaved (old, new, new, old, ...). Reported: min and median of the
+``main``, extracted with ``git archive`` into a kept folder,
+``_common.package_tree``) and the current working tree run in two
+long-lived workers of ``core_speed.py`` (the same work on both sides: its
+settings; when the base's package files are the working tree's, both import
+the working tree), warmed up first, repetitions interleaved (old, new, new, old, ...). Reported: min and median of the
 solver's wall time, of the whole ``simulate`` call, and of the right-hand
 side per call, with the ratios new/old (of the minima, of the medians, and
 the median of the ratios within each repetition); and whether the tips
@@ -48,16 +48,9 @@ def main(argv=None):
         f"bending test, N = {n}, t_end = {t_end:g} s, core_speed.py's worker settings; "
         f"{args.reps} interleaved repetitions per version"]
     tmp = tempfile.mkdtemp(prefix="rodmol-rest-speed-")
-    old_tree = os.path.join(tmp, "old")
-    os.makedirs(old_tree)
+    old_tree = core_speed.ROOT if same_tree else C.package_tree(base_sha)[0]
     versions, runs, per_call = [], [], []
     try:
-        if same_tree:
-            old_tree = core_speed.ROOT
-        else:
-            archive = subprocess.run(["git", "-C", core_speed.ROOT, "archive", base_sha, "rodmol"], check=True,
-                                     capture_output=True).stdout
-            subprocess.run(["tar", "-x", "-C", old_tree], input=archive, check=True)
         for label, tree in (("old", old_tree), ("new", core_speed.ROOT)):
             versions.append(core_speed.Version(label, tree, os.path.join(tmp, f"{label}.stderr")))
             versions[-1].ask(cmd="init", n=n, t_end=t_end)

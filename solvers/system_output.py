@@ -10,7 +10,7 @@ frame, so that only the writing is timed: each rod's files (a single rod's
 writer, the same in both versions) and the system's own (``system.h5``,
 ``bodies.xdmf`` and, after, the chunk files). The old version (``--commit``,
 default the last commit before the change, exported by ``git archive`` into
-a temporary folder) rewrote ``system.h5`` whole at every chunk, holding
+a kept folder, ``_common.package_tree``) rewrote ``system.h5`` whole at every chunk, holding
 every frame so far; the new one writes each chunk once and a small index.
 Each version runs in its own subprocess, with PYTHONPATH at its tree, after
 a warm-up (numba's compilation).
@@ -31,7 +31,6 @@ import json
 import os
 import subprocess
 import sys
-import tarfile
 import tempfile
 import textwrap
 
@@ -88,18 +87,6 @@ CHILD = textwrap.dedent("""
 """)
 
 
-def export(commit, folder):
-    """The package ``rodmol/`` of ``commit`` into ``folder`` (``git archive``); returns its full hash."""
-    sha = subprocess.run(["git", "-C", ROOT, "rev-parse", "--verify", commit + "^{commit}"], check=True,
-                         capture_output=True, text=True).stdout.strip()
-    os.makedirs(folder, exist_ok=True)
-    archive = os.path.join(folder, "old.tar")
-    subprocess.run(["git", "-C", ROOT, "archive", "--format=tar", "-o", archive, sha, "rodmol"], check=True)
-    with tarfile.open(archive) as tar:
-        tar.extractall(folder, filter="data")
-    return sha
-
-
 def measure(tree, out, n_chunks, chunk):
     proc = subprocess.run([sys.executable, "-c", CHILD, tree, out, str(n_chunks), str(chunk)],
                           capture_output=True, text=True, timeout=3600)
@@ -119,9 +106,9 @@ def main(argv=None):
     window = max(1, min(10, n_chunks // 4))
     rows = []
     with tempfile.TemporaryDirectory(prefix="rodmol_system_output_") as tmp:
-        # The smoke run skips the old version: its extracted tree would compile every kernel again.
-        sha = None if args.smoke else export(commit, os.path.join(tmp, "old"))
-        versions = [("new", ROOT)] if args.smoke else [("old", os.path.join(tmp, "old")), ("new", ROOT)]
+        # The smoke run skips the old version: a first extraction of its tree compiles every kernel again.
+        old_tree, sha = (None, None) if args.smoke else C.package_tree(commit)
+        versions = [("new", ROOT)] if args.smoke else [("old", old_tree), ("new", ROOT)]
         for label, tree in versions:
             r = measure(tree, os.path.join(tmp, f"out_{label}"), n_chunks, chunk)
             s, own, size = (C.np.asarray(r[key]) for key in ("seconds", "system_s", "index_bytes"))

@@ -8,7 +8,11 @@ first on the PATH. Three kinds of command are left out, because the suite
 itself stands for them: creating the virtual environment and installing
 rodmol (``python3 -m venv``, ``pip install``; ``.ci/run`` runs them as
 written on a fresh machine), the ``.venv/bin/`` prefix (this environment is
-that one), and running the test suite. A block after an HTML comment
+that one), and running the test suite. A plain ``rodmol ...`` command (no
+shell syntax) runs through ``rodmol.cli.main`` in this process, the same
+code without a fresh interpreter's start (a second or two each), except a
+page's first, which runs through the console script as written. A block
+after an HTML comment
 ``<!-- file: NAME -->`` is a file the page asks the reader to save (e.g. a
 ParaView script): it is written under that name, not run. ``pvpython`` gets a
 virtual display when there is none (``xvfb-run``), and a page that needs it is
@@ -19,6 +23,7 @@ import builtins
 import importlib
 import os
 import re
+import shlex
 import shutil
 import sys
 from pathlib import Path
@@ -31,6 +36,7 @@ PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 FENCE = re.compile(r"(?:<!-- file: (?P<file>[\w.-]+) -->\s*\n)?^```(?P<lang>python|bash)\n(?P<code>.*?)^```$",
                    re.M | re.S)
 SET_UP = re.compile(r"python3? -m venv|pip install|-m pytest")
+SHELL_SYNTAX = re.compile(r"[|&;<>()$`*?~{}'\"\\]")
 XVFB = ["xvfb-run", *xserver.XVFB_ARGS]
 
 
@@ -54,6 +60,23 @@ def commands(code):
             yield " && ".join(kept)
 
 
+def rodmol_arguments(command):
+    """The arguments of a plain ``rodmol ...`` command (no shell syntax), else None."""
+    if not command.startswith("rodmol ") or SHELL_SYNTAX.search(command):
+        return None
+    return shlex.split(command)[1:]
+
+
+def run_in_process(arguments):
+    """``rodmol.cli.main(arguments)``'s exit code (0 for None, as the console script)."""
+    from rodmol.cli.commands import main
+
+    try:
+        return main(arguments) or 0
+    except SystemExit as exc:  # argparse's --help and errors
+        return exc.code or 0
+
+
 @pytest.mark.subprocess
 @pytest.mark.parametrize("page", [p for p in PAGES if any(blocks(p))], ids=lambda p: p.name)
 def test_page_runs_as_written(page, tmp_path, monkeypatch):
@@ -65,6 +88,7 @@ def test_page_runs_as_written(page, tmp_path, monkeypatch):
     env = dict(os.environ, PATH=f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}",
                MPLBACKEND="Agg")
     namespace = {"__name__": "__main__"}
+    console_script_ran = False
     for kind, code, line in blocks(page):
         where = f"{page.relative_to(ROOT)}:{line}"
         if kind.startswith("file:"):
@@ -73,6 +97,12 @@ def test_page_runs_as_written(page, tmp_path, monkeypatch):
             exec(compile(code, where, "exec"), namespace)  # noqa: S102 (the page's own code)
         else:
             for command in commands(code):
+                arguments = rodmol_arguments(command)
+                if arguments is not None and console_script_ran:
+                    exit_code = run_in_process(arguments)
+                    assert exit_code == 0, f"{where}: `{command}` exited with {exit_code}"
+                    continue
+                console_script_ran = console_script_ran or arguments is not None
                 argv = ["bash", "-c", command]
                 if command.startswith("pvpython") and not os.environ.get("DISPLAY"):
                     argv = XVFB + argv

@@ -3,9 +3,18 @@ write their CSV, Markdown and PNG outputs, and each produces the figure it
 exists for within a loose physical bound: an observed order, an error against
 its reference, an agreement or a ratio measured in the same run. Wall times
 themselves are not checked. core_speed.py also checks out the pre-refactor
-commit into a temporary git worktree (skipped outside a git checkout that has it)."""
+commit into a temporary git worktree (skipped outside a git checkout that has it).
+
+The scripts run in this process (``main(argv)``, as their ``__main__`` block
+calls it): a fresh interpreter per script would add its start and the loading
+of the compiled kernels, a second or two each, to runs of about as long. One
+script runs as a command (``python solvers/<script> --smoke``), for the part
+they all share: the command line's start, ``_common``'s set-up and the exit code.
+Scripts that start workers of their own (old and new trees side by side) are
+marked ``subprocess``."""
 
 import csv
+import importlib
 import math
 import os
 import shutil
@@ -314,9 +323,13 @@ SCRIPTS = {
 }
 
 
-@pytest.mark.subprocess
-@pytest.mark.parametrize("script", sorted(SCRIPTS))
-def test_script_smoke_run(script, tmp_path):
+#: Scripts that start subprocesses themselves: the trees they compare, or a fresh run each.
+SPAWNING = {"core_speed.py", "long_output.py", "rest_strains_speed.py", "system_output.py", "view_open.py"}
+#: The script run as a command: one of the quickest.
+COMMAND = "release.py"
+
+
+def _skip_without_what_it_needs(script):
     if script == "core_speed.py" and subprocess.run(
             ["git", "-C", ROOT, "cat-file", "-e", "9fce6d7^{commit}"], capture_output=True).returncode != 0:
         pytest.skip("needs a git checkout holding commit 9fce6d7")
@@ -330,15 +343,39 @@ def test_script_smoke_run(script, tmp_path):
         pytest.importorskip("gymnasium")
     if script == "view_open.py" and shutil.which("pvpython") is None:
         pytest.skip("needs ParaView's pvpython")
-    proc = subprocess.run([sys.executable, os.path.join(ROOT, "solvers", script), "--smoke",
-                           "--out", str(tmp_path)], capture_output=True, text=True, timeout=300)
-    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-4000:]
+
+
+def _check_outputs(script, out):
     files, check = SCRIPTS[script]
     for name in files:
-        path = tmp_path / name
+        path = out / name
         assert path.is_file() and path.stat().st_size > 0, name
     markdown = next(name for name in files if name.endswith(".md"))
-    with open(tmp_path / markdown) as f:
+    with open(out / markdown) as f:
         text = f.read()
     assert "machine:" in text and "numba" in text  # the header names the machine and versions
-    check(tmp_path)
+    check(out)
+
+
+def _main(script):
+    """The ``main`` of solvers/``script``, imported as the script's siblings import one another."""
+    solvers = os.path.join(ROOT, "solvers")
+    if solvers not in sys.path:
+        sys.path.insert(0, solvers)
+    return importlib.import_module(script.removesuffix(".py")).main
+
+
+@pytest.mark.parametrize("script", [pytest.param(s, marks=pytest.mark.subprocess) if s in SPAWNING else s
+                                    for s in sorted(SCRIPTS) if s != COMMAND])
+def test_script_smoke_run(script, tmp_path):
+    _skip_without_what_it_needs(script)
+    _main(script)(["--smoke", "--out", str(tmp_path)])
+    _check_outputs(script, tmp_path)
+
+
+@pytest.mark.subprocess
+def test_script_smoke_run_as_a_command(tmp_path):
+    proc = subprocess.run([sys.executable, os.path.join(ROOT, "solvers", COMMAND), "--smoke",
+                           "--out", str(tmp_path)], capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-4000:]
+    _check_outputs(COMMAND, tmp_path)
