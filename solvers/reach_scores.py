@@ -31,7 +31,7 @@ import _common as C
 from _common import np, rodmol
 from scipy.optimize import lsq_linear
 
-sys.path.insert(0, os.path.join(os.path.dirname(C.HERE), "examples"))
+sys.path.append(os.path.join(os.path.dirname(C.HERE), "examples"))  # after solvers/: namesakes
 from reach_policies import proportional  # noqa: E402  (one owner of that law)
 
 from rodmol.control.envs import ReachEnv  # noqa: E402  (needs gymnasium)

@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from example_modules import load_example
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 ERROR = re.compile(r"relative error[^:]*:\s*([0-9.eE+-]+)")
@@ -57,12 +58,7 @@ def test_reach_policies_records_an_episode(tmp_path):
 
 def example(script):
     """examples/``script`` loaded as a module (its ``__main__`` part not run)."""
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location(script.removesuffix(".py") + "_example", EXAMPLES / script)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_example(script)
 
 
 def floor_force(result, k):

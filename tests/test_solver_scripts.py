@@ -360,7 +360,9 @@ def _check_outputs(script, out):
 def _main(script):
     """The ``main`` of solvers/``script``, imported as the script's siblings import one another."""
     solvers = os.path.join(ROOT, "solvers")
-    if solvers not in sys.path:
+    if sys.path[0] != solvers:  # first: examples/ holds namesakes (octopus.py)
+        if solvers in sys.path:
+            sys.path.remove(solvers)
         sys.path.insert(0, solvers)
     return importlib.import_module(script.removesuffix(".py")).main
 

@@ -2,18 +2,17 @@
 (and of systems with other inputs), the named outputs, the step response against
 simulate, and the refusals."""
 
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from example_modules import load_example
 
 import rodmol
 from rodmol.discretise.assembly import Assembly
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
-sys.path.insert(0, str(EXAMPLES))
-import parallel_robot  # noqa: E402
+parallel_robot = load_example("parallel_robot.py")
 
 MATERIAL = rodmol.Material(E=1e5, nu=0.5, mu=300.0, rho=1080.0)
 TURN = np.diag([-1.0, -1.0, 1.0])  # the left arm leaves the head along -x

@@ -8,13 +8,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from example_modules import load_example
 
 import rodmol
 from rodmol.discretise.assembly import Assembly
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
-sys.path.insert(0, str(EXAMPLES))
-import parallel_robot  # noqa: E402
+parallel_robot = load_example("parallel_robot.py")
 
 LEGS = ["leg0", "leg1", "leg2"]
 
