@@ -23,8 +23,8 @@ from ..control.held import Held
 from ..discretise.assembly import Assembly
 from ..discretise.system_jacobian import column_groups
 from ..simulate import check_state, check_word, initial_state
+from .linear_columns import point_loads, refuse_non_finite, tendons, tip_rows
 from .linear_model import LinearModel
-from .linearize import _point_loads, _refuse_non_finite, _tendons, _tip_rows
 
 #: Relative step of A's central differences (times max(|y_j|, the entry's scale)).
 STEP = 1e-6
@@ -88,9 +88,9 @@ def linearize_system(system, state, t=0.0, scheme=None):
         columns.append(b)
         values += list(knobs.tensions[rod])
         pulls += [True] * len(model.cables)
-        found = _tendons(model, sd, t, y[part], a, b, offset=part.start)
+        found = tendons(model, sd, t, y[part], a, b, offset=part.start)
         rates(y)  # each rod's base velocities and joints at y, for its own loads' columns
-        for name, column, value in _point_loads(model, sd, t, np.ascontiguousarray(y[part]), knobs.tensions[rod]):
+        for name, column, value in point_loads(model, sd, t, np.ascontiguousarray(y[part]), knobs.tensions[rod]):
             full = np.zeros(assembly.size)  # a rod's loads move its own rates only
             full[part] = column
             found.append((name, full, value))
@@ -108,7 +108,7 @@ def linearize_system(system, state, t=0.0, scheme=None):
     named = _outputs(assembly, t, y)
     drift = probe(t, y)  # the system's own rates at the operating point
     entries = [assembly.entry_name(i) for i in range(assembly.size)]
-    _refuse_non_finite(t, ("A", a, entries, entries), ("B", b, entries, names),
+    refuse_non_finite(t, ("A", a, entries, entries), ("B", b, entries, names),
                        *((f"the C of {key!r}", c, rows, entries) for key, (c, rows, _) in named.items()),
                        ("f0", drift[:, None], entries, ["t"]))
     bounds = np.array([[0.0, np.inf] if pull else [-np.inf, np.inf] for pull in pulls]).reshape(-1, 2)
@@ -209,7 +209,7 @@ def _outputs(assembly, t, y):
         part = assembly.parts[rod]
         rod_state = np.ascontiguousarray(y[part])
         c = np.zeros((3, assembly.size))
-        c[:, part] = _tip_rows(sd, t, rod_state)
+        c[:, part] = tip_rows(sd, t, rod_state)
         named[f"{rod}/tip"] = (c, tuple(f"{rod}/tip {axis} [m]" for axis in "xyz"),
                                sd.state_view(t, rod_state).tip)
     for body, part in assembly.bodies.items():
