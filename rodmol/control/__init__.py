@@ -12,7 +12,7 @@ by ``gymnasium.make``.
 from .inverse_statics import StaticFit, inverse_statics, inverse_statics_path
 from .registration import register_environments
 from .simulator import Simulator, Snapshot
-from .system_statics import SystemFit
+from .system_fit import SystemFit
 
 register_environments()
 

@@ -110,7 +110,7 @@ def inverse_statics(model, tip=None, *, direction=None, markers=None, pose=None,
         :class:`rodmol.System` takes its targets and inputs by rod and body
         name (``pose``, ``insertions``, ``driven`` and ``travel`` are for a
         System only): see :func:`rodmol.control.system_statics.fit_system`,
-        which returns a :class:`~rodmol.control.system_statics.SystemFit`.
+        which returns a :class:`~rodmol.control.system_fit.SystemFit`.
     tip : (3,) array, optional
         Target tip position [m], global frame.
     direction : (3,) array, optional

@@ -15,11 +15,10 @@ central differences of the cheap map from the unknowns to the state, along
 each input's tangent (dz/dp_j, e_j).
 """
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.sparse.linalg import splu
-from scipy.spatial.transform import Rotation
 
 from .. import _checks
 from ..discretise import rotations
@@ -39,9 +38,9 @@ from ._fitting import (
     levenberg_marquardt,
     out_of_reach,
     verdict,
-    with_cables,
 )
-from ._targets import Targets, check_aims
+from .system_fit import SystemFit
+from .system_targets import SystemTargets, distinct
 
 #: The equilibria's tolerance and Newton iterations (as ``rodmol.equilibrium``'s defaults).
 _TOL, _MAX_ITER = 1e-10, 40
@@ -50,115 +49,6 @@ _TANGENT_STEP = 1e-6
 #: The pose inputs of a driven body: its origin's offset [m] and a rotation vector [rad], global.
 POSE_AXES = ("x [m]", "y [m]", "z [m]", "rx [rad]", "ry [rad]", "rz [rad]")
 POSE_UNITS = ("m",) * 3 + ("rad",) * 3
-
-
-@dataclass(frozen=True)
-class SystemFit:
-    """What :func:`fit_system` found.
-
-    Attributes
-    ----------
-    inputs : tuple of str
-        The inputs solved for, in the order of ``values`` and of ``start``:
-        ``"<rod>/<cable> tension [N]"``, ``"<rod> insertion [m]"``,
-        ``"<body> x [m]"`` ... ``"<body> rz [rad]"``.
-    values : (n_inputs,) array
-        Their values.
-    tensions : dict
-        Rod name -> {cable name -> tension [N]}, every cable of every rod.
-    displacements : dict
-        Rod name -> {cable name -> actuator position z [m]} for the actuated
-        displacement-controlled cables.
-    insertions : dict
-        Rod name -> how far [m] its base moved along its own x axis (the rod's
-        tangent there), for the rods in ``insertions``.
-    driven : dict
-        Body name -> (position [m], rotation (3, 3)), global: the found initial
-        pose of each body in ``driven``.
-    state : (size,) array
-        The system's static equilibrium (``Assembly.parts``).
-    tips : dict
-        Rod name -> its tip [m], global.
-    poses : dict
-        Body name -> (position [m], rotation (3, 3)), global, every body.
-    residual : float
-        The weighted residual [m] over every target (as a rod's, plus
-        |x - x_target|^2 and (w_d theta)^2 of each body, theta the angle
-        between its rotation and the target's).
-    tip_errors, direction_errors : dict
-        Rod name -> [m], [rad], for the rods aimed at.
-    marker_errors : dict
-        Rod name -> {marker -> [m]}.
-    position_errors, rotation_errors : dict
-        Body name -> [m], [rad] (the rotation's only where a rotation is aimed at).
-    reachable : bool
-        ``residual <= tol``.
-    active : dict
-        Input name -> ``"lower"`` or ``"upper"``, for the inputs at a bound.
-    message : str
-    iterations, equilibria : int
-    """
-
-    inputs: tuple
-    values: np.ndarray = field(repr=False)
-    tensions: dict
-    displacements: dict
-    insertions: dict
-    driven: dict
-    state: np.ndarray = field(repr=False)
-    tips: dict = field(repr=False)
-    poses: dict = field(repr=False)
-    residual: float
-    tip_errors: dict
-    direction_errors: dict
-    marker_errors: dict
-    position_errors: dict
-    rotation_errors: dict
-    reachable: bool
-    active: dict
-    message: str
-    iterations: int
-    equilibria: int
-
-    def apply(self, system, ramp=None):
-        """``system`` with the found inputs: each rod's cables as a fit of the rod
-        (:meth:`StaticFit.apply`), each driven body's initial pose the found one, and
-        each inserted rod's base sliding along its axis by its insertion over the first
-        ``ramp`` seconds (smoothly, from rest to rest; a System's rods start where its
-        joints meet them at rest, so an inserted base cannot start inserted): for
-        ``simulate`` to settle into the found equilibrium."""
-        rods = {}
-        for name, model in system.given_rods.items():
-            rods[name] = with_cables(model, self.tensions.get(name, {}), self.displacements.get(name, {}))
-        moved = {name: d for name, d in self.insertions.items() if d != 0.0}
-        if moved:
-            if ramp is None:
-                raise ParameterError(f"the fit inserts {', '.join(map(repr, moved))}: give `ramp`, the time [s] "
-                                     "over which the bases slide there (a System starts with its rods where its "
-                                     "joints meet them at rest)")
-            ramp = _checks.positive("ramp", ramp, " s")
-            for name, d in moved.items():
-                rods[name] = rods[name].replace(base=replace(rods[name].base, velocity=_Slide(d, ramp)))
-        bodies = {}
-        for name, (position, rotation) in self.driven.items():
-            body = system.bodies[name]
-            motion = replace(body.motion, position=tuple(position.tolist()), rotation=tuple(map(tuple, rotation)))
-            bodies[name] = replace(body, motion=motion, position=None, rotation=None)
-        return system.replace(rods=rods, bodies=bodies)
-
-
-class _Slide:
-    """A base's velocity [m/s], local frame, sliding it along its x axis by ``distance`` [m]
-    over ``duration`` [s]: d (1 - cos(pi t / T)) / 2, from rest to rest."""
-
-    def __init__(self, distance, duration):
-        self.distance, self.duration = distance, duration
-
-    def __call__(self, t):
-        rate = 0.0
-        if 0.0 <= t < self.duration:
-            rate = 0.5 * np.pi * self.distance / self.duration * np.sin(np.pi * t / self.duration)
-        return np.array([rate, 0.0, 0.0])
 
 
 def fit_system(system, tip=None, *, direction=None, markers=None, pose=None, bounds=(0.0, np.inf), cables=None,
@@ -214,7 +104,7 @@ def fit_system(system, tip=None, *, direction=None, markers=None, pose=None, bou
     tol = _checks.positive("tol", tol, " m")
     max_iter = _checks.integer_at_least("max_iter", max_iter, 0)
     problem = _SystemProblem(system, cables, insertions, driven, bounds, travel, t, scheme)
-    problem.targets = _SystemTargets(system, problem.assembly, tip, direction, markers, pose, direction_weight,
+    problem.targets = SystemTargets(system, problem.assembly, tip, direction, markers, pose, direction_weight,
                                      marker_weight)
     inputs = problem.start(start)
     problem.check_held()
@@ -281,7 +171,7 @@ class _SystemProblem:
 
     def _insertions(self, insertions):
         system = self.system
-        names = _distinct("insertions", insertions, system.rods, "rod")
+        names = distinct("insertions", insertions, system.rods, "rod")
         for name in names:
             body = system.clamps.get(name, (None,))[0]
             where = ("pinned or joined to another rod" if name in system.base_bodies else
@@ -294,7 +184,7 @@ class _SystemProblem:
 
     def _driven(self, driven):
         bodies = self.system.bodies
-        names = _distinct("driven", driven, bodies, "body")
+        names = distinct("driven", driven, bodies, "body")
         for name in names:
             if not bodies[name].driven:
                 raise ParameterError(f"`driven`: body {name!r} is {bodies[name].motion!r}, not driven (a "
@@ -456,124 +346,3 @@ class _SystemProblem:
                          displacements, dict(zip(self.inserted, insertions.tolist())),
                          {name: poses[name] for name in self.driven}, y, tips, poses, residual,
                          *errors, residual <= tol, active, message, iterations, self.equilibria)
-
-
-def _distinct(what, value, pool, kind):
-    """The names ``value`` gives (a name or names; None: none), each in ``pool``, distinct."""
-    if value is None:
-        return []
-    names = [value] if isinstance(value, str) else list(value)
-    if len(set(names)) != len(names):
-        raise ParameterError(f"`{what}` must name distinct {kind}s, got {_checks.short(value)}")
-    for name in names:
-        if name not in pool:
-            raise ParameterError(f"`{what}`: no {kind} named {name!r} in the system" + _checks.did_you_mean(name, pool))
-    return names
-
-
-class _SystemTargets:
-    """The outputs aimed at: each rod's (:class:`Targets`), then each body's position and
-    w_d times its rotation's difference from the target's (a rotation vector, global)."""
-
-    def __init__(self, system, assembly, tip, direction, markers, pose, direction_weight, marker_weight):
-        self.assembly = assembly
-        given = {}
-        for what, value in (("tip", tip), ("direction", direction), ("markers", markers)):
-            if value is None:
-                continue
-            if not isinstance(value, dict) or not value:
-                raise ParameterError(f"`{what}` must map rod names to targets, got {_checks.short(value)}")
-            for name, aim in value.items():
-                if name not in system.rods:
-                    raise ParameterError(f"`{what}`: no rod named {name!r} in the system"
-                                         + _checks.did_you_mean(name, system.rods))
-                given.setdefault(name, {})[what] = aim
-        marker_weight = _checks.positive("marker_weight", marker_weight)
-        if direction_weight is not None:
-            direction_weight = _checks.positive("direction_weight", direction_weight, " m")
-        self.rods, self.tips, parts = {}, {}, []
-        for name in system.rods:  # in the system's order
-            if name not in given:
-                continue
-            model, aims = system.rods[name], given[name]
-            try:
-                point, tangent, names, positions = check_aims(model, aims.get("tip"), aims.get("direction"),
-                                                              aims.get("markers"))
-            except ParameterError as exc:
-                raise ParameterError(f"rod {name!r}: {exc}") from None
-            weight = model.rod.length if direction_weight is None else direction_weight
-            targets = Targets(model, assembly.rods[name].layout, point is not None, tangent is not None, names,
-                              weight, marker_weight)
-            self.rods[name] = targets
-            parts.append(targets.aim(point, tangent, positions))
-            if point is not None:
-                self.tips[name] = point
-        self.bodies = self._poses(system, pose)
-        self.weight = (max(m.rod.length for m in system.rods.values()) if direction_weight is None
-                       else direction_weight)
-        parts += [target for target, _ in self.bodies.values()]
-        parts += [np.zeros(3) for _, rotation in self.bodies.values() if rotation is not None]
-        if not parts:
-            raise ParameterError("give a target: `tip`, `direction`, `markers` or `pose`")
-        self.aim = np.concatenate(parts)
-
-    @staticmethod
-    def _poses(system, pose):
-        """{body: (position (3,), rotation (3, 3) or None)} of the checked ``pose``."""
-        if pose is None:
-            return {}
-        if not isinstance(pose, dict) or not pose:
-            raise ParameterError(f"`pose` must map body names to a position or (position, rotation), got "
-                                 f"{_checks.short(pose)}")
-        out = {}
-        for name, value in pose.items():
-            if name not in system.bodies:
-                raise ParameterError(f"`pose`: no body named {name!r} in the system"
-                                     + _checks.did_you_mean(name, system.bodies))
-            arr = _checks.floats(value)
-            if arr is not None and arr.shape == (3,):
-                out[name] = (_checks.vector3(f"pose[{name!r}]", value), None)
-                continue
-            try:
-                position, rotation = value
-            except (TypeError, ValueError):
-                raise ParameterError(f"`pose[{name!r}]` must be a position (3,) [m] or (position, rotation "
-                                     f"(3, 3)), got {_checks.short(value)}") from None
-            out[name] = (_checks.vector3(f"pose[{name!r}] position", position),
-                         _checks.rotation(f"pose[{name!r}] rotation", rotation))
-        return out
-
-    def _body(self, y, name):
-        part = self.assembly.bodies[name]
-        return y[part.fields["x"]], rotations.matrices(y[part.fields["Q"]])
-
-    def values(self, y):
-        parts = [targets.values(y[self.assembly.parts[name]]) for name, targets in self.rods.items()]
-        parts += [self._body(y, name)[0] for name in self.bodies]
-        for name, (_, rotation) in self.bodies.items():
-            if rotation is not None:
-                turn = self._body(y, name)[1] @ rotation.T
-                parts.append(self.weight * Rotation.from_matrix(turn).as_rotvec())
-        return np.concatenate(parts)
-
-    def errors(self, y):
-        """({rod: tip error}, {rod: angle}, {rod: {marker: error}}, {body: position error},
-        {body: rotation error})."""
-        tips, angles, marks, k = {}, {}, {}, 0
-        for name, targets in self.rods.items():
-            aim = self.aim[k:k + targets.size]
-            k += targets.size
-            tip, angle, found = targets.errors(y[self.assembly.parts[name]], aim)
-            if tip is not None:
-                tips[name] = tip
-            if angle is not None:
-                angles[name] = angle
-            if found:
-                marks[name] = found
-        positions, turns = {}, {}
-        for name, (target, rotation) in self.bodies.items():
-            position, matrix = self._body(y, name)
-            positions[name] = float(np.linalg.norm(position - target))
-            if rotation is not None:
-                turns[name] = float(np.linalg.norm(Rotation.from_matrix(matrix @ rotation.T).as_rotvec()))
-        return tips, angles, marks, positions, turns
