@@ -58,20 +58,20 @@ the segments' at their clamps) and quadratic drag.
 """
 
 import numpy as np
-from scipy import sparse
 
 from ..inputs import knot_times
 from .body_joints import BodyJointPart, body_joint_frequency
-from .body_part import BodyPart, clamp_velocities, cross, first_element
+from .body_part import BodyPart, clamp_velocities, cross
 from .contact_parts import contact_parts
-from .joints import JOINT_COLUMNS, JOINT_ROWS, JointPart, RecordedJoints, RodJointPart
+from .joints import JointPart, RecordedJoints, RodJointPart
 from .physics import quaternion_rate
 from .protocol import pattern_bandwidths
 from .rigid import clamp_wrench, free_body_rates
 from .rotations import from_matrix, matrices
-from .state_checks import LIMITS, OK, describe, least_stretch, scan_parts
+from .state_checks import least_stretch, parts_problem, parts_step_problem
 from .stencil import WORK_TOTAL
 from .system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE, SemiDiscrete, field_scales
+from .system_jacobian import assembly_pattern
 from .system_state_view import SystemStateView
 
 
@@ -133,7 +133,7 @@ class Assembly:
                 part.body_joints.append(joint)
         self.free = [p for p in self.bodies.values() if p.body.free]
         self.lightly_damped = any(sd.lightly_damped for sd in self.rods.values())
-        self._scan = None  # the arguments of step_problem's compiled scan, made at its first call
+        self.scan_arguments = None  # the step check's compiled scan arguments, made at its first call
         self._gravity = np.ascontiguousarray(system.gravity, dtype=float)
 
     def _rod_base(self, name):
@@ -313,37 +313,9 @@ class Assembly:
     # ------------------------------------------------------------------ structure
 
     def pattern(self):
-        """Structural Jacobian pattern (scipy CSC, size x size): each rod's
-        pattern on the diagonal, each body's block (:func:`_body_pattern`), and for each rod clamped
-        to a free body its header and first element against the body's
-        velocities, and the body's velocity rows against that element."""
-        blocks = [sparse.csr_matrix(sd.pattern()) for sd in self.rods.values()]
-        blocks += [sparse.csr_matrix(_body_pattern(p)) for p in self.bodies.values()]
-        pat = sparse.block_diag(blocks, format="lil", dtype=bool)
-        for part in self.free:
-            velocity = np.r_[part.fields["v"], part.fields["w"]]
-            for name, sd in zip(part.rods, part.systems):
-                start = self.parts[name].start
-                first = first_element(start, sd)
-                pat[np.ix_(first, velocity)] = True
-                pat[np.ix_(velocity, first)] = True
-        for joint in self.joints:
-            body = joint.part.slice
-            rows = joint.node + JOINT_ROWS
-            pat[np.ix_(rows, np.arange(body.start, body.stop))] = True
-            if joint.part.body.free:
-                node = joint.node + JOINT_COLUMNS
-                velocity = np.r_[joint.part.fields["v"], joint.part.fields["w"]]
-                pat[np.ix_(velocity, node)] = True
-        for joint in self.rod_joints:  # each side: its node's velocity rows against the partner node
-            pat[np.ix_(joint.node + JOINT_ROWS, joint.partner_fields)] = True
-        for joint in self.body_joints:  # each free body's velocity rows against the other's block
-            for part in joint.parts:
-                for other in joint.parts:
-                    if part.body.free:
-                        velocity = np.r_[part.fields["v"], part.fields["w"]]
-                        pat[np.ix_(velocity, np.arange(other.slice.start, other.slice.stop))] = True
-        return pat.tocsc()
+        """Structural Jacobian pattern (scipy CSC, size x size):
+        :func:`rodmol.discretise.system_jacobian.assembly_pattern`."""
+        return assembly_pattern(self)
 
     def bandwidths(self):
         """(lower, upper) half-bandwidths of :meth:`pattern`."""
@@ -405,41 +377,12 @@ class Assembly:
     def state_problem(self, t, y):
         """What is wrong with the state ``y`` at ``t`` [s]: each rod's part as a single rod's
         state (the message names the rod), the bodies' entries for finiteness; or None."""
-        return self._problem("state_problem", t, y)
+        return parts_problem(self, "state_problem", t, y)
 
     def step_problem(self, t, y):
-        """:meth:`state_problem` after a step of a run, and each rod's tip section
-        (``SemiDiscrete.tip_problem``). The rods' scans and the bodies' entries are one
-        compiled call (:func:`rodmol.discretise.state_checks.scan_parts`): this runs at every step."""
-        if self._scan is None:
-            rods = list(self.rods.values())
-            self._scan = (np.array([self.parts[name].start for name in self.rods], dtype=np.int64),
-                          np.array([sd.model.n_elements for sd in rods], dtype=np.int64),
-                          np.array([sd.model.ds for sd in rods]),
-                          min((p.slice.start for p in self.bodies.values()), default=self.size), *LIMITS)
-        part, code, i, value = scan_parts(y, *self._scan)
-        if code != OK:
-            if part < len(self.rods):
-                name = list(self.rods)[part]
-                sd = self.rods[name]
-                return f"rod {name!r}: {describe(sd.layout, sd.model.ds, t, code, i, value)}"
-            return self._problem("state_problem", t, y)  # a body's: named as the state check names it
-        for name, sd in self.rods.items():
-            if sd.tip_anchored:
-                problem = sd.tip_problem(t, y[self.parts[name]])
-                if problem:
-                    return f"rod {name!r}: {problem}"
-        return None
-
-    def _problem(self, check, t, y):
-        for name, sd in self.rods.items():
-            problem = getattr(sd, check)(t, y[self.parts[name]])
-            if problem:
-                return f"rod {name!r}: {problem}"
-        for name, part in self.bodies.items():
-            if not np.all(np.isfinite(y[part.slice])):
-                return f"the state of body {name!r} became non-finite at t = {t:.6g} s: the solution blew up"
-        return None
+        """:meth:`state_problem` after a step of a run, and each rod's tip section, in one
+        compiled scan (:func:`rodmol.discretise.state_checks.parts_step_problem`)."""
+        return parts_step_problem(self, t, y)
 
     def describe_stall(self, y):
         """The stall's diagnosis of the most compressed rod (its ``describe_stall``), naming it."""
@@ -468,19 +411,3 @@ class Assembly:
             linear += r @ momentum[:3]
             angular += cross(y[part.fields["x"]], r @ momentum[:3]) + r @ momentum[3:]
         return linear, angular
-
-
-def _body_pattern(part):
-    """A body block's own coupling: its quaternion rates read Q (the restoring
-    term), its position rates Q unless it is fixed, and a free body's pose
-    rates its velocities; its velocity rates read everything (gravity's
-    direction, gyroscopic terms)."""
-    sl, size = part.layout.slices(), part.layout.size
-    pat = np.zeros((size, size), dtype=bool)
-    pat[sl["Q"], sl["Q"]] = True
-    if part.body.motion != "fixed":
-        pat[sl["x"], sl["Q"]] = True
-    if "v" in sl:
-        pat[sl["x"], sl["v"]] = pat[sl["Q"], sl["w"]] = True
-        pat[sl["v"].start:, :] = True
-    return pat

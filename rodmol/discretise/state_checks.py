@@ -152,3 +152,41 @@ def describe(layout, ds, t, code, i, value):
         return (f"the orientation of node {i + 1} lost its unit norm (|Q| = {value:.3g}) {at}: "
                 "the solution blew up")
     return None
+
+
+def parts_problem(assembly, check, t, y):
+    """What a system's ``check`` (``"state_problem"``) finds in each rod's part of ``y`` (the
+    message names the rod), else a body's non-finite entries; or None."""
+    for name, sd in assembly.rods.items():
+        problem = getattr(sd, check)(t, y[assembly.parts[name]])
+        if problem:
+            return f"rod {name!r}: {problem}"
+    for name, part in assembly.bodies.items():
+        if not np.all(np.isfinite(y[part.slice])):
+            return f"the state of body {name!r} became non-finite at t = {t:.6g} s: the solution blew up"
+    return None
+
+
+def parts_step_problem(assembly, t, y):
+    """:func:`parts_problem` after a step of a run, and each rod's tip section
+    (``SemiDiscrete.tip_problem``). The rods' scans and the bodies' entries are one compiled
+    call (:func:`scan_parts`, its arguments kept on the assembly): this runs at every step."""
+    if assembly.scan_arguments is None:
+        rods = list(assembly.rods.values())
+        assembly.scan_arguments = (np.array([assembly.parts[name].start for name in assembly.rods], dtype=np.int64),
+                          np.array([sd.model.n_elements for sd in rods], dtype=np.int64),
+                          np.array([sd.model.ds for sd in rods]),
+                          min((p.slice.start for p in assembly.bodies.values()), default=assembly.size), *LIMITS)
+    part, code, i, value = scan_parts(y, *assembly.scan_arguments)
+    if code != OK:
+        if part < len(assembly.rods):
+            name = list(assembly.rods)[part]
+            sd = assembly.rods[name]
+            return f"rod {name!r}: {describe(sd.layout, sd.model.ds, t, code, i, value)}"
+        return parts_problem(assembly, "state_problem", t, y)  # a body's: named as the state check names it
+    for name, sd in assembly.rods.items():
+        if sd.tip_anchored:
+            problem = sd.tip_problem(t, y[assembly.parts[name]])
+            if problem:
+                return f"rod {name!r}: {problem}"
+    return None

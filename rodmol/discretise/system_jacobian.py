@@ -11,6 +11,10 @@ coupling blocks a few more.
 """
 
 import numpy as np
+from scipy import sparse
+
+from .body_part import first_element
+from .joints import JOINT_COLUMNS, JOINT_ROWS
 
 #: Relative step of the differences, times max(|y_j|, the entry's scale).
 STEP = np.sqrt(np.finfo(float).eps)
@@ -78,3 +82,54 @@ class SystemJacobian:
         matrix = self.sparsity.astype(float)
         self(t, y, fy, matrix.data)
         return matrix.toarray()
+
+
+def assembly_pattern(assembly):
+    """An :class:`~rodmol.discretise.assembly.Assembly`'s structural Jacobian pattern (scipy
+    CSC, size x size): each rod's
+    pattern on the diagonal, each body's block (:func:`_body_pattern`), and for each rod clamped
+    to a free body its header and first element against the body's
+    velocities, and the body's velocity rows against that element."""
+    blocks = [sparse.csr_matrix(sd.pattern()) for sd in assembly.rods.values()]
+    blocks += [sparse.csr_matrix(_body_pattern(p)) for p in assembly.bodies.values()]
+    pat = sparse.block_diag(blocks, format="lil", dtype=bool)
+    for part in assembly.free:
+        velocity = np.r_[part.fields["v"], part.fields["w"]]
+        for name, sd in zip(part.rods, part.systems):
+            start = assembly.parts[name].start
+            first = first_element(start, sd)
+            pat[np.ix_(first, velocity)] = True
+            pat[np.ix_(velocity, first)] = True
+    for joint in assembly.joints:
+        body = joint.part.slice
+        rows = joint.node + JOINT_ROWS
+        pat[np.ix_(rows, np.arange(body.start, body.stop))] = True
+        if joint.part.body.free:
+            node = joint.node + JOINT_COLUMNS
+            velocity = np.r_[joint.part.fields["v"], joint.part.fields["w"]]
+            pat[np.ix_(velocity, node)] = True
+    for joint in assembly.rod_joints:  # each side: its node's velocity rows against the partner node
+        pat[np.ix_(joint.node + JOINT_ROWS, joint.partner_fields)] = True
+    for joint in assembly.body_joints:  # each free body's velocity rows against the other's block
+        for part in joint.parts:
+            for other in joint.parts:
+                if part.body.free:
+                    velocity = np.r_[part.fields["v"], part.fields["w"]]
+                    pat[np.ix_(velocity, np.arange(other.slice.start, other.slice.stop))] = True
+    return pat.tocsc()
+
+
+def _body_pattern(part):
+    """A body block's own coupling: its quaternion rates read Q (the restoring
+    term), its position rates Q unless it is fixed, and a free body's pose
+    rates its velocities; its velocity rates read everything (gravity's
+    direction, gyroscopic terms)."""
+    sl, size = part.layout.slices(), part.layout.size
+    pat = np.zeros((size, size), dtype=bool)
+    pat[sl["Q"], sl["Q"]] = True
+    if part.body.motion != "fixed":
+        pat[sl["x"], sl["Q"]] = True
+    if "v" in sl:
+        pat[sl["x"], sl["v"]] = pat[sl["Q"], sl["w"]] = True
+        pat[sl["v"].start:, :] = True
+    return pat
