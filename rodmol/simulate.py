@@ -31,7 +31,7 @@ RESUMING = ("resume_point", "check", "record_settings")
 
 def default_atol(model, rtol):
     """Per-variable absolute tolerances: ``rtol`` times the typical size of
-    each field (``rodmol.discretise.system.field_scales``: positions L,
+    each field (``rodmol.discretise.rod_scales.field_scales``: positions L,
     strains 1, curvatures 1/L, velocities L/T, angular velocities L/(T r_min)
     with T the first bending period), so that every field's error moves the
     rod by about ``rtol`` L: ``rtol`` times the system's own

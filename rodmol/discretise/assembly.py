@@ -67,10 +67,11 @@ from .joints import JointPart, RecordedJoints, RodJointPart
 from .physics import quaternion_rate
 from .protocol import pattern_bandwidths
 from .rigid import clamp_wrench, free_body_rates
+from .rod_scales import field_scales
 from .rotations import from_matrix, matrices
 from .state_checks import least_stretch, parts_problem, parts_step_problem
 from .stencil import WORK_TOTAL
-from .system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE, SemiDiscrete, field_scales
+from .system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE, SemiDiscrete
 from .system_jacobian import assembly_pattern
 from .system_state_view import SystemStateView
 

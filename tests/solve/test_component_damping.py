@@ -7,8 +7,9 @@ import pytest
 from vibration import measure_free_vibration
 
 import rodmol
+from rodmol.discretise.rod_scales import grid_damping_ratio
 from rodmol.discretise.sampling import Sampled
-from rodmol.discretise.system import SemiDiscrete, grid_damping_ratio
+from rodmol.discretise.system import SemiDiscrete
 
 L, RADIUS, E, RHO = 0.3, 0.01, 1e5, 1000.0  # m, m, Pa, kg/m^3
 ETA_BENDING = 600.0  # Pa s: relaxation time 6 ms
