@@ -18,7 +18,7 @@ from gymnasium import spaces
 from .. import _checks
 from ..errors import IntegrationError, ParameterError
 from . import envs
-from .envs import ResetNeeded, action_tensions
+from .envs import ResetNeeded, action_tensions, episode_end
 from .octopus import ARMS, octopus
 from .simulator import Simulator
 
@@ -140,10 +140,7 @@ class OctopusCrawlEnv(gymnasium.Env):
         speed = (float(state["head"].position[0]) - x_before) / self.period
         reward = speed - self.effort_weight * float(tensions @ tensions)
         info["speed"] = speed
-        truncated = self._steps >= self.episode_steps and not terminated
-        if terminated or truncated:
-            self._ended = (f"after the episode was {'terminated' if terminated else 'truncated'} "
-                           f"at step {self._steps}")
+        truncated, self._ended = episode_end(self._steps, self.episode_steps, terminated)
         return self._observation(state), reward, terminated, truncated, info
 
     def _observation(self, state):

@@ -70,6 +70,15 @@ OPTIONS = {
 }
 
 
+def episode_end(steps, episode_steps, terminated):
+    """(truncated, why a further ``step`` must wait for ``reset`` or None) after step ``steps``
+    of an episode of ``episode_steps``: every environment's one rule."""
+    truncated = steps >= episode_steps and not terminated
+    if not (terminated or truncated):
+        return truncated, None
+    return truncated, f"after the episode was {'terminated' if terminated else 'truncated'} at step {steps}"
+
+
 class ReachEnv(gymnasium.Env):
     """Reach a target with the tip of the paper's arm in water, pulling its 12 cables.
 
@@ -212,10 +221,7 @@ class ReachEnv(gymnasium.Env):
         distance = float(np.linalg.norm(state.tip - self.target))
         reward = -distance - self.effort_weight * float(tensions @ tensions)
         info["distance"] = distance
-        truncated = self._steps >= self.episode_steps and not terminated
-        if terminated or truncated:
-            self._ended = (f"after the episode was {'terminated' if terminated else 'truncated'} "
-                           f"at step {self._steps}")
+        truncated, self._ended = episode_end(self._steps, self.episode_steps, terminated)
         return self._observation(state), reward, terminated, truncated, info
 
     def close(self):
