@@ -246,7 +246,7 @@ def solver_options(system, rtol, atol, linsolver="auto", max_step=0.0, jacobian=
                    max_nonlin_iters=3):
     """scikit-sundae's ``CVODE`` options for ``system`` (see :func:`rodmol.solve.cvode.cvode` for the
     arguments): returns (options, the linear solver chosen, the preconditioner or None)."""
-    from sksundae.cvode import CVODEPrecond
+    from sksundae.cvode import CVODEJacTimes, CVODEPrecond
 
     linsolver = linear_solver(system, linsolver)
     if jacobian == "auto":
@@ -267,6 +267,8 @@ def solver_options(system, rtol, atol, linsolver="auto", max_step=0.0, jacobian=
         precond = system.preconditioner(scale)
         options["precond"] = CVODEPrecond(precond.setup, precond.solve, "left")
         options["krylov_dim"] = KRYLOV_DIM
+        if hasattr(system, "jacobian_times"):  # its own products J v (a system with sensitivities)
+            options["jactimes"] = CVODEJacTimes(None, system.jacobian_times(scale))
     elif linsolver in ("band", "lapackband"):
         options["lband"], options["uband"] = system.bandwidths()
     if jacobian == "compiled" and linsolver != "gmres":
