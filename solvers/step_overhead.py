@@ -11,14 +11,17 @@ at N = 100 and at N = 30, CVODE with the default linear solver. Three parts:
 2. Cost per call (best of 7 batches): each compiled kernel bare and through
    its Python caller, one scikit-sundae interpolation call and one repeated
    one-step call, rodmol's per-step checks.
-3. The whole run three ways, interleaved, median: rodmol's driver
+3. The whole run three ways, interleaved, median of the CPU time (the
+   process's, from the first step to the last output, ``_common.run_cpu``:
+   on a shared machine the wall time counts the other jobs' time slices
+   too): rodmol's driver
    (``rodmol.solve.backends.cvode``); a bare loop of one-step calls with the
    same solver options and outputs (no watch, no output store, the system
    itself as the right-hand side); the same loop without the outputs
    (states at the steps' ends only, so no interpolation and no repeated
    step). The differences are the cost of rodmol's loop and of the outputs.
 
-The table multiplies (1) by (2); what is left of the run's wall time is
+The table multiplies (1) by (2); what is left of the driver's CPU time is
 CVODE's own work in C (vector operations, BDF, GMRES) and scikit-sundae's
 Cython wrappers of the callbacks, which cannot be timed apart from Python.
 
@@ -148,8 +151,8 @@ def costs(system, y0, rtol, atol, calls):
 
 
 def bare_loop(system, y0, t_out, rtol, atol, outputs=True):
-    """Wall time [s] of a bare one-step loop with rodmol's solver options: the outputs
-    interpolated (``outputs``) or only the steps' ends kept."""
+    """CPU time [s] of a bare one-step loop with rodmol's solver options, from the first
+    step on: the outputs interpolated (``outputs``) or only the steps' ends kept."""
     from sksundae.cvode import CVODE
 
     options, _, _ = solver_options(system, rtol, atol)
@@ -158,7 +161,7 @@ def bare_loop(system, y0, t_out, rtol, atol, outputs=True):
     t_end = float(t_out[-1])
     ys = np.empty((len(t_out), len(y0)))
     solver.init_step(float(t_out[0]), y0)
-    start = time.perf_counter()  # as rodmol's wall time: from the first step on
+    start = time.process_time()
     k, reached = 1, float(t_out[0])
     while reached < t_end:
         j = np.searchsorted(knots, reached, side="right")
@@ -170,7 +173,13 @@ def bare_loop(system, y0, t_out, rtol, atol, outputs=True):
         while k < len(t_out) and t_out[k] <= r.t:
             ys[k] = solver.step(float(t_out[k])).y if outputs else r.y
             k += 1
-    return time.perf_counter() - start
+    return time.process_time() - start
+
+
+def driver(system, y0, t_out, rtol):
+    """(CPU time [s] of rodmol's driver from its first step on; its solver wall time [s])."""
+    raw, cpu = C.run_cpu(C.cvode, system, y0, t_out, rtol)
+    return cpu, raw.stats["wall_time_s"]
 
 
 def study(n, t_end, reps, calls):
@@ -183,12 +192,15 @@ def study(n, t_end, reps, calls):
     C.warm_up(system, y0)
     raw, count = counts(system, y0, t_out, rtol, atol)
     us = costs(system, y0, rtol, atol, calls)
-    walls = {"rodmol's driver": [], "bare loop, outputs interpolated": [], "bare loop, no outputs": []}
+    cpu = {"rodmol's driver": [], "bare loop, outputs interpolated": [], "bare loop, no outputs": []}
+    walls = []
     for _ in range(reps):
-        walls["rodmol's driver"].append(C.run(C.cvode, system, y0, t_out, rtol).stats["wall_time_s"])
-        walls["bare loop, outputs interpolated"].append(bare_loop(system, y0, t_out, rtol, atol))
-        walls["bare loop, no outputs"].append(bare_loop(system, y0, t_out, rtol, atol, outputs=False))
-    wall = {k: float(np.median(v)) for k, v in walls.items()}
+        c, w = driver(system, y0, t_out, rtol)
+        cpu["rodmol's driver"].append(c)
+        walls.append(w)
+        cpu["bare loop, outputs interpolated"].append(bare_loop(system, y0, t_out, rtol, atol))
+        cpu["bare loop, no outputs"].append(bare_loop(system, y0, t_out, rtol, atol, outputs=False))
+    wall = {k: float(np.median(v)) for k, v in cpu.items()}
     total = wall["rodmol's driver"]
     linsolver = raw.stats["linear_solver"]
 
@@ -198,11 +210,11 @@ def study(n, t_end, reps, calls):
                     us_per_step=ms * 1e3 / count["steps"])
 
     rows = [row("right-hand side, kernel", count["rhs"], us["rhs kernel"]),
-            row("right-hand side, rodmol's Python around it", count["rhs"],
-                us["rhs through the Stepper (rodmol's callback)"] - us["rhs kernel"])]
+            row("right-hand side, the system's Python around it (inputs, dispatch)", count["rhs"],
+                us["rhs through SemiDiscrete"] - us["rhs kernel"])]
     if "preconditioner solve kernel" in us:
         rows += [row("preconditioner solve, kernel", count["psolves"], us["preconditioner solve kernel"]),
-                 row("preconditioner solve, rodmol's Python around it", count["psolves"],
+                 row("preconditioner solve, the Python around it", count["psolves"],
                      us["preconditioner solve (rodmol's callback)"] - us["preconditioner solve kernel"]),
                  row("preconditioner setup (factor)", count["psetups"],
                      us["preconditioner setup, Jacobian kept (factor)"]),
@@ -212,14 +224,15 @@ def study(n, t_end, reps, calls):
                  us["scikit-sundae repeated one-step call"]),
              row("scikit-sundae interpolation calls", count["interpolations"],
                  us["scikit-sundae interpolation call"]),
-             row("rodmol's loop: checks, outputs (driver - bare loop)", count["onestep"], float("nan"),
+             row("rodmol's loop: checks, output store, the Stepper's callback (driver - bare loop)",
+                 count["onestep"], float("nan"),
                  (total - wall["bare loop, outputs interpolated"]) * 1e3)]
     known = sum(r["ms_per_run"] for r in rows)
     rows.append(row("CVODE in C, scikit-sundae's callback wrappers and step calls (the rest)", count["steps"],
                     float("nan"), total * 1e3 - known))
-    rows.append(row("whole run (solver wall time)", count["steps"], float("nan"), total * 1e3))
-    summary = dict(N=n, linear_solver=linsolver, wall_ms=total * 1e3, realtime=t_end / total,
-                   us_per_step=total * 1e6 / count["steps"],
+    rows.append(row("whole run (rodmol's driver, CPU time)", count["steps"], float("nan"), total * 1e3))
+    summary = dict(N=n, linear_solver=linsolver, cpu_ms=total * 1e3, realtime_cpu=t_end / total,
+                   solver_wall_ms=float(np.median(walls)) * 1e3, us_per_step=total * 1e6 / count["steps"],
                    bare_loop_ms=wall["bare loop, outputs interpolated"] * 1e3,
                    bare_loop_no_outputs_ms=wall["bare loop, no outputs"] * 1e3, **count)
     print(summary, flush=True)
@@ -244,13 +257,14 @@ def main(argv=None):
         summaries.append(s)
         call_rows += c
     base = os.path.join(args.out, "step_overhead")
-    note = (f"bending test, {t_end:g} s, default scheme and rtol, outputs every 10 ms; wall times: medians of "
-            f"{args.reps} interleaved runs; per call: best of 7 batches of {calls // 7}")
+    note = (f"bending test, {t_end:g} s, default scheme and rtol, outputs every 10 ms; whole runs: CPU time, "
+            f"medians of {args.reps} interleaved runs (solver_wall_ms: the driver's wall time, median); per call: "
+            f"best of 7 batches of {calls // 7}")
     C.write_csv(base + ".csv", rows, header + [note])
     C.write_csv(base + "_runs.csv", summaries, header + [note])
     C.write_csv(base + "_calls.csv", call_rows, header + [note])
-    fmt = {"us_per_call": ".2f", "ms_per_run": ".2f", "share": ".1%", "us_per_step": ".1f", "wall_ms": ".1f",
-           "realtime": ".0f", "bare_loop_ms": ".1f", "bare_loop_no_outputs_ms": ".1f", "microseconds": ".2f"}
+    fmt = {"us_per_call": ".2f", "ms_per_run": ".2f", "share": ".1%", "us_per_step": ".1f", "cpu_ms": ".1f",
+           "solver_wall_ms": ".1f", "realtime_cpu": ".0f", "bare_loop_ms": ".1f", "bare_loop_no_outputs_ms": ".1f", "microseconds": ".2f"}
     sections = [("Runs", note + "\n\n" + C.markdown_table(summaries, None, fmt)),
                 ("Where the time goes", C.markdown_table(rows, None, fmt)),
                 ("Per call", C.markdown_table(call_rows, None, fmt))]
