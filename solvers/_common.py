@@ -227,27 +227,14 @@ def run(backend, system, y0, t_out, rtol, **options):
 
 def run_cpu(backend, system, y0, t_out, rtol, **options):
     """One integration (:func:`run`) and its CPU time [s] over the span of its ``wall_time_s``
-    (the output store's start to the solution: the steps, not building the solver). On a
-    shared machine the wall time counts the other jobs' time slices too; the CPU time of
-    this single-threaded process does not."""
+    (the steps, not building the solver; :func:`_cpu_span.cpu_span`)."""
+    from _cpu_span import cpu_span
+
     from rodmol.solve import outputs
 
-    init, solution, span = outputs.Outputs.__init__, outputs.Outputs.solution, {}
-
-    def starting(store, *args, **kwargs):
-        init(store, *args, **kwargs)
-        span["start"] = time.process_time()
-
-    def ending(store, *args, **kwargs):
-        span["end"] = time.process_time()
-        return solution(store, *args, **kwargs)
-
-    outputs.Outputs.__init__, outputs.Outputs.solution = starting, ending
-    try:
+    with cpu_span(outputs) as span:
         raw = run(backend, system, y0, t_out, rtol, **options)
-    finally:
-        outputs.Outputs.__init__, outputs.Outputs.solution = init, solution
-    return raw, span["end"] - span["start"]
+    return raw, span["cpu_s"]
 
 
 def timed(backend, system, y0, t_out, rtol, reps, **options):

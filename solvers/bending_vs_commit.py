@@ -5,8 +5,9 @@ options of each version, in two long-lived worker subprocesses (the old
 package extracted by ``_common.package_tree``, the new one this working
 tree; ``core_speed.Version``), both warmed up before anything is timed, the
 repetitions alternating (old, new, new, old, ...). Reported: the solver's
-wall time (``stats["wall_time_s"]``) and the whole ``simulate`` call (wall and
-CPU time: on a shared machine the wall time counts the other jobs' slices), min
+wall time (``stats["wall_time_s"]``) and CPU time over the same span
+(``_cpu_span``: on a shared machine the wall time counts the other jobs' time
+slices too) and the whole ``simulate`` call's wall and CPU time, min
 and median per version, and the median over repetitions of new/old within
 each (the two ran back to back, so they saw the same load); steps and
 right-hand sides; the largest distance between the two tip trajectories.
@@ -49,14 +50,20 @@ class _Worker:
     def simulate(self, tip_path=None):
         import gc
 
+        from _cpu_span import cpu_span
+
+        from rodmol.solve import outputs
+
         gc.collect()
         t0, c0 = time.perf_counter(), time.process_time()
-        res = self.rodmol.simulate(self.model, self.t_end)
+        with cpu_span(outputs) as span:
+            res = self.rodmol.simulate(self.model, self.t_end)
         total, cpu = time.perf_counter() - t0, time.process_time() - c0
         if tip_path:
             self.np.save(tip_path, self.np.column_stack([res.t, res.tip]))
         st = res.stats
-        return dict(wall_time_s=float(st["wall_time_s"]), simulate_s=total, simulate_cpu_s=cpu, steps=int(st["steps"]),
+        return dict(wall_time_s=float(st["wall_time_s"]), solver_cpu_s=span["cpu_s"], simulate_s=total,
+                    simulate_cpu_s=cpu, steps=int(st["steps"]),
                     rhs_evals=int(st["rhs_evals"]), success=bool(res.success))
 
 
@@ -107,7 +114,8 @@ def main(argv=None):
     m = min(len(a), len(b))
     tip_diff = float(np.max(np.linalg.norm(a[:m, 1:] - b[:m, 1:], axis=1)))
     rows = []
-    for key, label in (("wall_time_s", "solver wall time [s]"), ("simulate_s", "whole simulate call [s]"),
+    for key, label in (("wall_time_s", "solver wall time [s]"), ("solver_cpu_s", "solver CPU time [s]"),
+                       ("simulate_s", "whole simulate call [s]"),
                        ("simulate_cpu_s", "whole simulate call, CPU time [s]"),
                        ("steps", "steps"), ("rhs_evals", "right-hand sides")):
         old = [r[key] for r in runs if r["version"] == "old"]
