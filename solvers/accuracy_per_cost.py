@@ -1,7 +1,7 @@
 """Accuracy per cost on the bending test: the cheapest configuration per tip error.
 
 The paper's bending test (6 s) with the centred scheme (the default) over N,
-at the default rtol and at two looser ones. For each run: the largest
+at the default rtol and at three looser ones. For each run: the largest
 distance of the tip (``Result.tip``, rebuilt from the strains) from a
 Richardson reference (centred N = 400 and 800 at rtol 1e-9, as
 ``solvers/schemes.py``; kept in the user's cache folder between runs, keyed
@@ -82,7 +82,7 @@ def main(argv=None):
     ref_sizes = C.pick(args, (400, 800), (200, 400), (24, 48))
     sizes = C.pick(args, [20, 25, 30, 40, 50, 60, 70, 80, 90, 100, 120], [25, 50, 75, 100], [6, 8])
     default_rtol = rodmol.SCHEMES["centred"].default_rtol
-    rtols = C.pick(args, [default_rtol, 1e-4, 3e-4], [default_rtol, 1e-4], [default_rtol])
+    rtols = C.pick(args, [default_rtol, 1e-4, 3e-4, 1e-3], [default_rtol, 1e-4], [default_rtol])
     ref, ref_err = cached_reference(scenario, ref_sizes, t_out)
     print(f"reference: centred N = {ref_sizes}, its own error ~{ref_err * 1e3:.1e} mm", flush=True)
 
