@@ -299,6 +299,12 @@ def _step_overhead(out):
         assert run["rhs"] >= run["newton"] >= run["steps"], run  # one right-hand side per Newton iteration at least
 
 
+def _compiled_driver(out):
+    for row in rows(out / "compiled_driver.csv"):  # the same algorithm with compiled callbacks: the same run
+        assert row["compiled_steps"] == row["rodmol_steps"] and row["compiled_rhs"] == row["rodmol_rhs"], row
+        assert row["tip_gap_m"] < 1e-9, row
+
+
 def _bending_vs_commit(out):
     table = {row["quantity"]: row for row in rows(out / "bending_vs_commit.csv")}
     assert 0.5 < table["steps"]["new_over_old_paired"] < 2
@@ -346,6 +352,7 @@ SCRIPTS = {
     "step_overhead.py": (["step_overhead.csv", "step_overhead_runs.csv", "step_overhead_calls.csv",
                           "step_overhead.md"], _step_overhead),
     "bending_vs_commit.py": (["bending_vs_commit.csv", "bending_vs_commit.md"], _bending_vs_commit),
+    "compiled_driver.py": (["compiled_driver.csv", "compiled_driver.md"], _compiled_driver),
 }
 
 
