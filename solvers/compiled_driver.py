@@ -12,8 +12,9 @@ no loads that vary), and no step is checked: it measures, it does not
 replace ``rodmol.simulate``.
 
 Against rodmol's driver on the same system: the steps and right-hand sides
-(the same algorithm, so the same counts), the largest tip difference, and
-the CPU time of each (medians of --reps, interleaved).
+(the same algorithm, so the same counts), the largest tip difference, the
+CPU time of each (medians of --reps, interleaved), and the tip error against
+``accuracy_per_cost.py``'s reference.
 
     python solvers/compiled_driver.py [--quick | --smoke] [--out DIR] [--reps K]
 """
@@ -26,6 +27,7 @@ import time
 import _common as C
 import numba
 from _common import np, rodmol
+from accuracy_per_cost import PRIVATE_REFERENCE_S, cached_reference
 from numba import types
 from numba.extending import intrinsic
 
@@ -229,9 +231,11 @@ def main(argv=None):
     configs = C.pick(args, [(100, None), (100, 1e-4), (30, None), (30, 3e-4)], [(100, None)], [(8, None)])
     t_end = C.pick(args, 6.0, 6.0, 0.2)
     libs = _libraries()
+    scenario = rodmol.scenarios.get("bending")
+    reference, _ = cached_reference(scenario, C.pick(args, (400, 800), (400, 800), (24, 48)), C.outputs(t_end))
     rows = []
     for n, rtol in configs:
-        model = rodmol.scenarios.get("bending").model(n)
+        model = scenario.model(n)
         system = C.SemiDiscrete(model)
         y0 = C.initial_state(model, system=system)
         rtol = rtol or rodmol.SCHEMES[system.scheme.name].default_rtol
@@ -259,7 +263,9 @@ def main(argv=None):
                    rodmol_cpu_ms=1e3 * float(np.median(theirs)), compiled_cpu_ms=1e3 * float(np.median(ours)),
                    ratio=float(np.median(np.array(ours) / np.array(theirs))), rodmol_steps=raw.stats["steps"],
                    compiled_steps=steps, rodmol_rhs=raw.stats["rhs_evals"], compiled_rhs=rhs_evals,
-                   tip_gap_m=gap, realtime_compiled=t_end / float(np.median(ours)), compile_s=compile_s)
+                   tip_gap_m=gap, tip_err_mm=1e3 * float(np.max(np.linalg.norm(tip_theirs - reference, axis=1))),
+                   realtime_compiled=t_end / float(np.median(ours)),
+                   compiled_of_private_reference=float(np.median(ours)) / PRIVATE_REFERENCE_S, compile_s=compile_s)
         rows.append(row)
         print(row, flush=True)
     base = os.path.join(args.out, "compiled_driver")
@@ -269,7 +275,7 @@ def main(argv=None):
             "per pair; compile_s: building the cfuncs (not cached) and a first short run")
     C.write_csv(base + ".csv", rows, header + [note])
     fmt = {"rtol": ".0e", "rodmol_default_cpu_ms": ".1f", "rodmol_cpu_ms": ".1f", "compiled_cpu_ms": ".1f", "ratio": ".3f", "tip_gap_m": ".1e",
-           "realtime_compiled": ".0f", "compile_s": ".1f"}
+           "realtime_compiled": ".0f", "compile_s": ".1f", "tip_err_mm": ".3g", "compiled_of_private_reference": ".2f"}
     C.write_markdown(base + ".md", "A compiled driver against rodmol's, bending test", header,
                      [("Results", note + "\n\n" + C.markdown_table(rows, None, fmt))])
     print("wrote", base + ".{csv,md}")
