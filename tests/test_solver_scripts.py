@@ -303,6 +303,9 @@ def _compiled_driver(out):
     for row in rows(out / "compiled_driver.csv"):  # the same algorithm with compiled callbacks: the same run
         assert row["compiled_steps"] == row["rodmol_steps"] and row["compiled_rhs"] == row["rodmol_rhs"], row
         assert row["tip_gap_m"] < 1e-9, row
+        # and driven by rodmol's own Stepper (its watch, outputs and stop times), a drop-in solver
+        assert row["rodmol_driver_compiled_steps"] == row["rodmol_steps"], row
+        assert row["rodmol_driver_compiled_tip_gap_m"] < 1e-9, row
 
 
 def _bending_vs_commit(out):
