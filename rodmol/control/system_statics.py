@@ -40,7 +40,7 @@ from ._fitting import (
     verdict,
 )
 from .system_fit import SystemFit
-from .system_targets import SystemTargets, distinct
+from .system_targets import SystemTargets, distinct, path_steps
 
 #: The equilibria's tolerance and Newton iterations (as ``rodmol.equilibrium``'s defaults).
 _TOL, _MAX_ITER = 1e-10, 40
@@ -104,12 +104,60 @@ def fit_system(system, tip=None, *, direction=None, markers=None, pose=None, bou
     tol = _checks.positive("tol", tol, " m")
     max_iter = _checks.integer_at_least("max_iter", max_iter, 0)
     problem = _SystemProblem(system, cables, insertions, driven, bounds, travel, t, scheme)
-    problem.targets = SystemTargets(system, problem.assembly, tip, direction, markers, pose, direction_weight,
-                                     marker_weight)
+    targets = SystemTargets(system, problem.assembly, tip, direction, markers, pose, direction_weight, marker_weight)
     inputs = problem.start(start)
     problem.check_held()
-    values, rest, r, accepted = levenberg_marquardt(problem, problem.targets.aim, inputs, tol, max_iter)
-    return problem.report(values, rest, r, tol, accepted)
+    return problem.fit(targets, inputs, tol, max_iter)
+
+
+#: The options of :func:`fit_system_path` besides its targets.
+PATH_OPTIONS = ("bounds", "cables", "insertions", "driven", "travel", "t", "tol", "direction_weight", "start",
+                "scheme", "max_iter")
+
+
+def fit_system_path(system, tips=None, *, directions=None, poses=None, bounds=(0.0, np.inf), cables=None,
+                    insertions=None, driven=None, travel=None, t=0.0, tol=REACH_TOLERANCE, direction_weight=None,
+                    start=None, scheme=DEFAULT_SCHEME, max_iter=50):
+    """:func:`fit_system` along a sequence of n targets, each from the solution of the
+    one before (its inputs and its equilibrium): continuation along a path.
+
+    Parameters
+    ----------
+    system : System
+    tips, directions : dict, optional
+        Rod name -> (n, 3) array: its tip's target positions [m] / its tip tangent's
+        target directions, global, one row per target.
+    poses : dict, optional
+        Body name -> n poses, each a position (3,) [m] or (position, rotation (3, 3)),
+        global (an (n, 3) array: positions). At least one of the three; every
+        sequence of the same length n.
+    bounds, cables, insertions, driven, travel, t, tol, direction_weight, scheme, max_iter
+        As for :func:`fit_system` (``max_iter`` >= 1).
+    start : (n_inputs,) array, optional
+        The first target's initial inputs.
+
+    Returns
+    -------
+    list of SystemFit
+        One per target. Every target is checked before any equilibrium is solved.
+    """
+    tol = _checks.positive("tol", tol, " m")
+    max_iter = _checks.integer_at_least("max_iter", max_iter, 1)
+    problem = _SystemProblem(system, cables, insertions, driven, bounds, travel, t, scheme)
+    targets = []
+    for k, step in enumerate(path_steps(system, tips, directions, poses)):
+        try:
+            targets.append(SystemTargets(system, problem.assembly, step["tip"], step["direction"], None,
+                                         step["pose"], direction_weight, 1.0))
+        except ParameterError as exc:
+            raise ParameterError(f"target {k} of the path: {exc}") from None
+    inputs = problem.start(start)
+    problem.check_held()
+    fits = []
+    for aimed in targets:
+        fits.append(problem.fit(aimed, inputs, tol, max_iter))
+        inputs = fits[-1].values
+    return fits
 
 
 @dataclass
@@ -316,6 +364,13 @@ class _SystemProblem:
         shifted[j] += h
         self._place(equations, shifted)
         return equations.residual(z)
+
+    def fit(self, targets, inputs, tol, max_iter):
+        """The bounded least squares on ``targets`` (a :class:`SystemTargets`) from ``inputs``,
+        warm-started from the last equilibrium solved, reported."""
+        self.targets = targets
+        values, rest, r, accepted = levenberg_marquardt(self, targets.aim, inputs, tol, max_iter)
+        return self.report(values, rest, r, tol, accepted)
 
     # ------------------------------------------------------------------ the report
 
