@@ -37,7 +37,8 @@ from ._fitting import (
     with_cables,
 )
 from ._targets import Targets, check_aims, path_rows
-from .system_statics import PATH_OPTIONS, fit_system, fit_system_path
+from .system_path import PATH_OPTIONS, fit_system_path
+from .system_statics import fit_system
 
 
 @dataclass(frozen=True)
@@ -184,7 +185,7 @@ def inverse_statics_path(model, tips=None, *, directions=None, poses=None, **opt
     ----------
     model : Model or System
         A :class:`rodmol.System` takes its targets by rod and body name
-        (:func:`rodmol.control.system_statics.fit_system_path`) and returns
+        (:func:`rodmol.control.system_path.fit_system_path`) and returns
         one :class:`~rodmol.control.system_fit.SystemFit` per target.
     tips : (n, 3) array
         Target tip positions [m], global frame.

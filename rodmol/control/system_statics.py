@@ -40,7 +40,7 @@ from ._fitting import (
     verdict,
 )
 from .system_fit import SystemFit
-from .system_targets import SystemTargets, distinct, path_steps
+from .system_targets import SystemTargets, distinct
 
 #: The equilibria's tolerance and Newton iterations (as ``rodmol.equilibrium``'s defaults).
 _TOL, _MAX_ITER = 1e-10, 40
@@ -103,61 +103,11 @@ def fit_system(system, tip=None, *, direction=None, markers=None, pose=None, bou
     """
     tol = _checks.positive("tol", tol, " m")
     max_iter = _checks.integer_at_least("max_iter", max_iter, 0)
-    problem = _SystemProblem(system, cables, insertions, driven, bounds, travel, t, scheme)
+    problem = SystemProblem(system, cables, insertions, driven, bounds, travel, t, scheme)
     targets = SystemTargets(system, problem.assembly, tip, direction, markers, pose, direction_weight, marker_weight)
     inputs = problem.start(start)
     problem.check_held()
     return problem.fit(targets, inputs, tol, max_iter)
-
-
-#: The options of :func:`fit_system_path` besides its targets.
-PATH_OPTIONS = ("bounds", "cables", "insertions", "driven", "travel", "t", "tol", "direction_weight", "start",
-                "scheme", "max_iter")
-
-
-def fit_system_path(system, tips=None, *, directions=None, poses=None, bounds=(0.0, np.inf), cables=None,
-                    insertions=None, driven=None, travel=None, t=0.0, tol=REACH_TOLERANCE, direction_weight=None,
-                    start=None, scheme=DEFAULT_SCHEME, max_iter=50):
-    """:func:`fit_system` along a sequence of n targets, each from the solution of the
-    one before (its inputs and its equilibrium): continuation along a path.
-
-    Parameters
-    ----------
-    system : System
-    tips, directions : dict, optional
-        Rod name -> (n, 3) array: its tip's target positions [m] / its tip tangent's
-        target directions, global, one row per target.
-    poses : dict, optional
-        Body name -> n poses, each a position (3,) [m] or (position, rotation (3, 3)),
-        global (an (n, 3) array: positions). At least one of the three; every
-        sequence of the same length n.
-    bounds, cables, insertions, driven, travel, t, tol, direction_weight, scheme, max_iter
-        As for :func:`fit_system` (``max_iter`` >= 1).
-    start : (n_inputs,) array, optional
-        The first target's initial inputs.
-
-    Returns
-    -------
-    list of SystemFit
-        One per target. Every target is checked before any equilibrium is solved.
-    """
-    tol = _checks.positive("tol", tol, " m")
-    max_iter = _checks.integer_at_least("max_iter", max_iter, 1)
-    problem = _SystemProblem(system, cables, insertions, driven, bounds, travel, t, scheme)
-    targets = []
-    for k, step in enumerate(path_steps(system, tips, directions, poses)):
-        try:
-            targets.append(SystemTargets(system, problem.assembly, step["tip"], step["direction"], None,
-                                         step["pose"], direction_weight, 1.0))
-        except ParameterError as exc:
-            raise ParameterError(f"target {k} of the path: {exc}") from None
-    inputs = problem.start(start)
-    problem.check_held()
-    fits = []
-    for aimed in targets:
-        fits.append(problem.fit(aimed, inputs, tol, max_iter))
-        inputs = fits[-1].values
-    return fits
 
 
 @dataclass
@@ -169,7 +119,7 @@ class _Rest:
     equations: FreeRestEquations
 
 
-class _SystemProblem:
+class SystemProblem:
     """The inputs of a system's statics and its equilibria under them."""
 
     def __init__(self, system, cables, insertions, driven, bounds, travel, t, scheme):
