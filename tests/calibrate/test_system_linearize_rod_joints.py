@@ -1,6 +1,6 @@
 """Linearisation of Systems whose rods are joined to each other (rodmol/system_joints.py):
-two tips joined, a tip on another rod's node, two bases joined and a base on another
-rod's tip (a branch). A, B and the drift against central differences of the Assembly's
+two tips joined (clamped or pinned), a tip on another rod's node, two bases joined and
+a base on another rod's tip (a branch). A, B and the drift against central differences of the Assembly's
 rates and against Systems whose inputs are moved."""
 
 import numpy as np
@@ -19,6 +19,7 @@ PLACES = {  # rod b's base (position, rotation) and the joint of each case
     "tip on a node": ((L, 0.0, -2 * L / 3), UP, (("a", "tip"), ("b", 2 * L / 3))),
     "bases": ((0.0, 0.0, 0.0), BACK, (("a", "base"), ("b", "base"))),
     "branch": ((L, 0.0, 0.0), np.eye(3), (("b", "base"), ("a", "tip"))),
+    "tips pinned": ((2 * L, 0.0, 0.0), BACK, (("a", "tip"), ("b", "tip"), "pin")),
 }
 
 
@@ -27,14 +28,14 @@ def joined(case, pull=(0.05, 0.03), z=-0.002, force=(0.0, 0.002, 0.0)):
     a cable (``pull[0]`` [N]) and pushed at its middle (``force`` [N], global), b pulled
     by a cable (``pull[1]``) and by an actuator at ``z`` [m]; the bases not joined are
     clamped to the world."""
-    position, rotation, (end_a, end_b) = PLACES[case]
+    position, rotation, (end_a, end_b, *kind) = PLACES[case]
     rod = rodmol.Rod(L, radius=(0.012, 0.008), material=MATERIAL)
     a = rodmol.Model(rod, N, cables=[rodmol.Cable((0.005, 0.0), L, tension=pull[0], name="pull")],
                      loads=[rodmol.PointForce(L / 2, force, name="push")])
     b = rodmol.Model(rod, N, base=rodmol.BaseMotion(position=position, rotation=rotation),
                      cables=[rodmol.Cable((0.005, 0.0), L, tension=pull[1], name="pull"),
                              rodmol.Cable((0.0, 0.005), L, name="motor", displacement=z, compliance=5e-2)])
-    return rodmol.System({"a": a, "b": b}, joints=[rodmol.Joint(end_a, end_b)], gravity=(0.0, 0.0, -9.81))
+    return rodmol.System({"a": a, "b": b}, joints=[rodmol.Joint(end_a, end_b, *kind)], gravity=(0.0, 0.0, -9.81))
 
 
 def moving(system):
@@ -80,7 +81,7 @@ def test_state_jacobian_matches_central_differences_of_the_rates(linearised):
     reference = central(lambda x: assembly(T, x).copy(), y, 1e-5 * np.maximum(np.abs(y), assembly.atol_scale()))
     assert_close(lin.A, reference, 1e-5)
     a, b = assembly.parts["a"], assembly.parts["b"]
-    if case in ("tips", "tip on a node"):  # the two rods read each other's nodes
+    if case in ("tips", "tip on a node", "tips pinned"):  # the two rods read each other's nodes
         assert np.abs(lin.A[a, b]).max() > 1e-3 * np.abs(lin.A).max()
 
 
