@@ -1,4 +1,4 @@
-"""Reference scores on the learning environment rodmol/Reach-v0: four policies, seeded episodes.
+"""Reference scores on the learning environment rodmol/Reach-v0: five policies, seeded episodes.
 
 The environment at its defaults (N = 30, 20 ms periods, tensions 0-4 N,
 effort weight 1e-3 m/N^2), its episodes run to 5 s (250 periods; the first
@@ -71,15 +71,20 @@ class LinearMPC:
     carried over the horizon (offset-free feedback: far from the equilibrium
     the linear tip is off), and the tensions of each block of the
     ``HORIZON`` that bring the predicted tip nearest the target, within the
-    action box and ``TRUST`` of the equilibrium's, ``EFFORT`` on the change
-    (``scipy.optimize.lsq_linear``); the first block's is applied.
+    action box and ``TRUST`` of the model's operating tensions, ``EFFORT`` on
+    their departure from the target's (``scipy.optimize.lsq_linear``); the
+    first block's are applied.
     """
 
     def __init__(self, env, seed):
         self.env = env
         fit = rodmol.inverse_statics(env.model, env.target, bounds=(0.0, env.max_tension))
+        self.reference = np.array([fit.tensions[c.name] for c in env.model.cables])
         model = fit.apply(env.model)
-        lin = rodmol.linearize(model, fit.state).reduced(output="tip", order=ORDER).discretize(env.period)
+        self.use(rodmol.linearize(model, fit.state).reduced(output="tip", order=ORDER).discretize(env.period))
+
+    def use(self, lin):
+        """Plan on the sampled linear model ``lin`` of the tip from now on."""
         # y_k = y0 + C A^k x + sum_(j<k) C A^(k-1-j) B u_j with u_j its block's: by the prefix sums
         # S_m of the impulse responses C A^i B, block [s, e) adds S_(k-s) - S_(k-min(e, k)) to y_k.
         sums, power = [np.zeros_like(lin.D)], lin.C
@@ -91,8 +96,9 @@ class LinearMPC:
         rows = [np.hstack([(sums[k - s] - sums[k - min(e, k)] if s < k else 0.0 * lin.D)
                            + (lin.D if s <= k - 1 < e else 0.0) for s, e in zip(edges[:-1], edges[1:])])
                 for k in range(1, HORIZON + 1)]
-        m = len(lin.u0)
+        m, env = len(lin.u0), self.env
         self.gains = np.vstack(rows + [np.sqrt(EFFORT) * np.eye(len(BLOCKS) * m)])
+        self.effort = np.sqrt(EFFORT) * np.tile(self.reference - lin.u0, len(BLOCKS))
         low = np.maximum(np.maximum(lin.bounds[:, 0], 0.0) - lin.u0, -TRUST)
         high = np.minimum(np.minimum(lin.bounds[:, 1], env.max_tension) - lin.u0, TRUST)
         self.box, self.lin = (np.tile(low, len(BLOCKS)), np.tile(high, len(BLOCKS))), lin
@@ -104,13 +110,27 @@ class LinearMPC:
         for _ in range(HORIZON):
             x = lin.A @ x + lin.f0
             free.append(lin.y0 + lin.C @ x + miss)
-        misses = np.concatenate([env.target - f for f in free] + [np.zeros(self.gains.shape[1])])
+        misses = np.concatenate([env.target - f for f in free] + [self.effort])
         du = lsq_linear(self.gains, misses, bounds=self.box).x[:len(lin.u0)]  # the first block's
         return np.clip(lin.u0 + du, 0.0, env.max_tension).astype(np.float32)
 
 
+class SuccessiveMPC(LinearMPC):
+    """:class:`LinearMPC` on a model taken anew every period about the arm's state now and
+    the tensions held (``rodmol.linearize(env.held_model(), env.state, env.t)``, its drift
+    f0 the rates there), whole (a reduced model's static correction treats the drift's
+    dropped modes as settled), sampled at the period; the tensions within ``TRUST`` of
+    those held, ``EFFORT`` on their departure from the target's equilibrium's."""
+
+    def __call__(self, observation):
+        env = self.env
+        self.use(rodmol.linearize(env.held_model(), env.state, env.t).output("tip").discretize(env.period))
+        return super().__call__(observation)
+
+
 POLICIES = {"random": random_policy, "proportional": proportional_policy,
-            "inverse statics, open loop": inverse_statics_policy, "linear MPC": LinearMPC}
+            "inverse statics, open loop": inverse_statics_policy, "linear MPC": LinearMPC,
+            "successive linear MPC": SuccessiveMPC}
 
 
 def episode(env, make, seed):

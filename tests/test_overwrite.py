@@ -97,6 +97,15 @@ def _env(place, overwrite, variant, runs):
     env.sim.close()
 
 
+def _crawl(place, overwrite, variant, runs):
+    crawl = pytest.importorskip("rodmol.control.crawl")
+    env = crawl.OctopusCrawlEnv(n_elements=3, settle=0.05, episode_steps=2, record=place, overwrite=overwrite)
+    for _ in range(2 - variant):
+        env.reset(seed=0)
+        env.step(np.zeros(env.action_space.shape, np.float32))
+    env.close()
+
+
 def _small_spec():
     from rodmol.calibrate import apply
 
@@ -133,6 +142,7 @@ WRITERS = {
                                                                         out=p, overwrite=o)),
     "Simulator(out=)": Writer(_simulator),
     "ReachEnv(record=)": Writer(_env),
+    "OctopusCrawlEnv(record=)": Writer(_crawl),
     "output.pictures.render": Writer(lambda p, o, v, r: pictures.render(r["rod"][0], p, size=(64, 48),
                                                                         frames=2 - 2 * v, overwrite=o)),
     "output.pictures.plot": Writer(lambda p, o, v, r: pictures.plot(r["rod"][v], p, overwrite=o)),

@@ -278,7 +278,7 @@ def _rod_contact(out):
 
 def _reach_scores(out):
     table = {row["policy"]: row for row in rows(out / "reach_scores.csv")}
-    assert set(table) == {"random", "proportional", "inverse statics, open loop", "linear MPC"}
+    assert set(table) == {"random", "proportional", "inverse statics, open loop", "linear MPC", "successive linear MPC"}
     for row in table.values():  # a distance [m] of the reach, at most the arm's length from the target
         distances = [value for key, value in row.items() if key.endswith("_mm")]
         assert all(0.0 <= d < 1e3 for d in distances) and math.isfinite(row["mean_return"]), row

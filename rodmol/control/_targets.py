@@ -123,3 +123,13 @@ def check_aims(model, tip, direction, marker_targets):
     if tip is None and direction is None and not names:
         raise ParameterError("give a target: `tip`, `direction` or `markers`")
     return tip, direction, names, positions
+
+
+def path_rows(name, value):
+    """The checked (n, 3) array of a path's targets ``value`` (n >= 1, finite), named ``name``."""
+    arr = _checks.floats(value)
+    if arr is None or arr.ndim != 2 or arr.shape[1] != 3 or len(arr) == 0:
+        raise ParameterError(f"`{name}` must be an (n, 3) array of positions [m], got {_checks.short(value)}")
+    if not np.all(np.isfinite(arr)):
+        raise ParameterError(f"`{name}` must be finite, got {_checks.short(value)}")
+    return arr

@@ -40,6 +40,8 @@ OPTIONS = {
     "max_tension": envs._max_tension,
     "effort_weight": lambda name, value: _checks.non_negative(name, value, " m/(s N^2)"),
     "settle": lambda name, value: _checks.positive(name, value, " s"),
+    "record": envs._record,
+    "overwrite": _checks.flag,
 }
 
 
@@ -94,20 +96,30 @@ class OctopusCrawlEnv(gymnasium.Env):
         Weight of the effort in the reward [m/(s N^2)], >= 0.
     settle : float
         Time [s] the octopus settles on the floor before the episodes' start state.
+    record : path, optional
+        Stream every episode into ``record/episode_NNNN`` (``system.h5`` and ParaView's
+        series of each part: :func:`rodmol.load_result` reads it back), through the
+        Simulator's ``out`` (:class:`rodmol.control.envs.Recording`).
+    overwrite : bool
+        With ``record``: replace the episodes recorded there earlier, all of them (otherwise
+        refused when the environment is made).
     """
 
     metadata = {"render_modes": []}
 
     def __init__(self, n_elements=6, period=0.05, episode_steps=60, max_tension=2.0, effort_weight=1e-3,
-                 settle=1.0):
+                 settle=1.0, record=None, overwrite=False):
         given = dict(n_elements=n_elements, period=period, episode_steps=episode_steps, max_tension=max_tension,
-                     effort_weight=effort_weight, settle=settle)
+                     effort_weight=effort_weight, settle=settle, record=record, overwrite=overwrite)
         options = {name: check(name, given[name]) for name, check in OPTIONS.items()}
         self.n_elements, self.period = options["n_elements"], options["period"]
         self.episode_steps, self.max_tension = options["episode_steps"], options["max_tension"]
         self.effort_weight, self.settle = options["effort_weight"], options["settle"]
+        self.record = options["record"]
+        self._recording = envs.Recording(self.record, options["overwrite"])  # before any work
         self.system = octopus(self.n_elements)
-        self.sim = Simulator(self.system, initial=settled(self.n_elements, self.settle))
+        self._y0 = settled(self.n_elements, self.settle)
+        self.sim = Simulator(self.system, initial=self._y0)
         self._start = self.sim.copy()
         self.action_space = spaces.Box(0.0, self.max_tension, (ARMS * len(CABLES),), np.float32)
         self.observation_space = spaces.Box(-np.inf, np.inf, (OBSERVATION_SIZE,), np.float32)
@@ -118,9 +130,9 @@ class OctopusCrawlEnv(gymnasium.Env):
             raise ParameterError(f"`options` {_checks.short(options)}: {type(self).__name__}.reset "
                                  "takes none (None or {})")
         super().reset(seed=seed)
-        state = self.sim.reset(self._start)
+        self.sim = self._recording.next_episode(self.sim, self._start, self.system, self._y0)
         self._steps, self._ended = 0, None
-        return self._observation(state), {}
+        return self._observation(self.sim.state), {}
 
     def step(self, action):
         if self._ended is not None:
@@ -142,6 +154,9 @@ class OctopusCrawlEnv(gymnasium.Env):
         info["speed"] = speed
         truncated, self._ended = episode_end(self._steps, self.episode_steps, terminated)
         return self._observation(state), reward, terminated, truncated, info
+
+    def close(self):
+        self.sim.close()
 
     def _observation(self, state):
         head = state["head"]

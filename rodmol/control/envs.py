@@ -152,9 +152,8 @@ class ReachEnv(gymnasium.Env):
         options = {name: check(name, given[name]) for name, check in OPTIONS.items()}
         self.period, self.episode_steps = options["period"], options["episode_steps"]
         self.max_tension, self.effort_weight = options["max_tension"], options["effort_weight"]
-        self.record, self._overwrite, self._episodes = options["record"], options["overwrite"], 0
-        if self.record is not None:  # before any work: the episodes recorded there earlier
-            _claim_record(self.record, self._overwrite)
+        self.record = options["record"]
+        self._recording = Recording(self.record, options["overwrite"])  # before any work
         self.model = paper_arm(n_elements, medium="water")
         self.sim = Simulator(self.model)
         self._start, self._y0 = self.sim.copy(), self.sim.y
@@ -196,14 +195,7 @@ class ReachEnv(gymnasium.Env):
                                  "takes none (None or {})")
         super().reset(seed=seed)
         self.target = self._draw_target()
-        if self.record is not None:
-            self.sim.close()
-            self._episodes += 1
-            self.sim = Simulator(self.model, initial=self._y0,
-                                 out=self.record / f"episode_{self._episodes:04d}",
-                                 overwrite=self._overwrite)
-        else:
-            self.sim.reset(self._start)
+        self.sim = self._recording.next_episode(self.sim, self._start, self.model, self._y0)
         self._steps, self._ended = 0, None
         return self._observation(self.sim.state), {"target": self.target.copy()}
 
@@ -268,15 +260,38 @@ def vector_env(num_envs, env=ReachEnv, **kwargs):
     return gymnasium.vector.AsyncVectorEnv([functools.partial(env, **kwargs)] * int(num_envs))
 
 
-def _claim_record(record, overwrite):
-    """Refuse the episodes recorded in ``record`` earlier unless ``overwrite``, which removes them
-    all (a shorter recording would leave the later ones): :func:`rodmol.output.run_files.claim`."""
-    from ..output import run_files
+class Recording:
+    """Where an environment records its episodes, if anywhere: each episode streamed into
+    ``record/episode_NNNN`` (``NNNN`` from 0001) by a Simulator of its own (``out``: the run's
+    HDF5 file and ParaView's series), the rule of every environment's ``record=``.
 
-    episodes = sorted(record.glob("episode_[0-9][0-9][0-9][0-9]*")) if record.is_dir() else []
-    for folder in episodes:
-        run_files.refuse_replacing(folder, overwrite)
-    for folder in episodes:
-        run_files.claim(folder, True)
-        with contextlib.suppress(OSError):  # holds files not rodmol's
-            folder.rmdir()
+    Made at the environment's construction, before any work: the episodes recorded in
+    ``record`` earlier are refused unless ``overwrite``, which removes them all (a shorter
+    recording would leave the later ones beside it): :func:`rodmol.output.run_files.claim`.
+    """
+
+    def __init__(self, record, overwrite):
+        self.record, self.overwrite, self.episodes = record, overwrite, 0
+        if record is None:
+            return
+        from ..output import run_files
+
+        earlier = sorted(record.glob("episode_[0-9][0-9][0-9][0-9]*")) if record.is_dir() else []
+        for folder in earlier:
+            run_files.refuse_replacing(folder, overwrite)
+        for folder in earlier:
+            run_files.claim(folder, True)
+            with contextlib.suppress(OSError):  # holds files not rodmol's
+                folder.rmdir()
+
+    def next_episode(self, sim, start, model, initial):
+        """The simulator of the next episode: ``sim`` reset to its copy ``start`` or, recording,
+        ``sim`` closed and a new Simulator of ``model`` (sim's) from the state ``initial`` (at
+        t = 0, as ``start``) streaming into the next episode's folder."""
+        if self.record is None:
+            sim.reset(start)
+            return sim
+        sim.close()
+        self.episodes += 1
+        return Simulator(model, initial=initial, out=self.record / f"episode_{self.episodes:04d}",
+                         overwrite=self.overwrite)

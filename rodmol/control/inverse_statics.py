@@ -36,7 +36,8 @@ from ._fitting import (
     verdict,
     with_cables,
 )
-from ._targets import Targets, check_aims
+from ._targets import Targets, check_aims, path_rows
+from .system_path import PATH_OPTIONS, fit_system_path
 from .system_statics import fit_system
 
 
@@ -167,10 +168,7 @@ def inverse_statics(model, tip=None, *, direction=None, markers=None, pose=None,
                           direction_weight=direction_weight, marker_weight=marker_weight, start=start,
                           scheme=scheme, max_iter=max_iter)
     _check_model(model)
-    for name, value in (("pose", pose), ("insertions", insertions), ("driven", driven), ("travel", travel)):
-        if value is not None:
-            raise ParameterError(f"`{name}` is for a rodmol.System (its bodies and rods' bases), got "
-                                 f"{_checks.short(value)} for a Model")
+    _refuse_system_words(pose=pose, insertions=insertions, driven=driven, travel=travel)
     tip, direction, names, positions = check_aims(model, tip, direction, markers)
     tol = _checks.positive("tol", tol, " m")
     max_iter = _checks.integer_at_least("max_iter", max_iter, 0)
@@ -179,17 +177,22 @@ def inverse_statics(model, tip=None, *, direction=None, markers=None, pose=None,
     return problem.fit(problem.targets.aim(tip, direction, positions), problem.start(start), tol, max_iter)
 
 
-def inverse_statics_path(model, tips, *, directions=None, **options):
+def inverse_statics_path(model, tips=None, *, directions=None, poses=None, **options):
     """:func:`inverse_statics` along a sequence of targets, each warm-started
-    from the solution of the one before (its tensions and its equilibrium).
+    from the solution of the one before (its inputs and its equilibrium).
 
     Parameters
     ----------
-    model : Model
+    model : Model or System
+        A :class:`rodmol.System` takes its targets by rod and body name
+        (:func:`rodmol.control.system_path.fit_system_path`) and returns
+        one :class:`~rodmol.control.system_fit.SystemFit` per target.
     tips : (n, 3) array
         Target tip positions [m], global frame.
     directions : (n, 3) array, optional
         Target tip tangents, global frame.
+    poses : dict, optional
+        For a System only: body name -> its n target poses.
     **options
         As for :func:`inverse_statics` (``bounds``, ``cables``, ``tol``, ...);
         ``start`` applies to the first target.
@@ -198,16 +201,21 @@ def inverse_statics_path(model, tips, *, directions=None, **options):
     -------
     list of StaticFit
     """
-    tips = _targets("tips", tips)
+    if isinstance(model, System):
+        unknown = set(options) - set(PATH_OPTIONS)
+        if unknown:
+            raise ParameterError(f"unknown options {sorted(unknown)} for inverse_statics_path of a System "
+                                 f"(it takes {', '.join(PATH_OPTIONS)})")
+        return fit_system_path(model, tips, directions=directions, poses=poses, **options)
+    _check_model(model)
+    _refuse_system_words(poses=poses, **{k: options.pop(k) for k in ("insertions", "driven", "travel")
+                                          if k in options})
+    tips = path_rows("tips", tips)
     if directions is not None:
-        directions = _targets("directions", directions)
+        directions = path_rows("directions", directions)
         if len(directions) != len(tips):
             raise ParameterError(f"`directions` must have one row per target ({len(tips)}), got {len(directions)}")
     unknown = set(options) - {"bounds", "cables", "t", "tol", "direction_weight", "start", "scheme", "max_iter"}
-    if isinstance(model, System):
-        raise ParameterError("inverse_statics_path takes a rodmol.Model; for a System, call inverse_statics "
-                             "per target (its `start` the last fit's `values`)")
-    _check_model(model)
     if unknown:
         raise ParameterError(f"unknown options {sorted(unknown)} for inverse_statics_path")
     tol = _checks.positive("tol", options.get("tol", REACH_TOLERANCE), " m")
@@ -227,13 +235,12 @@ def inverse_statics_path(model, tips, *, directions=None, **options):
     return fits
 
 
-def _targets(name, value):
-    arr = _checks.floats(value)
-    if arr is None or arr.ndim != 2 or arr.shape[1] != 3 or len(arr) == 0:
-        raise ParameterError(f"`{name}` must be an (n, 3) array of positions [m], got {_checks.short(value)}")
-    if not np.all(np.isfinite(arr)):
-        raise ParameterError(f"`{name}` must be finite, got {_checks.short(value)}")
-    return arr
+def _refuse_system_words(**given):
+    """A System's words (its bodies' poses, its rods' insertions) given for a Model: refused."""
+    for name, value in given.items():
+        if value is not None:
+            raise ParameterError(f"`{name}` is for a rodmol.System (its bodies and rods' bases), got "
+                                 f"{_checks.short(value)} for a Model")
 
 
 def _check_model(model):

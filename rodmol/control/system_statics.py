@@ -103,13 +103,11 @@ def fit_system(system, tip=None, *, direction=None, markers=None, pose=None, bou
     """
     tol = _checks.positive("tol", tol, " m")
     max_iter = _checks.integer_at_least("max_iter", max_iter, 0)
-    problem = _SystemProblem(system, cables, insertions, driven, bounds, travel, t, scheme)
-    problem.targets = SystemTargets(system, problem.assembly, tip, direction, markers, pose, direction_weight,
-                                     marker_weight)
+    problem = SystemProblem(system, cables, insertions, driven, bounds, travel, t, scheme)
+    targets = SystemTargets(system, problem.assembly, tip, direction, markers, pose, direction_weight, marker_weight)
     inputs = problem.start(start)
     problem.check_held()
-    values, rest, r, accepted = levenberg_marquardt(problem, problem.targets.aim, inputs, tol, max_iter)
-    return problem.report(values, rest, r, tol, accepted)
+    return problem.fit(targets, inputs, tol, max_iter)
 
 
 @dataclass
@@ -121,7 +119,7 @@ class _Rest:
     equations: FreeRestEquations
 
 
-class _SystemProblem:
+class SystemProblem:
     """The inputs of a system's statics and its equilibria under them."""
 
     def __init__(self, system, cables, insertions, driven, bounds, travel, t, scheme):
@@ -316,6 +314,13 @@ class _SystemProblem:
         shifted[j] += h
         self._place(equations, shifted)
         return equations.residual(z)
+
+    def fit(self, targets, inputs, tol, max_iter):
+        """The bounded least squares on ``targets`` (a :class:`SystemTargets`) from ``inputs``,
+        warm-started from the last equilibrium solved, reported."""
+        self.targets = targets
+        values, rest, r, accepted = levenberg_marquardt(self, targets.aim, inputs, tol, max_iter)
+        return self.report(values, rest, r, tol, accepted)
 
     # ------------------------------------------------------------------ the report
 

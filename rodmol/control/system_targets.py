@@ -7,7 +7,7 @@ from scipy.spatial.transform import Rotation
 from .. import _checks
 from ..discretise import rotations
 from ..errors import ParameterError
-from ._targets import Targets, check_aims
+from ._targets import Targets, check_aims, path_rows
 
 
 def distinct(what, value, pool, kind):
@@ -18,9 +18,54 @@ def distinct(what, value, pool, kind):
     if len(set(names)) != len(names):
         raise ParameterError(f"`{what}` must name distinct {kind}s, got {_checks.short(value)}")
     for name in names:
-        if name not in pool:
-            raise ParameterError(f"`{what}`: no {kind} named {name!r} in the system" + _checks.did_you_mean(name, pool))
+        check_name(what, name, pool, kind)
     return names
+
+
+def check_name(what, name, pool, kind):
+    """Refuse a ``name`` given in ``what`` that is no {kind} of ``pool`` (the system's)."""
+    if name not in pool:
+        raise ParameterError(f"`{what}`: no {kind} named {name!r} in the system" + _checks.did_you_mean(name, pool))
+
+
+def path_steps(system, tips, directions, poses):
+    """The n targets of a path, each {"tip": {rod: (3,)} or None, "direction": ..., "pose":
+    {body: pose} or None}, of ``tips`` and ``directions`` ({rod: (n, 3)}) and ``poses``
+    ({body: n poses}) of ``system``; every sequence of the same length n. Each pose
+    itself is checked by :class:`SystemTargets`."""
+    rows = {}
+    for what, value in (("tips", tips), ("directions", directions), ("poses", poses)):
+        if value is None:
+            continue
+        if not isinstance(value, dict) or not value:
+            kind = "body names to sequences of poses" if what == "poses" else "rod names to (n, 3) arrays"
+            raise ParameterError(f"`{what}` must map {kind}, got {_checks.short(value)}")
+        for name, sequence in value.items():
+            check_name(what, name, system.bodies if what == "poses" else system.rods,
+                       "body" if what == "poses" else "rod")
+            label = f"{what}[{name!r}]"
+            if what != "poses":
+                sequence = path_rows(label, sequence)
+            elif isinstance(sequence, (str, bytes)) or not hasattr(sequence, "__len__") or len(sequence) == 0:
+                raise ParameterError(f"`{label}` must be a sequence of poses (each a position (3,) [m] or "
+                                     f"(position, rotation)), got {_checks.short(sequence)}")
+            rows[what, name] = sequence
+    if not rows:
+        raise ParameterError("give a path: `tips`, `directions` or `poses`")
+    lengths = {key: len(sequence) for key, sequence in rows.items()}
+    n = max(lengths.values())
+    for (what, name), length in lengths.items():
+        if length != n:
+            raise ParameterError(f"`{what}[{name!r}]` has {length} targets, others {n}: give every path the "
+                                 "same number of targets")
+    steps = []
+    for k in range(n):
+        step = {"tip": None, "direction": None, "pose": None}
+        for (what, name), sequence in rows.items():
+            key = {"tips": "tip", "directions": "direction", "poses": "pose"}[what]
+            step[key] = {**(step[key] or {}), name: sequence[k]}
+        steps.append(step)
+    return steps
 
 
 class SystemTargets:
@@ -36,9 +81,7 @@ class SystemTargets:
             if not isinstance(value, dict) or not value:
                 raise ParameterError(f"`{what}` must map rod names to targets, got {_checks.short(value)}")
             for name, aim in value.items():
-                if name not in system.rods:
-                    raise ParameterError(f"`{what}`: no rod named {name!r} in the system"
-                                         + _checks.did_you_mean(name, system.rods))
+                check_name(what, name, system.rods, "rod")
                 given.setdefault(name, {})[what] = aim
         marker_weight = _checks.positive("marker_weight", marker_weight)
         if direction_weight is not None:
@@ -79,9 +122,7 @@ class SystemTargets:
                                  f"{_checks.short(pose)}")
         out = {}
         for name, value in pose.items():
-            if name not in system.bodies:
-                raise ParameterError(f"`pose`: no body named {name!r} in the system"
-                                     + _checks.did_you_mean(name, system.bodies))
+            check_name("pose", name, system.bodies, "body")
             arr = _checks.floats(value)
             if arr is not None and arr.shape == (3,):
                 out[name] = (_checks.vector3(f"pose[{name!r}]", value), None)

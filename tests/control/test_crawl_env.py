@@ -65,6 +65,7 @@ def test_same_seed_same_trajectory_and_reward_as_documented(env):
 @pytest.mark.parametrize("option, value", [
     ("n_elements", 1), ("n_elements", 2.5), ("period", 0.0), ("period", float("nan")), ("episode_steps", 0),
     ("max_tension", -1.0), ("max_tension", float("inf")), ("effort_weight", -1.0), ("settle", 0.0),
+    ("record", 3), ("record", " "), ("overwrite", "yes"),
 ])
 def test_every_option_is_checked_at_construction_naming_it(monkeypatch, option, value):
     def no_work(*args, **kwargs):
@@ -90,6 +91,55 @@ def test_non_finite_actions_and_steps_after_the_end(env):
     env.step(np.zeros(16, dtype=np.float32))
     with pytest.raises(crawl.ResetNeeded, match="truncated at step 3"):
         env.step(np.zeros(16, dtype=np.float32))
+
+
+def test_records_each_episode_as_a_readable_series_of_its_states(tmp_path):
+    """Every episode streamed into record/episode_NNNN: rodmol.load_result reads back the
+    episode's states bitwise (the settled start, then one frame per step) and the tensions
+    held; ParaView's series of each part is written; the observations are those of an
+    environment that does not record."""
+    env = crawl.OctopusCrawlEnv(**SMALL, record=tmp_path)
+    plain = crawl.OctopusCrawlEnv(**SMALL)
+    states, actions = {}, {}
+    for episode in (1, 2):
+        actions[episode] = np.array([[0.2 * k + 0.1 * episode] * 16 for k in range(3)], dtype=np.float32)
+        observations = []
+        for made in (plain, env):  # env last: its states are the episode's
+            observations.append([made.reset(seed=episode)[0]])
+            states[episode] = [made.sim.y]
+            for action in actions[episode]:
+                observations[-1].append(made.step(action)[0])
+                states[episode].append(made.sim.y)
+        np.testing.assert_array_equal(observations[0], observations[1])
+    env.close()
+    for episode in (1, 2):
+        folder = tmp_path / f"episode_{episode:04d}"
+        stored = rodmol.load_result(folder)
+        assert stored.success and np.allclose(stored.t, [0.0, 0.05, 0.1, 0.15])
+        np.testing.assert_array_equal(stored.states, states[episode])
+        np.testing.assert_array_equal(stored["arm1"].tensions[1:, 1], actions[episode][:, 0])  # cable 2
+        assert (folder / "system.h5").is_file()
+        assert list(folder.glob("*.xdmf"))
+
+
+def test_a_record_holding_episodes_is_refused_before_any_work_unless_overwritten(tmp_path, monkeypatch):
+    env = crawl.OctopusCrawlEnv(**SMALL, record=tmp_path)
+    env.reset(seed=0)
+    env.step(np.zeros(16, dtype=np.float32))
+    env.close()
+
+    def no_work(*args, **kwargs):
+        raise AssertionError("the octopus was built before the record was claimed")
+
+    with monkeypatch.context() as patched:
+        patched.setattr(crawl, "octopus", no_work)
+        with pytest.raises(ParameterError, match="episode_0001.*overwrite=True"):
+            crawl.OctopusCrawlEnv(**SMALL, record=tmp_path)
+    again = crawl.OctopusCrawlEnv(**SMALL, record=tmp_path, overwrite=True)
+    assert not (tmp_path / "episode_0001").exists()  # the earlier episodes went at construction
+    again.reset(seed=0)
+    again.close()
+    assert rodmol.load_result(tmp_path / "episode_0001").success
 
 
 @pytest.mark.subprocess

@@ -171,8 +171,6 @@ def test_a_floating_head_and_system_words_for_a_rod_are_refused(tmp_path):
         rodmol.inverse_statics(free, tip={"right": (0.2, 0.0, 0.0)})
     with pytest.raises(rodmol.ParameterError, match="`insertions` is for a rodmol.System"):
         rodmol.inverse_statics(rodmol.paper_arm(4), tip=(0.2, 0.0, 0.0), insertions=["leg0"])
-    with pytest.raises(rodmol.ParameterError, match="inverse_statics_path takes a rodmol.Model"):
-        rodmol.inverse_statics_path(free, [(0.2, 0.0, 0.0)])
 
 
 def test_the_inserted_robot_settles_where_the_statics_put_it(robot):
