@@ -24,7 +24,7 @@ from .solve.adjoint_backward import LINEAR_SOLVERS, AdjointSystem, integrate_bac
 from .solve.checkpoints import ForwardRun
 
 
-def gradient(model, t_end, loss, parameters, *, checkpoint_every=None, adjoint_linsolver="sparse",
+def gradient(model, t_end, loss, parameters, *, checkpoint_every=None, adjoint_linsolver="auto",
              initial=None, scheme=None, rtol=None, atol=None, t0=None, max_wall_time=None, backend=None,
              stats=None, **backend_options):
     """The loss of a run of ``model`` to ``t_end`` [s] and its gradient by ``parameters``.
@@ -45,9 +45,9 @@ def gradient(model, t_end, loss, parameters, *, checkpoint_every=None, adjoint_l
         Keep every K-th forward step only and integrate a segment again when the
         backward integration reaches it: memory of one segment instead of the whole
         run, at the cost of a second forward run. None: keep every step.
-    adjoint_linsolver : "sparse" or "dense"
-        The backward integration's linear solver (SuperLU on the transposed
-        pattern, or dense LU for small systems).
+    adjoint_linsolver : "auto", "band", "dense" or "sparse"
+        The backward integration's linear solver on J^T (``"auto"``: band for a
+        rod, dense LU for a system up to 1500 entries, SuperLU beyond).
     initial, scheme, rtol, atol, t0, max_wall_time, **backend_options
         As for :func:`rodmol.simulate` (CVODE only; its options ``linsolver``,
         ``max_order`` ...). The backward integration takes the same ``rtol``.
@@ -92,13 +92,14 @@ def gradient(model, t_end, loss, parameters, *, checkpoint_every=None, adjoint_l
     value += loss.direct(model, args.t0, t_end)
     forward_s = time.perf_counter() - clock
     scale = np.asarray(args.atol, dtype=float) / args.rtol
-    adjoint = AdjointSystem(system, forward.state, scale, columns, columns.width)
+    adjoint = AdjointSystem(system, forward.state, scale)
     size = float(np.max(np.abs(jumps) * scale, initial=0.0))
     atol_lambda = args.rtol * (size if size > 0 else 1.0) / scale
     stops = np.concatenate([np.asarray(system.knot_times(), dtype=float), forward.boundaries()])
-    lam0, q0, info = integrate_backward(adjoint, args.t0, t_end, list(zip(frames_at, jumps)), stops, rtol=args.rtol,
+    lam0, q0, info = integrate_backward(adjoint, args.t0, t_end, list(zip(frames_at, jumps)), stops,
+                                        lambda t, lam: columns.weighted(t, forward.state(t), lam), rtol=args.rtol,
                                         atol=atol_lambda, linsolver=adjoint_linsolver)
-    total = np.array(q0)
+    total = np.zeros(columns.width) if q0 is None else np.array(q0)
     if isinstance(args.initial, str) and args.initial == "equilibrium" and np.any(lam0):
         total += lam0 @ columns.initial_equilibrium(args.t0)
     grads = columns.split(total)

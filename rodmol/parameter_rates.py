@@ -49,7 +49,8 @@ def shifted(parameter, model, delta):
 
 
 class ParameterColumns:
-    """F(t, y) = df/dp (n, width) of ``system`` (``kind``'s, of ``model``) for ``parameters``."""
+    """F(t, y) = df/dp (n, width) of ``system`` (``kind``'s, of ``model``) for ``parameters``,
+    weighted by the adjoint (:meth:`weighted`), and dy0/dp of the initial equilibrium."""
 
     def __init__(self, kind, model, system, parameters):
         self.kind, self.model, self.system, self.parameters = kind, model, system, tuple(parameters)
@@ -69,15 +70,16 @@ class ParameterColumns:
                 self._rules.append((column, p, "pair", pairs, None))
             column += p.size
 
-    def __call__(self, t, y, fy):
-        out = np.empty((self.system.size, self.width))
+    def weighted(self, t, y, lam):
+        """lambda^T F(t, y) (width,): the columns weighted by ``lam`` (n,), at (t, y)."""
+        fy = self.system(t, y).copy()
+        out = np.empty(self.width)
         for column, p, rule, systems, delta in self._rules:
             if rule == "linear":
-                rate = (systems(t, y) - fy) / delta
-                out[:, column:column + p.size] = rate[:, None] * hats(p, t)
+                out[column:column + p.size] = (lam @ (systems(t, y) - fy)) / delta * hats(p, t)
             else:
                 for j, (up, down, h) in enumerate(systems):
-                    out[:, column + j] = (up(t, y) - down(t, y)) / (2.0 * h)
+                    out[column + j] = lam @ (up(t, y) - down(t, y)) / (2.0 * h)
         return out
 
     def split(self, values):

@@ -1,20 +1,20 @@
-"""The backward half of a continuous adjoint: lambda and the gradient's quadrature,
-integrated by CVODE from the run's end back to its start.
+"""The backward half of a continuous adjoint: lambda integrated by CVODE from the run's end
+back to its start, and the gradient's quadrature along it.
 
 With the forward run y(t) (:class:`rodmol.solve.checkpoints.ForwardRun`), J(t) = df/dy
-and F(t) = df/dp at y(t), the state Lambda = [lambda, q] obeys::
+and F(t) = df/dp at y(t)::
 
-    lambda' = -J(t)^T lambda,     q' = -F(t)^T lambda,     lambda(T+) = 0, q(T) = 0
+    lambda' = -J(t)^T lambda,   lambda(T+) = 0,   lambda += dL/dy(t_k) at the loss's times,
+    dL/dp = integral over [t0, T] of lambda^T F dt  (+ lambda(t0)^T dy0/dp)
 
-with jumps lambda += dL/dy(t_k) at the loss's times (CVODE re-initialised there), so
-that q(t0) = integral of lambda^T F dt and lambda(t0) is dL/dy(t0). Both are
-integrated in t going down (SUNDIALS steps either way). J is the system's compiled
-finite-difference Jacobian on its pattern, at the interpolated state; J and F are
-evaluated once per distinct time (every right-hand side of a BDF step is at its
-new time), and the Newton matrix's Jacobian is the same J^T and F^T. The linear
-solver is SuperLU on the transposed pattern (``"sparse"``) or dense LU.
-q's entries are left out of CVODE's error test (its weights ~0): they do not feed
-back, and their integrand is as smooth as lambda's.
+lambda is integrated in t going down (SUNDIALS steps either way), CVODE re-initialised
+at each jump. J is the system's compiled finite-difference Jacobian on its pattern at
+the interpolated state, evaluated once per distinct time (every right-hand side of a
+BDF step is at its new time) and handed to the Newton matrix too. The quadrature is
+Gauss-Legendre on each backward step, lambda there by CVODE's own interpolant: so F is
+evaluated at a few points per step only, and the Newton matrix stays n x n whatever
+the number of parameters (with the quadrature as CVODE states, a hundred knots made
+it 5x larger and the run 3x slower, measured).
 """
 
 import numpy as np
@@ -22,14 +22,17 @@ from scipy import sparse
 
 from ..errors import IntegrationError
 
-#: q's absolute tolerance: large, so that its entries carry no weight in the error test.
-QUADRATURE_ATOL = 1e20
-#: The backward integration's linear solvers.
-LINEAR_SOLVERS = ("sparse", "dense")
+#: The backward integration's linear solvers: band LU on J^T's band (a rod's), dense
+#: LU, SuperLU on the transposed pattern; "auto": band if the system offers it, else
+#: dense up to DENSE_MAX entries, else sparse.
+LINEAR_SOLVERS = ("auto", "band", "dense", "sparse")
+DENSE_MAX = 1500
+#: Gauss-Legendre points per backward step (exact to degree 5 in the step).
+QUADRATURE_POINTS = 3
 
 
 class AdjointSystem:
-    """The rates of Lambda = [lambda, q] (see the module docstring).
+    """The rates -J(t)^T lambda (see the module docstring).
 
     Parameters
     ----------
@@ -38,103 +41,100 @@ class AdjointSystem:
         y(t) of the forward run.
     scale : (n,) array
         Typical magnitudes of the state (the Jacobian's steps).
-    columns : callable
-        ``columns(t, y, fy)`` -> F (n, P) = df/dp at (t, y).
-    width : int
-        P, the number of quadrature entries.
     """
 
-    def __init__(self, system, state, scale, columns, width):
-        self.system, self.state, self.columns, self.n, self.p = system, state, columns, system.size, width
-        self.size = self.n + self.p
+    def __init__(self, system, state, scale):
+        self.system, self.state, self.n = system, state, system.size
         self.jac = system.jacobian(scale, "sparse")
         pattern = sparse.csc_matrix(self.jac.sparsity, dtype=float)
         pattern.sort_indices()
-        self._j = pattern
+        self._indices, self._indptr = pattern.indices.copy(), pattern.indptr.copy()
         self._data = np.zeros(pattern.nnz)
-        # The transposed pattern's values in J's CSC order, and the augmented matrix
-        # [[-J^T, 0], [-F^T, 0]] (CSC) with the source of each stored value.
-        coded = sparse.csc_matrix((np.arange(1, pattern.nnz + 1, dtype=float), pattern.indices, pattern.indptr),
-                                  shape=pattern.shape)
-        quadrature = sparse.csc_matrix(-np.arange(1, self.p * self.n + 1, dtype=float).reshape(self.p, self.n))
-        full = sparse.bmat([[coded.T, None], [quadrature, None]], format="csc",
-                           dtype=float) if self.p else sparse.bmat([[coded.T]], format="csc", dtype=float)
-        full.resize((self.size, self.size))
-        full.sort_indices()
-        codes = full.data.astype(np.int64)
-        self.sparsity = sparse.csc_matrix((np.ones_like(full.data), full.indices, full.indptr), shape=full.shape)
-        self._from_j = np.flatnonzero(codes > 0), codes[codes > 0] - 1
-        self._from_f = np.flatnonzero(codes < 0), -codes[codes < 0] - 1  # into F^T (p, n) row-major
+        # J's CSC arrays read as CSR are J^T; its CSC form, for SuperLU, by a permutation.
+        coded = sparse.csr_matrix((np.arange(1.0, pattern.nnz + 1), self._indices, self._indptr), shape=pattern.shape)
+        transposed = coded.tocsc()
+        transposed.sort_indices()
+        self._permutation = transposed.data.astype(np.int64) - 1
+        self.sparsity = sparse.csc_matrix((np.ones(pattern.nnz), transposed.indices, transposed.indptr),
+                                          shape=pattern.shape)
         self._t = None
         self.evaluations = 0
 
-    def _at(self, t):
-        """J (CSC values) and F at time t, once per distinct t."""
+    def transposed(self, t):
+        """J(t)^T (CSR), once per distinct t."""
         if self._t != t:
             y = self.state(t)
             fy = self.system(t, y).copy()
             self.jac(t, y, fy, self._data)
-            self.J = sparse.csc_matrix((self._data.copy(), self._j.indices, self._j.indptr), shape=self._j.shape)
-            self.F = np.asarray(self.columns(t, y, fy), dtype=float).reshape(self.n, self.p)
+            self.JT = sparse.csr_matrix((self._data.copy(), self._indices, self._indptr), shape=(self.n, self.n))
             self._t = t
             self.evaluations += 1
-        return self.J, self.F
+        return self.JT
 
-    def rates(self, t, Y, out):
-        J, F = self._at(t)
-        lam = Y[:self.n]
-        out[:self.n] = -(J.T @ lam)
-        out[self.n:] = -(F.T @ lam)
+    def rates(self, t, lam, out):
+        out[:] = -(self.transposed(t) @ lam)
 
-    def sparse_jacobian(self, t, Y, fy, JJ):
-        J, F = self._at(t)
-        rows, source = self._from_j
-        JJ[rows] = -J.data[source]
-        rows, source = self._from_f
-        JJ[rows] = -F.T.ravel()[source]
+    def sparse_jacobian(self, t, lam, fy, JJ):
+        JJ[:] = -self.transposed(t).data[self._permutation]
 
-    def dense_jacobian(self, t, Y, fy, JJ):
-        J, F = self._at(t)
-        JJ[:] = 0.0
-        JJ[:self.n, :self.n] = -J.T.toarray()
-        JJ[self.n:, :self.n] = -F.T
+    def dense_jacobian(self, t, lam, fy, JJ):
+        JJ[:] = -self.transposed(t).toarray()
+
+    def options(self, linsolver):
+        """scikit-sundae's options for ``linsolver`` (see :data:`LINEAR_SOLVERS`)."""
+        if linsolver == "auto":
+            offered = self.system.linear_solvers()
+            linsolver = "band" if "band" in offered else ("dense" if self.n <= DENSE_MAX else "sparse")
+        if linsolver == "sparse":
+            return dict(linsolver="sparse", sparsity=self.sparsity, jacfn=self.sparse_jacobian)
+        if linsolver == "band":
+            lower, upper = self.system.bandwidths()
+            return dict(linsolver="band", lband=int(upper), uband=int(lower), jacfn=self.dense_jacobian)
+        return dict(linsolver="dense", jacfn=self.dense_jacobian)
 
 
-def integrate_backward(adjoint, t0, t_end, jumps, stops, *, rtol, atol, linsolver="sparse", max_order=5):
-    """lambda(t0) and q(t0): Lambda integrated from ``t_end`` down to ``t0`` [s].
+def integrate_backward(adjoint, t0, t_end, jumps, stops, integrand, *, rtol, atol, linsolver="auto",
+                       max_order=5):
+    """lambda(t0) and the quadrature's q = integral of lambda^T F dt over [t0, t_end] [s].
 
-    ``jumps`` is a list of (t [s], dL/dy (n,)) added to lambda at t; ``stops`` [s] are
-    times the steps end at (the inputs' knots, the bounded forward run's segments);
-    ``atol`` (n,) lambda's absolute tolerances. Returns (lambda (n,), q (p,), stats)."""
+    ``jumps``: (t [s], dL/dy (n,)) added to lambda at t; ``stops`` [s]: times the steps
+    end at (the inputs' knots, the bounded forward run's segments); ``integrand(t, lam)``
+    -> lambda^T F(t) (p,); ``atol`` (n,) lambda's absolute tolerances. Returns
+    (lambda(t0) (n,), q (p,), stats)."""
     from sksundae.cvode import CVODE
 
     n = adjoint.n
     jumps = sorted(((float(t), np.asarray(g, dtype=float)) for t, g in jumps), key=lambda j: -j[0])
-    options = dict(method="BDF", rtol=rtol, atol=np.concatenate([atol, np.full(adjoint.p, QUADRATURE_ATOL)]),
-                   max_num_steps=1_000_000, max_order=int(max_order))
-    if linsolver == "sparse":
-        options.update(linsolver="sparse", sparsity=adjoint.sparsity, jacfn=adjoint.sparse_jacobian)
-    else:
-        options.update(linsolver="dense", jacfn=adjoint.dense_jacobian)
-    solver = CVODE(adjoint.rates, **options)
-    Y = np.zeros(adjoint.size)
+    solver = CVODE(adjoint.rates, method="BDF", rtol=rtol, atol=atol, max_num_steps=1_000_000,
+                   max_order=int(max_order), **adjoint.options(linsolver))
+    x, w = np.polynomial.legendre.leggauss(QUADRATURE_POINTS)
+    lam, q, steps = np.zeros(n), None, 0
     times = sorted({float(t) for t in stops if t0 < t < t_end} | {j[0] for j in jumps if t0 < j[0] < t_end} | {t0},
                    reverse=True)
     t = float(t_end)
     for j in [j for j in jumps if j[0] >= t_end]:
-        Y[:n] += j[1]
-    solver.init_step(t, Y)
+        lam += j[1]
+    solver.init_step(t, lam)
     jumps = [j for j in jumps if j[0] < t_end]
     for stop in times:
-        if np.any(Y[:n]):  # else lambda stays 0 and q constant down to the next jump
-            r = solver.step(stop, tstop=stop)
+        while t > stop and np.any(lam):  # else lambda stays 0 down to the next jump
+            r = solver.step(stop, method="onestep", tstop=stop)
             if not r.success:
                 raise IntegrationError(f"the adjoint's backward integration failed at t = {t:.6g} s: {r.message}")
-            Y = np.array(r.y, dtype=float)
+            if r.t >= t:  # CVODE handing the same step back after an interpolation
+                continue
+            lam_step, t_step = np.array(r.y, dtype=float), float(r.t)
+            half, middle = (t - t_step) / 2.0, (t + t_step) / 2.0
+            for xi, wi in zip(x, w):
+                tg = middle + half * xi
+                part = wi * half * np.asarray(integrand(tg, solver.step(tg).y), dtype=float)
+                q = part if q is None else q + part
+            lam, t = lam_step, t_step
+            steps += 1
         t = stop
         added = [g for tj, g in jumps if tj == stop]
         if added:
             for g in added:
-                Y[:n] += g
-            solver.init_step(t, Y)
-    return Y[:n], Y[n:], dict(backward_evaluations=adjoint.evaluations)
+                lam = lam + g
+            solver.init_step(t, lam)
+    return lam, q, dict(backward_steps=steps, backward_jacobians=adjoint.evaluations)
