@@ -33,10 +33,12 @@ from .calibrate import (
     worsened_models,
 )
 from .contacts import Contact
-from .control import Simulator, StaticFit, SystemFit, inverse_statics, inverse_statics_path
+from .control import Simulator, StaticFit, SystemFit, TensionPlan, inverse_statics, inverse_statics_path, optimal_tensions
 from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
 from .discretise.system import SemiDiscrete, StateView, straight_state, undeformed_state
+from .gradients import gradient
+from .losses import Effort, MarkerTracking, StateLoss, TerminalTarget, TipTracking
 from .errors import (
     EquilibriumError,
     IntegrationError,
@@ -80,4 +82,7 @@ __all__ = [
     "worsened_models",
     # rodmol.control: questions a controller asks
     "StaticFit", "SystemFit", "inverse_statics", "inverse_statics_path",
+    # gradients of a run (docs/gradients.md)
+    "Effort", "MarkerTracking", "StateLoss", "TensionPlan", "TerminalTarget", "TipTracking", "gradient",
+    "optimal_tensions",
 ]

@@ -106,7 +106,7 @@ def gradient(model, t_end, loss, parameters, *, checkpoint_every=None, adjoint_l
     for p in chosen:
         grads[p.key] += loss.direct_gradient(model, p, args.t0, t_end)
     if stats is not None:
-        stats.update(forward_steps=forward.steps, forward_s=forward_s, backward_s=time.perf_counter() - clock - forward_s,
+        stats.update(forward_steps=forward.steps, kept_steps=len(forward.kept_t), forward_s=forward_s, backward_s=time.perf_counter() - clock - forward_s,
                      **info)
     return float(value), grads
 
