@@ -33,12 +33,18 @@ from .calibrate import (
     worsened_models,
 )
 from .contacts import Contact
-from .control import Simulator, StaticFit, SystemFit, TensionPlan, inverse_statics, inverse_statics_path, optimal_tensions
+from .control import (
+    Simulator,
+    StaticFit,
+    SystemFit,
+    TensionPlan,
+    inverse_statics,
+    inverse_statics_path,
+    optimal_tensions,
+)
 from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
 from .discretise.system import SemiDiscrete, StateView, straight_state, undeformed_state
-from .gradients import gradient
-from .losses import Effort, MarkerTracking, StateLoss, TerminalTarget, TipTracking
 from .errors import (
     EquilibriumError,
     IntegrationError,
@@ -47,6 +53,7 @@ from .errors import (
     RodmolError,
     UserFunctionError,
 )
+from .gradients import gradient
 from .loads import (
     CapsuleContact,
     DistributedForce,
@@ -57,6 +64,7 @@ from .loads import (
     PointMoment,
     SphereContact,
 )
+from .losses import Effort, MarkerTracking, StateLoss, TerminalTarget, TipTracking
 from .markers import Marker
 from .model import Model
 from .output.formats import load_result, write_series

@@ -24,6 +24,7 @@ import numpy as np
 from . import _checks
 from .errors import ParameterError
 from .frame_gradient import frame_gradient
+from .parameter_rates import hats, is_tension_value
 from .systems import System
 
 #: Gauss-Legendre points per interval between the tensions' knots: exact for the square of a
@@ -227,9 +228,13 @@ class Effort(Loss):
         return self.weight * float(total)
 
     def direct_gradient(self, model, parameter, t0, t_end):
+        if is_tension_value(parameter):  # T(t) = sum of v_k b_k(t): d/dv_k = 2 weight * integral of T b_k
+            t, w = _quadrature(model, t0, t_end)
+            b = np.array([hats(parameter, ti) for ti in t])
+            return 2.0 * self.weight * ((w * (b @ parameter.value)) @ b)
         if not any("tension" in field.split(".") for field in parameter.fields):
             return np.zeros(parameter.size)
-        # The effort is quadratic in a tension's values: the central difference is exact to round-off.
+        # A tension's scale or offset: the central difference of the value.
         out = np.empty(parameter.size)
         for j in range(parameter.size):
             up, down, h = parameter.pair(model, j)

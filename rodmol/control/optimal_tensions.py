@@ -12,9 +12,9 @@ import numpy as np
 from scipy import optimize
 
 from .. import _checks, model_variants, named_parameters, system_variants
+from ..cables import Tension
 from ..errors import ParameterError
 from ..gradients import gradient
-from ..cables import Tension
 from ..inputs import Knots
 from ..simulate import simulate
 from ..systems import System
