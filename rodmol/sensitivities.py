@@ -66,13 +66,14 @@ class Plan:
 
     def initial(self, y0, initial, t0):
         """Y at ``t0`` [s]: ``y0`` and its sensitivities: 0 for a given state or the rest
-        shape, the equilibrium's central difference for ``initial="equilibrium"``."""
+        shape, the equilibrium's central difference for ``initial="equilibrium"`` (each side
+        solved by Newton from ``y0``: a few iterations)."""
         s0 = np.zeros((len(self.columns), self.base.size))
         if isinstance(initial, str) and initial == "equilibrium":
             for i, (p, j) in enumerate(self.columns):
                 up, down, h = p.pair(self.model, j, step=EQUILIBRIUM_STEP * p.scale)
                 systems = [self.kind.discretise(m, self.base.scheme) for m in (up, down)]
-                plus, minus = (equilibrium(s, t0, tol=EQUILIBRIUM_TOL) for s in systems)
+                plus, minus = (equilibrium(s, t0, tol=EQUILIBRIUM_TOL, start=y0) for s in systems)
                 s0[i] = (plus - minus) / (2.0 * h)
         return np.concatenate([np.asarray(y0, dtype=float), s0.reshape(-1)])
 

@@ -205,13 +205,12 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         y0, timings = prepare_run(system, args, progress, sink)
         solver = dict(rtol=args.rtol, atol=args.atol, progress=progress, max_wall_time=args.max_wall_time,
                       **args.backend_options)
-        if augmented is not None:
+        integrated, start = system, y0
+        if augmented is not None:  # the state and its sensitivities, one system (never into a sink)
+            integrated, start = augmented.system, augmented.initial(y0, args.initial, args.t0)
             solver["atol"] = augmented.atol(args.atol)
-            raw = keep_before_failure(args.run, augmented.system, augmented.initial(y0, args.initial, args.t0),
-                                      t_out, **solver)
-            success, message, stats, error = raw.success, raw.message, raw.stats, raw.error
-        elif sink is None:
-            raw = keep_before_failure(args.run, system, y0, t_out, **solver)
+        if sink is None:
+            raw = keep_before_failure(args.run, integrated, start, t_out, **solver)
             success, message, stats, error = raw.success, raw.message, raw.stats, raw.error
         else:  # in chunks into the sink, whose result it is
             success, message, stats, error = run_chunked(args.run, system, y0, t_out, sink, first, **solver)

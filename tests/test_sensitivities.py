@@ -135,3 +135,17 @@ def test_what_sensitivities_cannot_do_is_refused_before_any_work(options, words,
 def test_a_sensitivity_not_asked_for_is_refused_naming_those_that_were(arm_run):
     with pytest.raises(ParameterError, match="'material.rho'.*'material.E'"):
         arm_run.sensitivity("material.rho")
+
+
+def test_a_run_that_fails_keeps_the_sensitivities_of_its_frames():
+    def fails_late(t):
+        if t > 0.2:
+            raise RuntimeError("sensor lost")
+        return 0.5
+
+    arm = rodmol.paper_arm(8, tensions={11: KNOTS, 2: fails_late})
+    with pytest.warns(RuntimeWarning, match="sensor lost"):
+        run = rodmol.simulate(arm, 0.5, initial="straight", sensitivities=["material.E"], **RUN)
+    assert not run.success and 0.15 <= run.t[-1] <= 0.2
+    tip = run.sensitivity("material.E").tip
+    assert tip.shape == run.tip.shape and np.all(np.isfinite(tip)) and np.any(tip != 0.0)

@@ -179,6 +179,16 @@ def _quaternion_norm(out):
         assert row["tip_difference_m"] < 1e-6 and row["steps_with"] == row["steps_without"], row
 
 
+def _sensitivity_accuracy(out):
+    table = rows(out / "sensitivity_accuracy.csv")
+    accuracy = [row for row in table if row["table"] == "accuracy"]
+    tight = min(accuracy, key=lambda row: row["rtol"])
+    assert all(tight[k] < 1e-4 for k in ("error_E", "error_CyCz", "error_11")), tight  # the target
+    assert tight["error_E"] < max(row["error_E"] for row in accuracy)  # tighter tolerances, closer
+    cost = [row for row in table if row["table"] == "cost" and row["run"] == "2 sensitivities"]
+    assert cost and all(1.0 < row["ratio_to_plain"] < 10.0 for row in cost), cost
+
+
 def _octopus(out):
     table = rows(out / "octopus.csv")
     assert all(row["success"] is True for row in table), table
@@ -308,6 +318,7 @@ SCRIPTS = {
     "reach_scores.py": (["reach_scores.csv", "reach_scores.md"], _reach_scores),
     "quaternion_norm.py": (["quaternion_norm.csv", "quaternion_norm.md"], _quaternion_norm),
     "octopus.py": (["octopus.csv", "octopus.md"], _octopus),
+    "sensitivity_accuracy.py": (["sensitivity_accuracy.csv", "sensitivity_accuracy.md"], _sensitivity_accuracy),
     "octopus_stats.py": (["octopus_stats.csv", "octopus_stats.md"], _octopus_stats),
     "system_stepping.py": (["system_stepping.csv", "system_stepping.md"], _system_stepping),
     "system_equilibrium_speed.py": (["system_equilibrium_speed.csv", "system_equilibrium_speed.md"],

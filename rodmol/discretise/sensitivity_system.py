@@ -46,7 +46,8 @@ class SensitivitySystem:
         self.n, self.columns = base.size, len(self.pairs)
         self.size = self.n * (1 + self.columns)
         self.scheme, self.lightly_damped = base.scheme, base.lightly_damped
-        self._up, self._down, self._tmp = np.empty(self.n), np.empty(self.n), np.empty(self.n)
+        # Work arrays: the right-hand sides run thousands of times.
+        self._up, self._down, self._tmp, self._moved = (np.empty(self.n) for _ in range(4))
         probe = np.full(self.n, 2.0)
         base.project_quaternions(probe)
         self._quaternion = probe != 2.0  # the entries the projection moves
@@ -64,32 +65,36 @@ class SensitivitySystem:
         n = self.n
         y = Y[:n]
         self.base(t, y, out[:n])
+        moved, move = self._moved, self._tmp
         for i, (plus, minus) in enumerate(self.pairs):
             h, block = self.steps[i], slice((i + 1) * n, (i + 2) * n)
-            move = h * Y[block]
-            plus(t, y + move, self._up)
-            minus(t, y - move, self._down)
+            np.multiply(Y[block], h, out=move)
+            plus(t, np.add(y, move, out=moved), self._up)
+            minus(t, np.subtract(y, move, out=moved), self._down)
             np.subtract(self._up, self._down, out=out[block])
-            out[block] /= 2.0 * h
+            out[block] *= 0.5 / h
         return out
 
     def jacobian_times(self, scale):
         """scikit-sundae's ``jactimes.solvefn``: Jv of each block, J the model's, by one-sided
         differences of f at y (``fy`` the rates CVODE holds); ``scale`` (size,) typical magnitudes."""
-        n, base, tmp = self.n, self.base, self._tmp
-        scale = np.asarray(scale, dtype=float)[:n]
+        n, base = self.n, self.base
+        inverse = 1.0 / np.asarray(scale, dtype=float)[:n]
+        work, moved, rates = np.empty(n), np.empty(n), np.empty(n)
 
         def solve(t, Y, FY, V, JV):
             y, fy = Y[:n], FY[:n]
             for k in range(1 + self.columns):
-                v = V[k * n:(k + 1) * n]
-                size = np.max(np.abs(v) / scale)
+                v, jv = V[k * n:(k + 1) * n], JV[k * n:(k + 1) * n]
+                size = np.multiply(np.abs(v, out=work), inverse, out=work).max()
                 if size == 0.0:
-                    JV[k * n:(k + 1) * n] = 0.0
+                    jv[:] = 0.0
                     continue
                 sigma = JV_STEP / size
-                base(t, y + sigma * v, tmp)
-                JV[k * n:(k + 1) * n] = (tmp - fy) / sigma
+                np.multiply(v, sigma, out=moved)
+                base(t, np.add(moved, y, out=moved), rates)
+                np.subtract(rates, fy, out=jv)
+                jv *= 1.0 / sigma
         return solve
 
     def preconditioner(self, scale):
