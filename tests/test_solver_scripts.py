@@ -189,6 +189,16 @@ def _sensitivity_accuracy(out):
     assert cost and all(1.0 < row["ratio_to_plain"] < 10.0 for row in cost), cost
 
 
+def _adjoint_cost(out):
+    table = rows(out / "adjoint_cost.csv")
+    accuracy = [row for row in table if row["table"] == "accuracy"]
+    tight = min(accuracy, key=lambda row: row["rtol"])
+    assert all(tight[k] < 1e-4 for k in tight if k.startswith("error_")), tight  # the target
+    assert tight["error_knot5"] <= max(row["error_knot5"] for row in accuracy)  # tighter tolerances, closer
+    cost = [row for row in table if row["table"] == "cost" and row["run"] != "plain"]
+    assert cost and all(1.0 < row["ratio_to_plain"] < 30.0 for row in cost), cost
+
+
 def _octopus(out):
     table = rows(out / "octopus.csv")
     assert all(row["success"] is True for row in table), table
@@ -319,6 +329,7 @@ SCRIPTS = {
     "quaternion_norm.py": (["quaternion_norm.csv", "quaternion_norm.md"], _quaternion_norm),
     "octopus.py": (["octopus.csv", "octopus.md"], _octopus),
     "sensitivity_accuracy.py": (["sensitivity_accuracy.csv", "sensitivity_accuracy.md"], _sensitivity_accuracy),
+    "adjoint_cost.py": (["adjoint_cost.csv", "adjoint_cost.md"], _adjoint_cost),
     "octopus_stats.py": (["octopus_stats.csv", "octopus_stats.md"], _octopus_stats),
     "system_stepping.py": (["system_stepping.csv", "system_stepping.md"], _system_stepping),
     "system_equilibrium_speed.py": (["system_equilibrium_speed.csv", "system_equilibrium_speed.md"],
