@@ -101,7 +101,7 @@ def gradient(model, t_end, loss, parameters, *, checkpoint_every=None, adjoint_l
                                         atol=atol_lambda, linsolver=adjoint_linsolver)
     total = np.zeros(columns.width) if q0 is None else np.array(q0)
     if isinstance(args.initial, str) and args.initial == "equilibrium" and np.any(lam0):
-        total += lam0 @ columns.initial_equilibrium(args.t0)
+        total += lam0 @ columns.initial_equilibrium(args.t0, y0)
     grads = columns.split(total)
     for p in chosen:
         grads[p.key] += loss.direct_gradient(model, p, args.t0, t_end)

@@ -90,15 +90,15 @@ class ParameterColumns:
             column += p.size
         return out
 
-    def initial_equilibrium(self, t0):
+    def initial_equilibrium(self, t0, y0):
         """dy0/dp (n, width) of the equilibrium at ``t0`` [s] (``initial="equilibrium"``): central
         differences of two equilibria per component (:meth:`Parameter.pair`, as the forward
-        sensitivities take them); a tension's of its value at t0 (one-sided of second order
+        sensitivities take them, each solved by Newton from the run's ``y0``); a tension's of its value at t0 (one-sided of second order
         where a value sits at zero), times the hats there."""
         out = np.zeros((self.system.size, self.width))
 
         def rest(model):
-            return equilibrium(self.kind.discretise(model, self.system.scheme), t0, tol=EQUILIBRIUM_TOL)
+            return equilibrium(self.kind.discretise(model, self.system.scheme), t0, tol=EQUILIBRIUM_TOL, start=y0)
 
         for column, p, rule, _, _ in self._rules:
             h = EQUILIBRIUM_STEP * p.scale

@@ -11,7 +11,10 @@ track recorded with another history (TipTracking at every 0.1 s):
   times by 2x); the gradient with bounded memory (``checkpoint_every=20``) too;
 * accuracy: the gradient at rtol 1e-4 .. 1e-8 against central differences of the
   loss of two runs of ``simulate`` at rtol 1e-10 (step 1e-3 of the value): E, Cy,Cz
-  and two knots (relative to the largest knot component).
+  and two knots (relative to the largest knot component); E and Cy,Cz also against
+  the forward sensitivities of one run at rtol 1e-10 (``simulate(...,
+  sensitivities=[...])``, the loss's derivative by the chain rule), a reference
+  without the differences' cancellation.
 
     python solvers/adjoint_cost.py [--quick | --smoke] [--out DIR] [--reps K]
 """
@@ -57,6 +60,12 @@ def accuracy(model, t_end, times, loss, rtols, knot_components):
         down[component] -= h
         references[key, component] = (loss_of(p.at(model, up), t_end, times, loss, REFERENCE_RTOL)
                                       - loss_of(p.at(model, down), t_end, times, loss, REFERENCE_RTOL)) / (2 * h)
+    forward = rodmol.simulate(model, t_end, output_times=times, rtol=REFERENCE_RTOL,
+                              sensitivities=["material.E", "medium.Cy,Cz"])
+    rows_at = np.searchsorted(forward.t, times)
+    residual = forward.tip[rows_at] - loss.targets
+    by_forward = {key: float(2.0 * np.sum(residual * forward.sensitivity(key).tip[rows_at]))
+                  for key in ("material.E", "medium.Cy,Cz")}
     rows = []
     for rtol in rtols:
         start = time.perf_counter()
@@ -67,6 +76,9 @@ def accuracy(model, t_end, times, loss, rtols, knot_components):
             scale = largest_knot if key.startswith("tension") else abs(references[key, component])
             name = f"knot{component}" if key.startswith("tension") else key.split(".")[-1].replace(",", "")
             row[f"error_{name}"] = float(abs(grads[key][component] - references[key, component]) / scale)
+        for key, reference in by_forward.items():
+            name = key.split(".")[-1].replace(",", "")
+            row[f"error_{name}_vs_forward"] = float(abs(grads[key][0] - reference) / abs(reference))
         rows.append(row)
         print(row, flush=True)
     return rows
@@ -89,7 +101,8 @@ def cost(model, t_end, times, loss, rtols, reps):
                 cpus[name].append(time.process_time() - cpu)
                 info[name] = dict(steps=out.stats["steps"]) if name == "plain" else dict(
                     steps=stats["forward_steps"], backward_steps=stats["backward_steps"],
-                    kept_steps=stats["kept_steps"])
+                    kept_steps=stats["kept_steps"], forward_wall_s=stats["forward_s"],
+                    backward_wall_s=stats["backward_s"])
         plain = float(np.median(cpus["plain"]))
         for name in runs:
             cpu = float(np.median(cpus[name]))
@@ -116,7 +129,8 @@ def main(argv=None):
          C.markdown_table(accurate, formats=dict(wall_s=".3f", **errors))),
         (f"cost: the gradient by {knots} knots, E and Cy,Cz against the plain run at the same rtol, median of "
          f"{args.reps}; ratios of CPU time",
-         C.markdown_table(costs, formats=dict(cpu_s=".3f", ratio_to_plain=".2f"))),
+         C.markdown_table(costs, formats=dict(cpu_s=".3f", ratio_to_plain=".2f", forward_wall_s=".3f",
+                                                    backward_wall_s=".3f"))),
     ]
     C.write_results(args, "adjoint_cost", "Adjoint gradients: cost and accuracy", header,
                     [dict(table="accuracy", **row) for row in accurate] + [dict(table="cost", **row) for row in costs],
