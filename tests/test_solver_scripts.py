@@ -199,6 +199,12 @@ def _adjoint_cost(out):
     assert cost and all(1.0 < row["ratio_to_plain"] < 30.0 for row in cost), cost
 
 
+def _optimal_tensions(out):
+    summary = [row for row in rows(out / "optimal_tensions.csv") if row["table"] == "summary"][0]
+    assert summary["success"] is True and summary["rms_error_N"] < 0.05, summary  # the target
+    assert summary["loss_end"] < 1e-6 * summary["loss_start"], summary
+
+
 def _octopus(out):
     table = rows(out / "octopus.csv")
     assert all(row["success"] is True for row in table), table
@@ -330,6 +336,8 @@ SCRIPTS = {
     "octopus.py": (["octopus.csv", "octopus.md"], _octopus),
     "sensitivity_accuracy.py": (["sensitivity_accuracy.csv", "sensitivity_accuracy.md"], _sensitivity_accuracy),
     "adjoint_cost.py": (["adjoint_cost.csv", "adjoint_cost.md"], _adjoint_cost),
+    "optimal_tensions.py": (["optimal_tensions.csv", "optimal_tensions.md", "optimal_tensions.png"],
+                            _optimal_tensions),
     "octopus_stats.py": (["octopus_stats.csv", "octopus_stats.md"], _octopus_stats),
     "system_stepping.py": (["system_stepping.csv", "system_stepping.md"], _system_stepping),
     "system_equilibrium_speed.py": (["system_equilibrium_speed.csv", "system_equilibrium_speed.md"],
@@ -389,7 +397,12 @@ def _main(script):
     return importlib.import_module(script.removesuffix(".py")).main
 
 
-@pytest.mark.parametrize("script", [pytest.param(s, marks=pytest.mark.subprocess) if s in SPAWNING else s
+#: Scripts whose smoke run takes tens of seconds (an optimisation of many runs).
+SLOW = {"optimal_tensions.py"}
+
+
+@pytest.mark.parametrize("script", [pytest.param(s, marks=pytest.mark.subprocess) if s in SPAWNING
+                                    else pytest.param(s, marks=pytest.mark.slow) if s in SLOW else s
                                     for s in sorted(SCRIPTS) if s != COMMAND])
 def test_script_smoke_run(script, tmp_path):
     _skip_without_what_it_needs(script)
