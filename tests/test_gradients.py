@@ -97,6 +97,15 @@ def test_bounded_checkpoints_give_the_same_gradient(rod_gradient):
     assert stats["kept_steps"] * 4 < stats["forward_steps"]  # memory: every 8th step and one segment
 
 
+def test_a_loss_time_a_rounding_error_off_a_knot_is_that_knots_time():
+    # np.linspace's 3.5000000000000004 beside a knot at 3.5 s: the backward integration failed with
+    # "the output and initial times are too close" (the solvers/optimal_tensions.py run).
+    exact, rounded = ([t, 0.5] for t in (0.2, 0.2 + 2e-16))
+    grads = [rodmol.gradient(_arm(), 0.5, rodmol.TipTracking(times, TARGETS[:2]), ["tension.11"],
+                             initial="straight", rtol=1e-6)[1]["tension.11"] for times in (exact, rounded)]
+    np.testing.assert_allclose(grads[1], grads[0], rtol=1e-6)
+
+
 def test_a_loss_read_before_any_force_moves_nothing():
     # The arm starts straight and unloaded: a target at t0 is a constant.
     loss = rodmol.TerminalTarget([0.0, 0.2, 0.0], t=0.0)

@@ -27,6 +27,8 @@ from ..errors import IntegrationError
 #: dense up to DENSE_MAX entries, else sparse.
 LINEAR_SOLVERS = ("auto", "band", "dense", "sparse")
 DENSE_MAX = 1500
+#: Times closer than this fraction of the run's span are one stop of the backward steps.
+RESOLUTION = 1e-9
 #: Gauss-Legendre points per backward step (exact to degree 3 in the step; 3 points changed
 #: the gradient by 1e-9 relative and cost 15 % more, measured on the benchmark's arm).
 QUADRATURE_POINTS = 2
@@ -110,8 +112,10 @@ def integrate_backward(adjoint, t0, t_end, jumps, stops, integrand, *, rtol, ato
                    max_order=int(max_order), **adjoint.options(linsolver))
     x, w = np.polynomial.legendre.leggauss(QUADRATURE_POINTS)
     lam, q, steps = np.zeros(n), None, 0
-    times = sorted({float(t) for t in stops if t0 < t < t_end} | {j[0] for j in jumps if t0 < j[0] < t_end} | {t0},
-                   reverse=True)
+    times = _stops(t0, t_end, [*stops, *(j[0] for j in jumps)])
+    # Each jump at the stop it falls on (times closer than the resolution are one: a loss
+    # time of 3.5000000000000004 s at a knot of 3.5 s would be a step CVODE cannot take).
+    jumps = [(min([t_end, *times], key=lambda s: abs(s - tj)), g) for tj, g in jumps]
     t = float(t_end)
     for j in [j for j in jumps if j[0] >= t_end]:
         lam += j[1]
@@ -139,3 +143,17 @@ def integrate_backward(adjoint, t0, t_end, jumps, stops, integrand, *, rtol, ato
                 lam = lam + g
             solver.init_step(t, lam)
     return lam, q, dict(backward_steps=steps, backward_jacobians=adjoint.evaluations)
+
+
+def _stops(t0, t_end, candidates):
+    """The times in [t0, t_end) the backward steps end at, decreasing, ending with t0; times
+    closer than :data:`RESOLUTION` of the span to a later one are dropped."""
+    gap = RESOLUTION * max(abs(t_end), abs(t0), t_end - t0)
+    kept, last = [], float(t_end)
+    for c in sorted({float(c) for c in candidates if t0 < c < t_end}, reverse=True):
+        if last - c > gap:
+            kept.append(c)
+            last = c
+    if kept and kept[-1] - t0 <= gap:
+        kept.pop()
+    return [*kept, float(t0)]
