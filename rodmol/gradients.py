@@ -93,7 +93,7 @@ def gradient(model, t_end, loss, parameters, *, checkpoint_every=None, adjoint_l
     frames_at = np.asarray(loss.times(args.t0, t_end), dtype=float)
     forward = ForwardRun(system, args.t0, y0, t_end, frames_at, rtol=args.rtol, atol=args.atol,
                          every=checkpoint_every, max_wall_time=args.max_wall_time, **args.backend_options)
-    value, jumps = loss.evaluate(kind, system, frames_at, forward.frames)
+    value, jumps = loss.evaluate(kind, system, frames_at, forward.frames, (args.t0, t_end))
     value += loss.direct(model, args.t0, t_end)
     forward_s = time.perf_counter() - clock
     scale = np.asarray(args.atol, dtype=float) / args.rtol

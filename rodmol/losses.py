@@ -48,8 +48,9 @@ class Loss:
             raise ParameterError(f"{type(self).__name__}: its times [{times[0]!r}, {times[-1]!r}] s must lie in "
                                  f"the run's [{t0!r}, {t_end!r}] s")
 
-    def evaluate(self, kind, system, t, states):
-        """(value, dL/dy (len(t), size)) of the frames ``states`` at this loss's times ``t``."""
+    def evaluate(self, kind, system, t, states, span=None):
+        """(value, dL/dy (len(t), size)) of the frames ``states`` at this loss's times ``t``
+        of a run over ``span`` = (t0, t_end) [s]."""
         return 0.0, np.zeros_like(np.asarray(states, dtype=float))
 
     def direct(self, model, t0, t_end):
@@ -89,13 +90,13 @@ class LossSum(Loss):
         for part in self.parts:
             part.check(model, t0, t_end)
 
-    def evaluate(self, kind, system, t, states):
+    def evaluate(self, kind, system, t, states, span=None):
         value, gradient = 0.0, np.zeros_like(np.asarray(states, dtype=float))
-        t0, t_end = (t[0], t[-1]) if len(t) else (0.0, 0.0)
+        t0, t_end = span if span is not None else ((t[0], t[-1]) if len(t) else (0.0, 0.0))
         for part in self.parts:
             own = part.times(t0, t_end) if len(t) else np.empty(0)
             rows = np.searchsorted(t, own)
-            v, g = part.evaluate(kind, system, t[rows], states[rows])
+            v, g = part.evaluate(kind, system, t[rows], states[rows], span)
             value += v
             np.add.at(gradient, rows, g)
         return value, gradient
@@ -117,7 +118,7 @@ class FrameLoss(Loss):
     def term(self, result, k):
         raise NotImplementedError
 
-    def evaluate(self, kind, system, t, states):
+    def evaluate(self, kind, system, t, states, span=None):
         states = np.asarray(states, dtype=float)
         result = kind.result(system, t, states, True, "", {})
         value = float(sum(self.term(result, k)[k] for k in range(len(t))))
@@ -189,6 +190,10 @@ class MarkerTracking(FrameLoss):
 
     def times(self, t0, t_end):
         return np.asarray(_times_of(self.tracks), dtype=float)
+
+    def evaluate(self, kind, system, t, states, span=None):
+        self._matched = None  # matched afresh to each run's result (another model may differ)
+        return super().evaluate(kind, system, t, states, span)
 
     def term(self, result, k):
         measured, targets = self._match(result)
@@ -279,7 +284,7 @@ class StateLoss(Loss):
     def times(self, t0, t_end):
         return self._times
 
-    def evaluate(self, kind, system, t, states):
+    def evaluate(self, kind, system, t, states, span=None):
         try:
             value = self.value(t.copy(), states.copy())
             gradient = self.gradient(t.copy(), states.copy())
