@@ -57,6 +57,11 @@ class Loss:
         """The part of the value that reads the model, not the state."""
         return 0.0
 
+    def until(self, t):
+        """This loss over a run that ends at ``t`` [s]: its terms at times up to ``t`` (None if
+        none is left), for a growing horizon (:func:`rodmol.optimal_tensions`' ``horizons``)."""
+        return self
+
     def direct_gradient(self, model, parameter, t0, t_end):
         """d :meth:`direct` / d ``parameter`` (a :class:`rodmol.named_parameters.Parameter`), (m,)."""
         return np.zeros(parameter.size)
@@ -104,6 +109,10 @@ class LossSum(Loss):
     def direct(self, model, t0, t_end):
         return sum(p.direct(model, t0, t_end) for p in self.parts)
 
+    def until(self, t):
+        kept = [w for w in (p.until(t) for p in self.parts) if w is not None]
+        return None if not kept else kept[0] if len(kept) == 1 else LossSum(kept)
+
     def direct_gradient(self, model, parameter, t0, t_end):
         return sum(p.direct_gradient(model, parameter, t0, t_end) for p in self.parts)
 
@@ -148,6 +157,12 @@ class TipTracking(FrameLoss):
         super().check(model, t0, t_end)
         _check_rod(model, self.rod, type(self).__name__)
 
+    def until(self, t):
+        keep = self._times <= t
+        if not keep.any():
+            return None
+        return TipTracking(self._times[keep], self.targets[keep], self.weights[keep], self.rod)
+
     def term(self, result, k):
         tip = (result if self.rod is None else result[self.rod]).tip
         return self.weights[k] * np.sum((tip - self.targets[k]) ** 2, axis=-1)
@@ -165,6 +180,9 @@ class TerminalTarget(TipTracking):
 
     def times(self, t0, t_end):
         return np.array([t_end if self.at is None else self.at])
+
+    def until(self, t):
+        return self if self.at is not None and self.at <= t else None
 
     def __repr__(self):
         return f"TerminalTarget(t={'end' if self.at is None else self.at})"
@@ -190,6 +208,13 @@ class MarkerTracking(FrameLoss):
 
     def times(self, t0, t_end):
         return np.asarray(_times_of(self.tracks), dtype=float)
+
+    def until(self, t):
+        if _times_of(self.tracks)[0] > t:
+            return None
+        if isinstance(self.tracks, dict):
+            return MarkerTracking({part: tracks.until(t) for part, tracks in self.tracks.items()})
+        return MarkerTracking(self.tracks.until(t))
 
     def evaluate(self, kind, system, t, states, span=None):
         self._matched = None  # matched afresh to each run's result (another model may differ)
@@ -283,6 +308,10 @@ class StateLoss(Loss):
 
     def times(self, t0, t_end):
         return self._times
+
+    def until(self, t):
+        keep = self._times <= t
+        return StateLoss(self._times[keep], self.value, self.gradient) if keep.any() else None
 
     def evaluate(self, kind, system, t, states, span=None):
         try:

@@ -112,6 +112,23 @@ def test_losses_add_up():
     assert total == pytest.approx(sum(parts), rel=1e-9)
 
 
+def test_a_loss_until_a_time_keeps_its_terms_up_to_it():
+    tracking = rodmol.TipTracking(TIMES, TARGETS)
+    early = tracking.until(0.3)
+    np.testing.assert_array_equal(early.times(0.0, 0.3), TIMES[:2])
+    np.testing.assert_array_equal(early.targets, TARGETS[:2])
+    assert tracking.until(0.05) is None
+    assert rodmol.TerminalTarget([0, 0, 0]).until(0.3) is None  # the run's end is not in a shorter run
+    both = (tracking + rodmol.Effort(1.0) + rodmol.TerminalTarget([0, 0, 0], t=0.4)).until(0.3)
+    assert [type(p).__name__ for p in both.parts] == ["TipTracking", "Effort"]
+    tracks = MarkerTracks(TIMES, np.zeros((4, 4, 3)), ("a", "b", "c", "d"))
+    np.testing.assert_array_equal(rodmol.MarkerTracking(tracks).until(0.3).times(0, 0.3), TIMES[:2])
+    # The value of the shorter run's loss is the full loss's terms up to then.
+    value, _ = rodmol.gradient(_arm(), 0.3, early, ["material.E"], initial="straight", rtol=RTOL)
+    run = rodmol.simulate(_arm(), 0.5, initial="straight", rtol=RTOL, output_times=TIMES)
+    assert value == pytest.approx(float(np.sum((run.tip[1:3] - TARGETS[:2]) ** 2)), rel=1e-6)
+
+
 def test_a_users_loss_that_raises_is_named():
     def broken(t, states):
         raise KeyError("oops")

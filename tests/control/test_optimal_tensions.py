@@ -36,7 +36,7 @@ def test_a_bending_motions_tensions_are_recovered_from_its_tip_track():
 def test_the_plan_starts_where_asked_and_stays_in_its_bounds():
     loss = rodmol.TerminalTarget([0.0, 0.15, 0.2], t=0.3)
     plan = rodmol.optimal_tensions(_arm(), 0.3, loss, ["11"], [0.0, 0.3], bounds=(0.5, 1.0), start=3.0,
-                                   initial="straight", max_iterations=3)
+                                   initial="straight", max_iterations=3, horizons=[0.2])
     values = plan.tensions["11"].values[:, 0]
     assert np.all((values >= 0.5) & (values <= 1.0)) and len(plan.history) >= 1
     assert plan.result.t[-1] == pytest.approx(0.3)
@@ -49,6 +49,8 @@ def test_the_plan_starts_where_asked_and_stays_in_its_bounds():
     (dict(bounds=(2.0, 1.0)), "bounds"),
     (dict(bounds=3.0), "bounds"),
     (dict(start=np.nan), "start"),
+    (dict(horizons=[0.5, 2.0]), "horizons"),
+    (dict(horizons=[0.6, 0.3]), "horizons"),
 ])
 def test_what_optimal_tensions_refuses(kwargs, words):
     args = dict(cables=["cable 11"], knots=KNOTS, bounds=(0.0, 5.0))
