@@ -159,13 +159,13 @@ def parameter(model, key):
 
 
 def _refuse_structure(key, field):
-    tail = field.split(".")
-    joined = ".".join(tail[-2:])
+    """A ParameterError saying why ``field`` (of ``key``) is not a parameter, if it is not."""
     for name, why in NOT_PARAMETERS.items():
         if field == name or field.endswith("." + name):
             raise ParameterError(f"{key!r} is not a parameter: {why}")
-    if field.startswith(("solver.",)) or joined == "discretization.scheme":
+    if field.startswith("solver."):
         raise ParameterError(f"{key!r} is not a parameter: it is a setting of the run")
+    tail = field.split(".")
     if len(tail) >= 2 and tail[-2] == "medium" and tail[-1] in rod_variants.SWITCHES:
         raise ParameterError(f"{key!r} is not a parameter: a switch (true/false) has no derivative")
 
