@@ -33,7 +33,15 @@ from .calibrate import (
     worsened_models,
 )
 from .contacts import Contact
-from .control import Simulator, StaticFit, SystemFit, inverse_statics, inverse_statics_path
+from .control import (
+    Simulator,
+    StaticFit,
+    SystemFit,
+    TensionPlan,
+    inverse_statics,
+    inverse_statics_path,
+    optimal_tensions,
+)
 from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
 from .discretise.system import SemiDiscrete, StateView, straight_state, undeformed_state
@@ -45,6 +53,7 @@ from .errors import (
     RodmolError,
     UserFunctionError,
 )
+from .gradients import gradient
 from .loads import (
     CapsuleContact,
     DistributedForce,
@@ -55,6 +64,7 @@ from .loads import (
     PointMoment,
     SphereContact,
 )
+from .losses import Effort, MarkerTracking, StateLoss, TerminalTarget, TipTracking
 from .markers import Marker
 from .model import Model
 from .output.formats import load_result, write_series
@@ -80,4 +90,7 @@ __all__ = [
     "worsened_models",
     # rodmol.control: questions a controller asks
     "StaticFit", "SystemFit", "inverse_statics", "inverse_statics_path",
+    # gradients of a run (docs/gradients.md)
+    "Effort", "MarkerTracking", "StateLoss", "TensionPlan", "TerminalTarget", "TipTracking", "gradient",
+    "optimal_tensions",
 ]

@@ -189,6 +189,22 @@ def _sensitivity_accuracy(out):
     assert cost and all(1.0 < row["ratio_to_plain"] < 10.0 for row in cost), cost
 
 
+def _adjoint_cost(out):
+    table = rows(out / "adjoint_cost.csv")
+    accuracy = [row for row in table if row["table"] == "accuracy"]
+    tight = min(accuracy, key=lambda row: row["rtol"])
+    assert all(tight[k] < 1e-4 for k in tight if k.startswith("error_")), tight  # the target
+    assert tight["error_knot5"] <= max(row["error_knot5"] for row in accuracy)  # tighter tolerances, closer
+    cost = [row for row in table if row["table"] == "cost" and row["run"] != "plain"]
+    assert cost and all(1.0 < row["ratio_to_plain"] < 30.0 for row in cost), cost
+
+
+def _optimal_tensions(out):
+    summary = [row for row in rows(out / "optimal_tensions.csv") if row["table"] == "summary"][0]
+    assert summary["success"] is True and summary["rms_error_N"] < 0.05, summary  # the target
+    assert summary["loss_end"] < 1e-6 * summary["loss_start"], summary
+
+
 def _octopus(out):
     table = rows(out / "octopus.csv")
     assert all(row["success"] is True for row in table), table
@@ -350,6 +366,9 @@ SCRIPTS = {
     "quaternion_norm.py": (["quaternion_norm.csv", "quaternion_norm.md"], _quaternion_norm),
     "octopus.py": (["octopus.csv", "octopus.md"], _octopus),
     "sensitivity_accuracy.py": (["sensitivity_accuracy.csv", "sensitivity_accuracy.md"], _sensitivity_accuracy),
+    "adjoint_cost.py": (["adjoint_cost.csv", "adjoint_cost.md"], _adjoint_cost),
+    "optimal_tensions.py": (["optimal_tensions.csv", "optimal_tensions.md", "optimal_tensions.png"],
+                            _optimal_tensions),
     "octopus_stats.py": (["octopus_stats.csv", "octopus_stats.md"], _octopus_stats),
     "system_stepping.py": (["system_stepping.csv", "system_stepping.md"], _system_stepping),
     "system_equilibrium_speed.py": (["system_equilibrium_speed.csv", "system_equilibrium_speed.md"],
@@ -417,7 +436,12 @@ def _main(script):
     return importlib.import_module(script.removesuffix(".py")).main
 
 
-@pytest.mark.parametrize("script", [pytest.param(s, marks=pytest.mark.subprocess) if s in SPAWNING else s
+#: Scripts whose smoke run takes tens of seconds (an optimisation of many runs).
+SLOW = {"optimal_tensions.py"}
+
+
+@pytest.mark.parametrize("script", [pytest.param(s, marks=pytest.mark.subprocess) if s in SPAWNING
+                                    else pytest.param(s, marks=pytest.mark.slow) if s in SLOW else s
                                     for s in sorted(SCRIPTS) if s != COMMAND])
 def test_script_smoke_run(script, tmp_path):
     _skip_without_what_it_needs(script)

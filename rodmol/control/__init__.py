@@ -10,10 +10,12 @@ by ``gymnasium.make``.
 """
 
 from .inverse_statics import StaticFit, inverse_statics, inverse_statics_path
+from .optimal_tensions import TensionPlan, optimal_tensions
 from .registration import register_environments
 from .simulator import Simulator, Snapshot
 from .system_fit import SystemFit
 
 register_environments()
 
-__all__ = ["Simulator", "Snapshot", "StaticFit", "SystemFit", "inverse_statics", "inverse_statics_path"]
+__all__ = ["Simulator", "Snapshot", "StaticFit", "SystemFit", "TensionPlan", "inverse_statics", "inverse_statics_path",
+           "optimal_tensions"]

@@ -1,0 +1,59 @@
+"""optimal_tensions: a tension history recovered from its own tip track, starting from zero
+tension; what it refuses before any work."""
+
+import numpy as np
+import pytest
+
+import rodmol
+from rodmol.errors import ParameterError
+
+KNOTS = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
+TRUE = np.array([0.0, 1.5, 2.5, 1.0, 0.5])
+#: RMS error [N] asserted on the recovered knots (measured: 2e-6 N in 28 losses and gradients).
+RMS = 1e-3
+
+
+def _arm(values=TRUE):
+    return rodmol.paper_arm(6, tensions={11: list(zip(KNOTS, values))})
+
+
+@pytest.mark.slow
+def test_a_bending_motions_tensions_are_recovered_from_its_tip_track():
+    times = np.linspace(0.05, 1.0, 20)
+    run = rodmol.simulate(_arm(), 1.0, initial="straight", rtol=1e-7, output_times=times)
+    loss = rodmol.TipTracking(times, run.tip[np.searchsorted(run.t, times)])
+    plan = rodmol.optimal_tensions(_arm(np.zeros(5)), 1.0, loss, ["cable 11"], KNOTS, bounds=(0.0, 5.0),
+                                   initial="straight", rtol=1e-7)
+    found = plan.tensions["cable 11"].values[:, 0]
+    rms = float(np.sqrt(np.mean((found - TRUE) ** 2)))
+    print(f"RMS error {rms:.2e} N after {plan.evaluations} evaluations, loss {plan.history[0]:.3g} -> "
+          f"{plan.history[-1]:.3g} m^2")
+    assert plan.success and rms < RMS
+    assert plan.history[-1] < 1e-6 * plan.history[0]
+    np.testing.assert_allclose(plan.result.tip[-1], run.tip[-1], atol=1e-5)
+
+
+def test_the_plan_starts_where_asked_and_stays_in_its_bounds():
+    loss = rodmol.TerminalTarget([0.0, 0.15, 0.2], t=0.3)
+    plan = rodmol.optimal_tensions(_arm(), 0.3, loss, ["11"], [0.0, 0.3], bounds=(0.5, 1.0), start=3.0,
+                                   initial="straight", max_iterations=3, horizons=[0.2])
+    values = plan.tensions["11"].values[:, 0]
+    assert np.all((values >= 0.5) & (values <= 1.0)) and len(plan.history) >= 1
+    assert plan.result.t[-1] == pytest.approx(0.3)
+
+
+@pytest.mark.parametrize("kwargs, words", [
+    (dict(cables="cable 11"), "cables"),
+    (dict(cables=["cable 99"]), "cable 99"),
+    (dict(knots=[0.5, 0.2]), "knots"),
+    (dict(bounds=(2.0, 1.0)), "bounds"),
+    (dict(bounds=3.0), "bounds"),
+    (dict(start=np.nan), "start"),
+    (dict(horizons=[0.5, 2.0]), "horizons"),
+    (dict(horizons=[0.6, 0.3]), "horizons"),
+])
+def test_what_optimal_tensions_refuses(kwargs, words):
+    args = dict(cables=["cable 11"], knots=KNOTS, bounds=(0.0, 5.0))
+    args.update(kwargs)
+    with pytest.raises(ParameterError, match=words):
+        rodmol.optimal_tensions(_arm(), 1.0, rodmol.TerminalTarget([0, 0, 0.3]), initial="straight", **args)
