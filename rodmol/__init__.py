@@ -32,6 +32,7 @@ from .calibrate import (
     triangulate,
     worsened_models,
 )
+from .calibrate.marker_loss import MarkerTracking
 from .contacts import Contact
 from .control import (
     Simulator,
@@ -64,7 +65,7 @@ from .loads import (
     PointMoment,
     SphereContact,
 )
-from .losses import Effort, MarkerTracking, StateLoss, TerminalTarget, TipTracking
+from .losses import Effort, StateLoss, TerminalTarget, TipTracking
 from .markers import Marker
 from .model import Model
 from .output.formats import load_result, write_series

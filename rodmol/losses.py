@@ -10,7 +10,9 @@ Effort(1e-3)``.
 
 * :class:`TipTracking` sum over times of w_k |tip(t_k) - target_k|^2 [m^2];
 * :class:`TerminalTarget` w |tip(t) - target|^2 at one time (default: the end);
-* :class:`MarkerTracking` sum over frames and seen markers of |marker - measured|^2 [m^2];
+* :class:`rodmol.calibrate.marker_loss.MarkerTracking` (on the calibration's floor, which
+  owns how a measurement names the parts it sees) sum over frames and seen markers of
+  |marker - measured|^2 [m^2];
 * :class:`Effort` weight * integral of the sum of squared tensions dt [weight N^2 s];
 * :class:`StateLoss` the user's own function of the states at given times, with its gradient.
 
@@ -186,56 +188,6 @@ class TerminalTarget(TipTracking):
 
     def __repr__(self):
         return f"TerminalTarget(t={'end' if self.at is None else self.at})"
-
-
-class MarkerTracking(FrameLoss):
-    """sum over the frames of ``tracks`` (a :class:`rodmol.calibrate.MarkerTracks`, or
-    ``{part: MarkerTracks}`` of a System, as :func:`rodmol.identify` takes them) and
-    over the markers seen (NaN: not seen) of |marker - measured|^2 [m^2]."""
-
-    def __init__(self, tracks):
-        self.tracks = tracks
-        self._matched = None  # (MarkerTracks, Targets) once the run's result is known
-
-    def _match(self, result):
-        if self._matched is None:
-            # The calibration owns how a measurement names the parts it sees (imported
-            # here: it reads a result, and the gradient sits below it).
-            from .calibrate.targets import of_result
-
-            self._matched = of_result(result, self.tracks)
-        return self._matched
-
-    def times(self, t0, t_end):
-        return np.asarray(_times_of(self.tracks), dtype=float)
-
-    def until(self, t):
-        if _times_of(self.tracks)[0] > t:
-            return None
-        if isinstance(self.tracks, dict):
-            return MarkerTracking({part: tracks.until(t) for part, tracks in self.tracks.items()})
-        return MarkerTracking(self.tracks.until(t))
-
-    def evaluate(self, kind, system, t, states, span=None):
-        self._matched = None  # matched afresh to each run's result (another model may differ)
-        return super().evaluate(kind, system, t, states, span)
-
-    def term(self, result, k):
-        measured, targets = self._match(result)
-        seen = np.isfinite(measured.xyz[k]).all(axis=-1)
-        moved = targets.markers(result)[:, seen] - measured.xyz[k][seen]
-        return np.sum(moved ** 2, axis=(1, 2))
-
-    def __repr__(self):
-        return f"MarkerTracking({len(self.times(0, 0))} frames)"
-
-
-def _times_of(tracks):
-    first = next(iter(tracks.values())) if isinstance(tracks, dict) else tracks
-    first = first[0] if isinstance(first, (list, tuple)) else first
-    if not hasattr(first, "t"):
-        raise ParameterError(f"`tracks` must be MarkerTracks (or {{part: MarkerTracks}}), got {_checks.short(tracks)}")
-    return first.t
 
 
 class Effort(Loss):
