@@ -61,7 +61,7 @@ import numpy as np
 
 from ..inputs import knot_times
 from .body_joints import BodyJointPart, body_joint_frequency
-from .body_part import BodyPart, clamp_velocities, cross
+from .body_part import BodyPart, clamp_map
 from .contact_parts import contact_parts
 from .joints import JointPart, RecordedJoints, RodJointPart
 from .physics import quaternion_rate
@@ -147,8 +147,10 @@ class Assembly:
         _, point, rj = system.clamps[name]
         motion = system.bodies[body].motion
 
+        moves = clamp_map(point, np.asarray(rj)[None])
+
         def velocities(t):
-            return clamp_velocities(point[None], rj[None], *motion.velocities(t))[0]
+            return moves @ np.concatenate([np.asarray(a, dtype=float) for a in motion.velocities(t)])
 
         return type(base)(lambda t: velocities(t)[:3], lambda t: velocities(t)[3:], base.position, base.rotation)
 
@@ -250,8 +252,7 @@ class Assembly:
         if out is None:
             out = np.empty(self.size)
         for part in self.free:  # the rods' base velocities first
-            for sd, row in zip(part.systems, part.base_velocities(y[part.fields["v"]], y[part.fields["w"]])):
-                sd.base_velocities[:] = row
+            part.move_bases(y)
         reactions = {part.name: np.zeros(6) for part in self.free if part.joints or part.body_joints}
         for joint in self.joints:  # and the held points of the penalty joints, with their bodies' reactions
             f, m = joint.wrench(y, self.body_state(joint.part, t, y), joint.row, joint.value)
@@ -404,11 +405,11 @@ class Assembly:
             p = np.einsum("nij,nj->ni", rot, sd.sampled.mass * lay.field(y_rod, "v") * lengths)
             h = np.einsum("nij,nj->ni", rot, sd.sampled.inertia * lay.field(y_rod, "w") * lengths)
             linear += p.sum(axis=0)
-            angular += (cross(lay.field(y_rod, "u"), p) + h).sum(axis=0)
+            angular += (np.cross(lay.field(y_rod, "u"), p) + h).sum(axis=0)
         for part in self.free:
             r = matrices(y[part.fields["Q"]])
             v, w = y[part.fields["v"]], y[part.fields["w"]]
             momentum = part.rigid_mass @ np.concatenate([v, w])
             linear += r @ momentum[:3]
-            angular += cross(y[part.fields["x"]], r @ momentum[:3]) + r @ momentum[3:]
+            angular += np.cross(y[part.fields["x"]], r @ momentum[:3]) + r @ momentum[3:]
         return linear, angular

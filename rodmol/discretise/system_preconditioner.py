@@ -120,11 +120,25 @@ class SystemPreconditioner:
         size = FREE_BODY.size * len(self.coupled)
         self._schur = np.eye(size)
         # Per linked rod, N_rr^-1 N_rb (its columns: S's); all links' rod entries and N_br over them.
-        linked = dict.fromkeys(link.rod for p in self.coupled for link in self.links[p.name])
-        self._solved = {rod: np.zeros((assembly.rods[rod].size, size)) for rod in linked}
+        # All of them rows of one matrix (one product per solve, not one per rod).
+        linked = list(dict.fromkeys(link.rod for p in self.coupled for link in self.links[p.name]))
+        self._solved_rows = np.concatenate([np.arange(assembly.parts[rod].start, assembly.parts[rod].stop)
+                                            for rod in linked] or [np.zeros(0, dtype=int)])
+        self._all_solved = np.zeros((len(self._solved_rows), size))
+        self._solved, first = {}, 0
+        for rod in linked:
+            self._solved[rod] = self._all_solved[first:first + assembly.rods[rod].size]
+            first += assembly.rods[rod].size
         self._reads = np.concatenate([link.columns for p in self.coupled for link in self.links[p.name]]
                                      or [np.zeros(0, dtype=int)])
+        where = np.full(assembly.size, -1)
+        where[self._solved_rows] = np.arange(len(self._solved_rows))
+        self._reads_solved = where[self._reads]  # each read entry's row of _all_solved
         self._n_br = np.zeros((size, len(self._reads)))
+        self._body_rows = np.concatenate([np.arange(p.slice.start, p.slice.stop) for p in self.coupled]
+                                         or [np.zeros(0, dtype=int)])  # S's rows, state indices
+        self._moving = []  # per coupled body and linked rod: (offset, rod, its entries moved, N_rb moved / -gamma)
+        self._rod_factors = []  # per rod: (its slice, block_solve's factors), after each factorisation
         self.rod_joints = RodJointCoupling(assembly, BODY_STEP * np.maximum(scale, 1e-300), JOINT_ROWS)
         self.jac_evals = self.setups = self.solves = 0
 
@@ -166,10 +180,12 @@ class SystemPreconditioner:
             assembly(t, y, self._out)  # leave the rods as at y
             if self.rod_joints.sides:
                 self.rod_joints.evaluate(t, y, fy)
+            self._moved()
             self.jac_evals += 1
             jnew[0] = 1
         for prec in self.rods.values():
             prec.factor(gamma)
+        self._rod_factors = [(parts[name], prec.factors) for name, prec in self.rods.items()]
         for part in self.bodies:
             if part not in self.coupled:
                 self._inverse[part.name] = np.linalg.inv(np.eye(part.layout.size) - gamma * self._jac[part.name])
@@ -209,30 +225,31 @@ class SystemPreconditioner:
         for (name, other), block in self._pairs.items():  # the body joints' coupling of two free bodies
             o, oo = self._offset[name], self._offset[other]
             schur[oo:oo + size, o:o + size] -= gamma * block
-        for solved in self._solved.values():
-            solved[:] = 0.0
+        for o, rod, moving, coupling in self._moving:
+            out = np.empty_like(coupling)
+            g, head, fac, scratch = self.rods[rod].factors
+            _solve_rows(g, head, fac, gamma * coupling, out, *scratch)
+            self._solved[rod][:, o + moving] = out.T
+        # every body linked to a rod reads N_rr^-1 N_rb at its links' columns
+        schur -= self._n_br @ self._all_solved[self._reads_solved]
+        self._schur = np.linalg.inv(schur)
+
+    def _moved(self):
+        """After a Jacobian: per coupled body and rod, the body entries that move the rod (a
+        clamp's: its velocities) and N_rb / -gamma in them, one rod solve each at a factorisation."""
+        self._moving = []
+        self._all_solved[:] = 0.0  # the columns no body entry moves stay zero
         for part in self.coupled:
-            o = self._offset[part.name]
             by_rod = {}
             for link in self.links[part.name]:
                 by_rod.setdefault(link.rod, []).append(link)
             for rod, rod_links in by_rod.items():
-                # The body entries that move the rod (a clamp's: its velocities), one rod solve each.
                 moving = np.flatnonzero(np.any([link.to_body.any(axis=0) for link in rod_links], axis=0))
                 start = self.assembly.parts[rod].start
-                rhs = np.zeros((len(moving), self.assembly.rods[rod].size))
+                coupling = np.zeros((len(moving), self.assembly.rods[rod].size))
                 for link in rod_links:
-                    rhs[:, link.rows - start] -= gamma * link.to_body[:, moving].T
-                out = np.empty_like(rhs)
-                g, head, fac, scratch = self.rods[rod].factors
-                _solve_rows(g, head, fac, rhs, out, *scratch)
-                self._solved[rod][:, o + moving] = out.T
-        reads = self._reads  # every body linked to a rod reads N_rr^-1 N_rb at its links' columns
-        for rod, solved in self._solved.items():
-            sl = self.assembly.parts[rod]
-            inside = (reads >= sl.start) & (reads < sl.stop)
-            schur -= self._n_br[:, inside] @ solved[reads[inside] - sl.start]
-        self._schur = np.linalg.inv(schur)
+                    coupling[:, link.rows - start] -= link.to_body[:, moving].T
+                self._moving.append((self._offset[part.name], rod, moving, coupling))
 
     def solve(self, t, y, fy, r, z, gamma, delta, lr):
         """z = P^-1 r with the last factors."""
@@ -243,19 +260,12 @@ class SystemPreconditioner:
 
     def _solve_blocks(self, r, z):
         """z = P^-1 r without the rod-rod joints' coupling: the rods', the bodies' blocks and S."""
-        parts = self.assembly.parts
-        for name, prec in self.rods.items():
-            sl = parts[name]
-            g, head, fac, scratch = prec.factors
+        for sl, (g, head, fac, scratch) in self._rod_factors:
             block_solve(g, head, fac, read_only(r[sl]), z[sl], *scratch)
         for part in self.bodies:
             if part not in self.coupled:
                 z[part.slice] = self._inverse[part.name] @ r[part.slice]
         if self.coupled:
-            rhs = np.concatenate([r[part.slice] for part in self.coupled]) - self._n_br @ z[self._reads]
-            z_b = self._schur @ rhs
-            for part in self.coupled:
-                o = self._offset[part.name]
-                z[part.slice] = z_b[o:o + FREE_BODY.size]
-            for rod, solved in self._solved.items():
-                z[parts[rod]] -= solved @ z_b
+            z_b = self._schur @ (r[self._body_rows] - self._n_br @ z[self._reads])
+            z[self._body_rows] = z_b
+            z[self._solved_rows] -= self._all_solved @ z_b
