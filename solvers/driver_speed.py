@@ -20,7 +20,6 @@ new / old and new / main (the two ran back to back in the round).
     python solvers/driver_speed.py [--quick | --smoke] [--out DIR] [--reps K] [--main REV]
 """
 
-import json
 import os
 import shutil
 import subprocess
@@ -29,11 +28,12 @@ import tempfile
 import time
 import types
 
+from _workers import Version, paired_ratio, serve
+
 SCRIPT = "driver_speed.py"
 OLD_COMMIT = "548824c^"  # the last commit with solve/system_cvode.py
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
-MARK = "@@driver_speed@@ "  # prefix of the workers' answers
 CASES = ("octopus ramp", "octopus pulsing", "bending N=100")
 
 # --------------------------------------------------------------------------- worker
@@ -42,7 +42,7 @@ CASES = ("octopus ramp", "octopus pulsing", "bending N=100")
 
 
 class _Worker:
-    def __init__(self, mode):
+    def __init__(self, mode="full"):
         import numpy as np
 
         import rodmol
@@ -63,9 +63,6 @@ class _Worker:
         for name in self.cases:  # compiles (or loads) every kernel before anything is timed
             self.run(name)
 
-    def info(self):
-        return dict(rodmol_file=self.rodmol.__file__)
-
     def run(self, name):
         import gc
 
@@ -81,68 +78,8 @@ class _Worker:
                     prec_solves=counters["prec_solves"])
 
 
-def worker_main(mode):
-    """Answer one JSON command per stdin line with one MARK-prefixed JSON line."""
-    # An editable install's finder would serve the installed checkout's modules that a tree lacks.
-    sys.meta_path[:] = [f for f in sys.meta_path
-                        if "editable" not in getattr(f, "__name__", type(f).__name__).lower()]
-    w = None
-    for line in sys.stdin:
-        cmd = json.loads(line)
-        try:
-            if cmd["cmd"] == "init":
-                w = _Worker(mode)
-                answer = w.info()
-            elif cmd["cmd"] == "run":
-                answer = w.run(cmd["case"])
-            else:
-                break
-        except Exception as exc:  # noqa: BLE001  (hand any failure to the parent)
-            import traceback
-
-            answer = dict(error=f"{type(exc).__name__}: {exc}", traceback=traceback.format_exc())
-        sys.stdout.write(MARK + json.dumps(answer) + "\n")
-        sys.stdout.flush()
-
-
-# --------------------------------------------------------------------------- parent
-
-
-class Version:
-    """A worker subprocess running the rodmol of ``tree``."""
-
-    def __init__(self, label, tree, mode, stderr_path):
-        env = dict(os.environ, PYTHONPATH=tree)
-        for var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS"):
-            env[var] = "1"
-        self.label, self.tree = label, tree
-        self._err = open(stderr_path, "w")  # noqa: SIM115  (open for the worker's lifetime)
-        self.proc = subprocess.Popen([sys.executable, os.path.abspath(__file__), "--worker", mode], env=env,
-                                     stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self._err,
-                                     text=True, cwd=tree)
-
-    def ask(self, **cmd):
-        self.proc.stdin.write(json.dumps(cmd) + "\n")
-        self.proc.stdin.flush()
-        for line in self.proc.stdout:
-            if line.startswith(MARK):
-                answer = json.loads(line[len(MARK):])
-                if "error" in answer:
-                    raise RuntimeError(f"{self.label} worker: {answer['error']}\n{answer['traceback']}")
-                return answer
-        self._err.flush()
-        with open(self._err.name) as f:
-            raise RuntimeError(f"{self.label} worker exited:\n{f.read()[-4000:]}")
-
-    def close(self):
-        try:
-            self.proc.stdin.write(json.dumps(dict(cmd="quit")) + "\n")
-            self.proc.stdin.close()
-            self.proc.wait(timeout=30)
-        except Exception:  # noqa: BLE001  (a worker that will not quit is killed)
-            self.proc.kill()
-            self.proc.wait()
-        self._err.close()
+def run(worker, case):
+    return worker.run(case)
 
 
 def git(*args):
@@ -178,9 +115,9 @@ def table(np, runs):
                 row[f"{label}_{key}"] = values[0] if len(values) == 1 else "/".join(map(str, values))
         for base in ("old", "main"):
             ratios = [d["new"]["cpu_s"] / d[base]["cpu_s"] for d in by.values()]
-            row[f"new_vs_{base}"] = float(np.median(ratios))
+            row[f"new_vs_{base}"] = paired_ratio(np, mine, "cpu_s", "new", base)
             row[f"new_vs_{base}_iqr"] = "%.3f-%.3f" % tuple(np.percentile(ratios, [25, 75]))
-        row["main_vs_old"] = float(np.median([d["main"]["cpu_s"] / d["old"]["cpu_s"] for d in by.values()]))
+        row["main_vs_old"] = paired_ratio(np, mine, "cpu_s", "main", "old")
         rows.append(row)
     return rows
 
@@ -208,12 +145,10 @@ def main(argv=None):
     versions = []
     try:
         for label, tree in (("old", trees["old"][0]), ("main", trees["main"][0]), ("new", ROOT)):
-            versions.append(Version(label, tree, args.mode, os.path.join(tmp, f"{label}.stderr")))
+            versions.append(Version(label, tree, __file__, os.path.join(tmp, f"{label}.stderr")))
         for v in versions:  # one after the other: compilation wants a core
             t0 = time.perf_counter()
-            file = v.ask(cmd="init")["rodmol_file"]
-            if not os.path.realpath(file).startswith(os.path.realpath(v.tree) + os.sep):
-                raise RuntimeError(f"{v.label} worker imported {file}, not from {v.tree}")
+            file = v.start(mode=args.mode)
             print(f"{v.label}: {file} ready in {time.perf_counter() - t0:.1f} s", flush=True)
         runs = rounds(versions, args.reps)
     finally:
@@ -231,7 +166,7 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) > 2 and sys.argv[1] == "--worker":
-        worker_main(sys.argv[2])
+    if sys.argv[1:] == ["--worker"]:
+        serve(_Worker, dict(run=run))
     else:
         main()
