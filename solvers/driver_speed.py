@@ -126,7 +126,7 @@ def main(argv=None):
     import _common as C  # the parent runs with this checkout (header, file writers)
 
     argv = sys.argv[1:] if argv is None else list(argv)
-    main_rev = "HEAD"
+    main_rev = "main"
     if "--main" in argv:
         i = argv.index("--main")
         main_rev = argv[i + 1]
