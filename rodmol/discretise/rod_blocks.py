@@ -24,6 +24,14 @@ def _solve_stacked(gamma, heads, facs, starts, size, r, z, y_x, y_p, h):
         block_solve(gamma, heads[i], facs[i], r[a:a + size], z[a:a + size], y_x, y_p, h)
 
 
+@jit
+def _solve_rows_stacked(gamma, heads, facs, which, rhs, out, y_x, y_p, h):
+    """out[i, j] = (I - gamma J)^-1 rhs[i, j] with the stacked rod ``which[i]``'s factors."""
+    for i in range(which.shape[0]):
+        for j in range(rhs.shape[1]):
+            block_solve(gamma, heads[which[i]], facs[which[i]], rhs[i, j], out[i, j], y_x, y_p, h)
+
+
 class RodBlocks:
     """The rods' preconditioners ``rods`` ({name: BlockPreconditioner}) of a system whose
     rods' entries are at ``parts`` ({name: slice}), grouped by size."""
@@ -33,8 +41,9 @@ class RodBlocks:
         groups = {}
         for name, prec in rods.items():
             groups.setdefault(parts[name].stop - parts[name].start, []).append(name)
-        self._groups = []
+        self._groups, self._where = [], {}  # each rod's (group, place in it)
         for size, names in groups.items():
+            self._where.update({name: (len(self._groups), i) for i, name in enumerate(names)})
             n = rods[names[0]].factors[2].shape[0]
             heads, facs = np.zeros((len(names), HEADER, HEADER)), np.zeros((len(names), n, N_FACTORS))
             for i, name in enumerate(names):
@@ -53,3 +62,16 @@ class RodBlocks:
         for first, heads, facs, starts, size in self._groups:
             gamma, _, _, scratch = self.rods[first].factors
             _solve_stacked(gamma, heads, facs, starts, size, r, z, *scratch)
+
+    def solve_rows(self, names, rhs):
+        """(k, m, size) solutions of (I - gamma J) x = rhs[i, j] on rod ``names[i]`` (all of one
+        size, ``rhs`` (k, m, size)), with the last factors."""
+        group = {self._where[name][0] for name in names}
+        if len(group) != 1:
+            raise ValueError(f"rods {names} are not all of one size")
+        first, heads, facs, _, _ = self._groups[group.pop()]
+        which = np.array([self._where[name][1] for name in names], dtype=np.int64)
+        gamma, _, _, scratch = self.rods[first].factors
+        out = np.empty_like(rhs)
+        _solve_rows_stacked(gamma, heads, facs, which, rhs, out, *scratch)
+        return out

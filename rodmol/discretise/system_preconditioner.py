@@ -45,8 +45,6 @@ import numpy as np
 
 from .body_part import first_element
 from .joints import JOINT_COLUMNS, JOINT_ROWS, block_entries
-from .physics import jit
-from .preconditioner import block_solve
 from .rigid import FREE_BODY
 from .rod_blocks import RodBlocks
 from .rod_joint_coupling import RodJointCoupling
@@ -57,13 +55,6 @@ CLAMP_COLUMNS = block_entries("q", "k", "v", "w")
 
 #: Relative step of the body blocks' differences, times each entry's scale.
 BODY_STEP = 1e-7
-
-
-@jit
-def _solve_rows(gamma, head, fac, rhs, out, y_x, y_p, h):
-    """out[j] = (I - gamma J)^-1 rhs[j] for each row j, with a rod's factors (:func:`block_solve`)."""
-    for j in range(rhs.shape[0]):
-        block_solve(gamma, head, fac, rhs[j], out[j], y_x, y_p, h)
 
 
 class Link:
@@ -127,9 +118,9 @@ class SystemPreconditioner:
         self._all_solved = np.zeros((len(self._solved_rows), size))
         if len(self._solved_rows) and np.all(np.diff(self._solved_rows) == 1):  # a slice costs 3 us less
             self._solved_rows = slice(int(self._solved_rows[0]), int(self._solved_rows[-1]) + 1)
-        self._solved, first = {}, 0
+        self._where_solved, first = {}, 0  # each linked rod's first row of _all_solved
         for rod in linked:
-            self._solved[rod] = self._all_solved[first:first + assembly.rods[rod].size]
+            self._where_solved[rod] = first
             first += assembly.rods[rod].size
         self._reads = np.concatenate([link.columns for p in self.coupled for link in self.links[p.name]]
                                      or [np.zeros(0, dtype=int)])
@@ -139,7 +130,11 @@ class SystemPreconditioner:
         self._n_br = np.zeros((size, len(self._reads)))
         self._body_rows = np.concatenate([np.arange(p.slice.start, p.slice.stop) for p in self.coupled]
                                          or [np.zeros(0, dtype=int)])  # S's rows, state indices
-        self._moving = []  # per coupled body and linked rod: (offset, rod, its entries moved, N_rb moved / -gamma)
+        self._n_br_jac = np.zeros_like(self._n_br)  # N_br / -gamma
+        self._s_jac = np.zeros((size, size))  # (I - S) / gamma before the rods' part
+        # Per rod size and count of body entries moving a rod: (the rods, their rows and columns
+        # of _all_solved, N_rb / -gamma in those entries); after each Jacobian (_moved).
+        self._couplings = []
         self.rod_blocks = RodBlocks(self.rods, assembly.parts)  # the rods' blocks, solved together
         self.rod_joints = RodJointCoupling(assembly, BODY_STEP * np.maximum(scale, 1e-300), JOINT_ROWS)
         self.jac_evals = self.setups = self.solves = 0
@@ -213,43 +208,47 @@ class SystemPreconditioner:
 
     def _factor_schur(self, gamma):
         """S = N_bb - N_br N_rr^-1 N_rb over the coupled bodies, inverted; N_rr^-1 N_rb and N_br kept."""
-        schur, size = np.zeros_like(self._schur), FREE_BODY.size
-        column = 0
-        for part in self.coupled:
-            o = self._offset[part.name]
-            schur[o:o + size, o:o + size] = np.eye(size) - gamma * self._jac[part.name]
-            for link in self.links[part.name]:
-                self._n_br[:, column:column + len(link.columns)] = 0.0
-                self._n_br[o:o + size, column:column + len(link.columns)] = -gamma * link.from_rod
-                column += len(link.columns)
-        for (name, other), block in self._pairs.items():  # the body joints' coupling of two free bodies
-            o, oo = self._offset[name], self._offset[other]
-            schur[oo:oo + size, o:o + size] -= gamma * block
-        for o, rod, moving, coupling in self._moving:
-            out = np.empty_like(coupling)
-            g, head, fac, scratch = self.rods[rod].factors
-            _solve_rows(g, head, fac, gamma * coupling, out, *scratch)
-            self._solved[rod][:, o + moving] = out.T
+        self._n_br = -gamma * self._n_br_jac
+        for names, rows, columns, coupling in self._couplings:
+            self._all_solved[rows, columns] = self.rod_blocks.solve_rows(names, gamma * coupling).transpose(0, 2, 1)
         # every body linked to a rod reads N_rr^-1 N_rb at its links' columns
-        schur -= self._n_br @ self._all_solved[self._reads_solved]
+        schur = np.eye(len(self._schur)) - gamma * self._s_jac - self._n_br @ self._all_solved[self._reads_solved]
         self._schur = np.linalg.inv(schur)
 
     def _moved(self):
-        """After a Jacobian: per coupled body and rod, the body entries that move the rod (a
-        clamp's: its velocities) and N_rb / -gamma in them, one rod solve each at a factorisation."""
-        self._moving = []
+        """After a Jacobian: its parts of S and N_br over -gamma, and per coupled body and rod the
+        body entries that move the rod (a clamp's: its velocities) with N_rb / -gamma in them,
+        stacked by rod size and count (one compiled call of rod solves each at a factorisation)."""
+        size = FREE_BODY.size
+        self._s_jac[:] = 0.0
+        self._n_br_jac[:] = 0.0
+        column = 0
+        for part in self.coupled:
+            o = self._offset[part.name]
+            self._s_jac[o:o + size, o:o + size] = self._jac[part.name]
+            for link in self.links[part.name]:
+                self._n_br_jac[o:o + size, column:column + len(link.columns)] = link.from_rod
+                column += len(link.columns)
+        for (name, other), block in self._pairs.items():  # the body joints' coupling of two free bodies
+            o, oo = self._offset[name], self._offset[other]
+            self._s_jac[oo:oo + size, o:o + size] += block
         self._all_solved[:] = 0.0  # the columns no body entry moves stay zero
+        stacks = {}
         for part in self.coupled:
             by_rod = {}
             for link in self.links[part.name]:
                 by_rod.setdefault(link.rod, []).append(link)
             for rod, rod_links in by_rod.items():
                 moving = np.flatnonzero(np.any([link.to_body.any(axis=0) for link in rod_links], axis=0))
-                start = self.assembly.parts[rod].start
-                coupling = np.zeros((len(moving), self.assembly.rods[rod].size))
+                start, n = self.assembly.parts[rod].start, self.assembly.rods[rod].size
+                coupling = np.zeros((len(moving), n))
                 for link in rod_links:
                     coupling[:, link.rows - start] -= link.to_body[:, moving].T
-                self._moving.append((self._offset[part.name], rod, moving, coupling))
+                rows = self._where_solved[rod] + np.arange(n)
+                stacks.setdefault((n, len(moving)), []).append((rod, rows, self._offset[part.name] + moving, coupling))
+        self._couplings = [([s[0] for s in stack], np.array([s[1] for s in stack])[:, :, None],
+                            np.array([s[2] for s in stack])[:, None, :], np.array([s[3] for s in stack]))
+                           for stack in stacks.values()]
 
     def solve(self, t, y, fy, r, z, gamma, delta, lr):
         """z = P^-1 r with the last factors."""
