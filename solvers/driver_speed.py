@@ -116,7 +116,8 @@ def table(np, runs):
         for base in ("old", "main"):
             ratios = [d["new"]["cpu_s"] / d[base]["cpu_s"] for d in by.values()]
             row[f"new_vs_{base}"] = paired_ratio(np, mine, "cpu_s", "new", base)
-            row[f"new_vs_{base}_iqr"] = "%.3f-%.3f" % tuple(np.percentile(ratios, [25, 75]))
+            low, high = np.percentile(ratios, [25, 75])
+            row[f"new_vs_{base}_iqr"] = f"{low:.3f}-{high:.3f}"
         row["main_vs_old"] = paired_ratio(np, mine, "cpu_s", "main", "old")
         rows.append(row)
     return rows

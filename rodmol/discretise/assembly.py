@@ -70,7 +70,6 @@ from .rigid import clamp_wrench, free_body_rates
 from .rod_scales import field_scales
 from .rotations import from_matrix, matrices
 from .state_checks import least_stretch, parts_problem, parts_step_problem
-from .stencil import WORK_TOTAL
 from .system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE, SemiDiscrete
 from .system_jacobian import assembly_pattern
 from .system_state_view import SystemStateView
@@ -133,6 +132,10 @@ class Assembly:
             for part in joint.parts:
                 part.body_joints.append(joint)
         self.free = [p for p in self.bodies.values() if p.body.free]
+        # What every right-hand side walks, once: each rod's system and entries, the free bodies
+        # whose penalty or body joints' reactions it sums.
+        self._rod_parts = [(sd, self.parts[name]) for name, sd in self.rods.items()]
+        self._reacting = [p.name for p in self.free if p.joints or p.body_joints]
         self.lightly_damped = any(sd.lightly_damped for sd in self.rods.values())
         self.scan_arguments = None  # the step check's compiled scan arguments, made at its first call
         self._gravity = np.ascontiguousarray(system.gravity, dtype=float)
@@ -253,16 +256,16 @@ class Assembly:
             out = np.empty(self.size)
         for part in self.free:  # the rods' base velocities first
             part.move_bases(y)
-        reactions = {part.name: np.zeros(6) for part in self.free if part.joints or part.body_joints}
+        reactions = {name: np.zeros(6) for name in self._reacting}
         for joint in self.joints:  # and the held points of the penalty joints, with their bodies' reactions
             f, m = joint.wrench(y, self.body_state(joint.part, t, y), joint.row, joint.value)
             if joint.part.name in reactions:
                 reactions[joint.part.name] += (*f, *m)
-        self.add_body_joints(t, y, reactions)
+        if self.body_joints:
+            self.add_body_joints(t, y, reactions)
         for joint in self.rod_joints:
             joint.wrench(y, joint.row, joint.value)
-        for name, sd in self.rods.items():
-            sl = self.parts[name]
+        for sd, sl in self._rod_parts:
             sd(t, y[sl], out[sl])
         for part in self.bodies.values():
             self.body_rates(part, t, y, out, reactions.get(part.name))
@@ -309,7 +312,7 @@ class Assembly:
         """Force and moment about the origin [N, N m] of the rods clamped to
         ``part``, body frame, after the rods' rates at ``y``
         (:func:`rodmol.discretise.rigid.clamp_wrench`)."""
-        stress = np.array([work[0, WORK_TOTAL:WORK_TOTAL + 6] for work in part.works]).reshape(-1, 6)
+        stress = np.array(part.stress_rows).reshape(-1, 6)
         return clamp_wrench(stress, np.ascontiguousarray(y[part.strains]), part.shares, part.flat_turns, part.points)
 
     # ------------------------------------------------------------------ structure

@@ -12,6 +12,7 @@ from .body_contact import BodyContacts
 from .layout import BlockLayout
 from .rigid import BODY_FIELDS, NET_MASS, NET_MOMENT, POSE_FIELDS, pack_body
 from .sampling import section_masses
+from .stencil import WORK_TOTAL
 
 
 def clamp_map(points, turns):
@@ -58,6 +59,7 @@ class BodyPart:
         self.rigid_mass = own * (body.mass_matrix - body.added_mass)
         self.rods, self.systems = [], []
         self.works = []  # each rod kernel's scratch: cell 0's total stress after a call (stencil.rhs)
+        self.stress_rows = []  # views of that stress in each of them, (6,)
         self.points, self.turns = np.zeros((0, 3)), np.zeros((0, 3, 3))
         self.velocity_map = clamp_map(self.points, self.turns)  # (6 n, 6): :func:`clamp_map`
         #: Its velocities (v, w), consecutive in its block (BODY_FIELDS), if free.
@@ -75,6 +77,7 @@ class BodyPart:
         self.rods.append(name)
         self.systems.append(sd)
         self.works.append(sd.kernel_arguments()[-1])
+        self.stress_rows.append(self.works[-1][0, WORK_TOTAL:WORK_TOTAL + 6])
         self.points = np.vstack([self.points, point])
         self.turns = np.concatenate([self.turns, np.asarray(turn, dtype=float)[None]])
         self.flat_turns = np.ascontiguousarray(self.turns.reshape(-1, 9))  # row-major, for the kernel

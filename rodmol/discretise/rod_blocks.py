@@ -39,7 +39,7 @@ class RodBlocks:
     def __init__(self, rods, parts):
         self.rods = rods
         groups = {}
-        for name, prec in rods.items():
+        for name in rods:
             groups.setdefault(parts[name].stop - parts[name].start, []).append(name)
         self._groups, self._where = [], {}  # each rod's (group, place in it)
         for size, names in groups.items():
