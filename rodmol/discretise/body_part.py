@@ -62,6 +62,7 @@ class BodyPart:
         self.stress_rows = []  # views of that stress in each of them, (6,)
         self.points, self.turns = np.zeros((0, 3)), np.zeros((0, 3, 3))
         self.velocity_map = clamp_map(self.points, self.turns)  # (6 n, 6): :func:`clamp_map`
+        self._bases = np.zeros(0)  # (6 n,) its rods' base velocities (:meth:`move_bases`)
         #: Its velocities (v, w), consecutive in its block (BODY_FIELDS), if free.
         self.velocities = slice(self.fields["v"].start, self.fields["w"].stop) if body.free else None
         self.shares = np.zeros(0)  # the base node's share of cell 0 [m] (Scheme.base_share ds)
@@ -82,6 +83,10 @@ class BodyPart:
         self.turns = np.concatenate([self.turns, np.asarray(turn, dtype=float)[None]])
         self.flat_turns = np.ascontiguousarray(self.turns.reshape(-1, 9))  # row-major, for the kernel
         self.velocity_map = clamp_map(self.points, self.turns)
+        # The rods' base velocities, one row each, which their systems read (one product a call).
+        self._bases = np.concatenate([self._bases, sd.base_velocities])
+        for i, system in enumerate(self.systems):
+            system.read_base_velocities_from(self._bases[6 * i:6 * i + 6])
         sl, first = sd.layout.slices(), start + sd.layout.header
         index = np.r_[first + sl["q"].start:first + sl["q"].stop, first + sl["k"].start:first + sl["k"].stop]
         self.strains = np.vstack([self.strains, index])
@@ -113,6 +118,4 @@ class BodyPart:
     def move_bases(self, y):
         """Set its rods' base velocities (their systems' ``base_velocities``) from its
         velocities in the state ``y`` (a free body's)."""
-        rows = (self.velocity_map @ y[self.velocities]).reshape(-1, 6)
-        for sd, row in zip(self.systems, rows):
-            sd.base_velocities[:] = row
+        np.dot(self.velocity_map, y[self.velocities], out=self._bases)
