@@ -5,6 +5,7 @@ from functools import partial
 
 import numpy as np
 
+from . import derivatives
 from ._files import claim, refuse_directories, write_atomically
 from .discretise import centreline, physics, rotations
 from .discretise.layout import StateLayout
@@ -109,6 +110,13 @@ class Result:
             if name not in arrays and (name in self.__dict__ or name in STORED and name in self._deferred):
                 arrays[name] = getattr(self, name)[frames]
         return Result(arrays, self.success, self.message, self.stats, self.meta)
+
+    def sensitivity(self, key):
+        """The derivative of this run by the parameter ``key``, one of those asked of
+        :func:`rodmol.simulate` with ``sensitivities=``: a result-shaped
+        :class:`rodmol.derivatives.Derivative` whose fields are those of this result per
+        unit of the parameter (a knot tension's: a leading axis over its knots)."""
+        return derivatives.lookup(self, key)
 
     def __repr__(self):
         return (f"Result(n_t={len(self.t)}, t_end={self.t[-1] if len(self.t) else None} s, "

@@ -42,7 +42,7 @@ def default_atol(model, rtol):
 
 def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None, atol=None,
              output_dt=None, output_times=None, t0=None, progress=None, max_wall_time=None, out=None,
-             resume=False, overwrite=False, **backend_options):
+             resume=False, overwrite=False, sensitivities=None, **backend_options):
     """Integrate the model from t = 0 to ``t_end``.
 
     Parameters
@@ -122,6 +122,15 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
     overwrite : bool
         With ``out``: replace an earlier run in that directory (every file a
         run writes there, :mod:`rodmol.output.run_files`; other files are kept).
+    sensitivities : list of str, optional
+        Parameter keys (:mod:`rodmol.named_parameters`: ``"material.E"``,
+        ``"medium.Cy,Cz"``, ``"tension.11"`` (its knot values),
+        ``"bodies.head.mass"``, ``"rods.arm.material.E"`` ...) whose forward
+        sensitivities are integrated with the state
+        (:mod:`rodmol.sensitivities`); ``result.sensitivity(key)`` is then the
+        derivative of every field of the result by that parameter
+        (:class:`rodmol.derivatives.Derivative`, see ``docs/gradients.md``).
+        CVODE (with GMRES) and RK23 only, not with ``out``.
     **backend_options
         Passed to the backend (e.g. ``linsolver="sparse"`` for CVODE);
         unknown names and bad values are refused before any work. None given
@@ -139,6 +148,10 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
     kind = run_kind(model)
     if not (resume is True or resume is False or (isinstance(resume, str) and resume in RESUME)):
         raise ParameterError(f"`resume` must be False, True or 'force', got {_checks.short(resume)}")
+    if sensitivities is not None:
+        from . import sensitivities as sensitivity
+
+        sensitivity.check(sensitivities, DEFAULT_BACKEND if backend is None else backend, out, resume)
     sink, first, plan, recorded, kept = None, 0, None, {}, None
     asked_plan, asked_initial = (t0, output_dt, output_times), initial
     if resume:  # the run's directory first: its settings fill in what the call leaves out
@@ -159,6 +172,10 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
     if resume:  # before anything is sized by it: the states kept fix the grid
         sink.check(system)
     args = fit(args, system)
+    augmented = None
+    if sensitivities is not None:  # its keys checked and its systems built before any work
+        augmented = sensitivity.Plan(kind, model, system, sensitivities)
+        options.offered_by(augmented.system, args.backend_options)
     if resume and np.shape(kept) != (system.size,):
         raise ParameterError(f"cannot resume the run in {_where(sink)}: its state has {np.size(kept)} entries, "
                              f"this model's {system.size}")
@@ -188,14 +205,20 @@ def simulate(model, t_end, *, initial=None, scheme=None, backend=None, rtol=None
         y0, timings = prepare_run(system, args, progress, sink)
         solver = dict(rtol=args.rtol, atol=args.atol, progress=progress, max_wall_time=args.max_wall_time,
                       **args.backend_options)
+        integrated, start = system, y0
+        if augmented is not None:  # the state and its sensitivities, one system (never into a sink)
+            integrated, start = augmented.system, augmented.initial(y0, args.initial, args.t0)
+            solver["atol"] = augmented.atol(args.atol)
         if sink is None:
-            raw = keep_before_failure(args.run, system, y0, t_out, **solver)
+            raw = keep_before_failure(args.run, integrated, start, t_out, **solver)
             success, message, stats, error = raw.success, raw.message, raw.stats, raw.error
         else:  # in chunks into the sink, whose result it is
             success, message, stats, error = run_chunked(args.run, system, y0, t_out, sink, first, **solver)
         stats.update(timings, backend=args.backend)
-        result = kind.result(system, raw.t, raw.y, success, message, stats) if sink is None else \
-            sink.end(success, message, stats)
+        result = kind.result(system, raw.t, raw.y[:, :system.size], success, message, stats) if sink is None \
+            else sink.end(success, message, stats)
+        if augmented is not None:
+            result.sensitivities = augmented.derivatives(raw.t, raw.y, success, message, stats)
     finally:
         if args.progress is True:
             progress.close()

@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from . import derivatives
 from .base_motion import BaseMotion
 from .discretise.contact_parts import ContactPart
 from .discretise.rotations import matrices
@@ -182,6 +183,13 @@ class SystemResult:
         relative = np.einsum("nji,njk->nik", expected_r, r0)
         cos = np.clip((np.trace(relative, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
         return np.linalg.norm(lay.base_position(y_rod) - expected_u, axis=-1), np.arccos(cos)
+
+    def sensitivity(self, key):
+        """The derivative of this run by the parameter ``key``, one of those asked of
+        :func:`rodmol.simulate` with ``sensitivities=``: a result-shaped
+        :class:`rodmol.derivatives.Derivative` whose fields are those of this result per
+        unit of the parameter (a knot tension's: a leading axis over its knots)."""
+        return derivatives.lookup(self, key)
 
     def __repr__(self):
         state = "success" if self.success else f"failed: {self.message}"

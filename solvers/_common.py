@@ -225,6 +225,18 @@ def run(backend, system, y0, t_out, rtol, **options):
     return backend(system, y0, t_out, rtol=rtol, atol=atol, **options)
 
 
+def run_cpu(backend, system, y0, t_out, rtol, **options):
+    """One integration (:func:`run`) and its CPU time [s] over the span of its ``wall_time_s``
+    (the steps, not building the solver; :func:`_cpu_span.cpu_span`)."""
+    from _cpu_span import cpu_span
+
+    from rodmol.solve import outputs
+
+    with cpu_span(outputs) as span:
+        raw = run(backend, system, y0, t_out, rtol, **options)
+    return raw, span["cpu_s"]
+
+
 def timed(backend, system, y0, t_out, rtol, reps, **options):
     """Median wall time [s] of ``reps`` runs (solver only, as in its stats) and the last run."""
     walls, raw = [], None

@@ -146,8 +146,11 @@ class _Worker:
         }
 
 
-def worker_main():
-    """Answer one JSON command per stdin line with one MARK-prefixed JSON line."""
+def worker_main(make=None):
+    """Answer one JSON command per stdin line with one MARK-prefixed JSON line: ``init``
+    makes the worker (``make(n, t_end)``, default :class:`_Worker`) and answers its
+    ``info()``; any other command but ``quit`` calls the worker's method of that name
+    with the command's other fields."""
     # An editable install of rodmol adds a finder that serves, for any module a
     # tree lacks, the installed checkout's (rodmol.discretise for the old tree):
     # drop it so that only the tree on PYTHONPATH is seen.
@@ -155,16 +158,15 @@ def worker_main():
     w = None
     for line in sys.stdin:
         cmd = json.loads(line)
+        name = cmd.pop("cmd")
         try:
-            if cmd["cmd"] == "init":
-                w = _Worker(cmd["n"], cmd["t_end"])
+            if name == "init":
+                w = (make or _Worker)(cmd["n"], cmd["t_end"])
                 answer = w.info()
-            elif cmd["cmd"] == "simulate":
-                answer = w.simulate(cmd.get("tip_path"))
-            elif cmd["cmd"] == "percall":
-                answer = w.percall(cmd["calls"])
-            else:
+            elif name == "quit":
                 break
+            else:
+                answer = getattr(w, name)(**cmd)
         except Exception as exc:  # noqa: BLE001  (hand any failure to the parent)
             import traceback
 
@@ -177,15 +179,17 @@ def worker_main():
 
 
 class Version:
-    """A worker subprocess running the rodmol of ``tree``."""
+    """A worker subprocess running the rodmol of ``tree`` (the ``--worker`` of ``script``,
+    by default this file)."""
 
-    def __init__(self, label, tree, stderr_path):
+    def __init__(self, label, tree, stderr_path, script=None):
         env = dict(os.environ, PYTHONPATH=tree)
         for var in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS"):
             env[var] = "1"
         self.label, self.tree = label, tree
         self._err = open(stderr_path, "w")  # noqa: SIM115  (open for the worker's lifetime)
-        self.proc = subprocess.Popen([sys.executable, os.path.abspath(__file__), "--worker"], env=env,
+        script = script or os.path.abspath(__file__)  # the worker's script: this one's, or another study's
+        self.proc = subprocess.Popen([sys.executable, script, "--worker"], env=env,
                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self._err,
                                      text=True, cwd=tree)
 

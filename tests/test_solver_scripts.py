@@ -179,6 +179,16 @@ def _quaternion_norm(out):
         assert row["tip_difference_m"] < 1e-6 and row["steps_with"] == row["steps_without"], row
 
 
+def _sensitivity_accuracy(out):
+    table = rows(out / "sensitivity_accuracy.csv")
+    accuracy = [row for row in table if row["table"] == "accuracy"]
+    tight = min(accuracy, key=lambda row: row["rtol"])
+    assert all(tight[k] < 1e-4 for k in ("error_E", "error_CyCz", "error_11")), tight  # the target
+    assert tight["error_E"] < max(row["error_E"] for row in accuracy)  # tighter tolerances, closer
+    cost = [row for row in table if row["table"] == "cost" and row["run"] == "2 sensitivities"]
+    assert cost and all(1.0 < row["ratio_to_plain"] < 10.0 for row in cost), cost
+
+
 def _octopus(out):
     table = rows(out / "octopus.csv")
     assert all(row["success"] is True for row in table), table
@@ -304,6 +314,37 @@ def _crawl_speed(out):
         assert row["steps"] > 0 and row["cpu_per_sim_s"] > 0 and row["head_error_m"] < 1e-4, row
 
 
+def _accuracy_per_cost(out):
+    table = [row for row in rows(out / "accuracy_per_cost.csv") if row["default_rtol"]]
+    errors = [row["tip_err_mm"] for row in sorted(table, key=lambda row: row["N"])]
+    assert 0 < errors[-1] < errors[0] < 50, errors  # refining the default scheme reduces the error
+    assert all(row["cpu_s"] > 0 and row["of_private_reference"] > 0 for row in table), table
+
+
+def _step_overhead(out):
+    for run in rows(out / "step_overhead_runs.csv"):
+        # CVODE's steps: the one-step calls less those that handed a step back after outputs inside it
+        assert run["onestep"] - run["repeats"] == run["steps"] and run["repeats"] <= run["interpolations"], run
+        assert run["rhs"] >= run["newton"] >= run["steps"], run  # one right-hand side per Newton iteration at least
+
+
+def _compiled_driver(out):
+    for row in rows(out / "compiled_driver.csv"):  # the same algorithm with compiled callbacks: the same run
+        assert row["compiled_steps"] == row["rodmol_steps"] and row["compiled_rhs"] == row["rodmol_rhs"], row
+        assert row["tip_gap_m"] < 1e-9, row
+        # and driven by rodmol's own Stepper (its watch, outputs and stop times), a drop-in solver
+        assert row["rodmol_driver_compiled_steps"] == row["rodmol_steps"], row
+        assert row["rodmol_driver_compiled_tip_gap_m"] < 1e-9, row
+
+
+def _bending_vs_commit(out):
+    table = {row["quantity"]: row for row in rows(out / "bending_vs_commit.csv")}
+    assert 0.5 < table["steps"]["new_over_old_paired"] < 2
+    with open(out / "bending_vs_commit.md") as f:  # the two versions compute the same motion
+        gap = float(f.read().split("max |old - new| = ")[1].split(" m")[0])
+    assert gap < 1e-5
+
+
 SCRIPTS = {
     "scaling.py": (["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"], _scaling),
     "temporal.py": (["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv", "temporal_options.csv"],
@@ -327,6 +368,7 @@ SCRIPTS = {
     "reach_scores.py": (["reach_scores.csv", "reach_scores.md"], _reach_scores),
     "quaternion_norm.py": (["quaternion_norm.csv", "quaternion_norm.md"], _quaternion_norm),
     "octopus.py": (["octopus.csv", "octopus.md"], _octopus),
+    "sensitivity_accuracy.py": (["sensitivity_accuracy.csv", "sensitivity_accuracy.md"], _sensitivity_accuracy),
     "octopus_stats.py": (["octopus_stats.csv", "octopus_stats.md"], _octopus_stats),
     "system_stepping.py": (["system_stepping.csv", "system_stepping.md"], _system_stepping),
     "system_equilibrium_speed.py": (["system_equilibrium_speed.csv", "system_equilibrium_speed.md"],
@@ -341,12 +383,17 @@ SCRIPTS = {
     "vtp_series_cost.py": (["vtp_series_cost.csv", "vtp_series_cost.md"], _vtp_series_cost),
     "driver_speed.py": (["driver_speed.csv", "driver_speed.md", "driver_speed_runs.csv"], _driver_speed),
     "crawl_speed.py": (["crawl_speed.csv", "crawl_speed.md", "crawl_speed_runs.csv"], _crawl_speed),
+    "accuracy_per_cost.py": (["accuracy_per_cost.csv", "accuracy_per_cost.md"], _accuracy_per_cost),
+    "step_overhead.py": (["step_overhead.csv", "step_overhead_runs.csv", "step_overhead_calls.csv",
+                          "step_overhead.md"], _step_overhead),
+    "bending_vs_commit.py": (["bending_vs_commit.csv", "bending_vs_commit.md"], _bending_vs_commit),
+    "compiled_driver.py": (["compiled_driver.csv", "compiled_driver.md"], _compiled_driver),
 }
 
 
 #: Scripts that start subprocesses themselves: the trees they compare, or a fresh run each.
-SPAWNING = {"core_speed.py", "long_output.py", "rest_strains_speed.py", "system_output.py", "view_open.py",
-            "driver_speed.py", "crawl_speed.py"}
+SPAWNING = {"bending_vs_commit.py", "core_speed.py", "long_output.py", "rest_strains_speed.py", "system_output.py",
+            "view_open.py", "driver_speed.py", "crawl_speed.py"}
 #: The script run as a command: one of the quickest.
 COMMAND = "release.py"
 
@@ -355,6 +402,9 @@ def _skip_without_what_it_needs(script):
     if script == "core_speed.py" and subprocess.run(
             ["git", "-C", ROOT, "cat-file", "-e", "9fce6d7^{commit}"], capture_output=True).returncode != 0:
         pytest.skip("needs a git checkout holding commit 9fce6d7")
+    if script == "bending_vs_commit.py" and subprocess.run(
+            ["git", "-C", ROOT, "cat-file", "-e", "f8094e2^{commit}"], capture_output=True).returncode != 0:
+        pytest.skip("needs a git checkout holding commit f8094e2")
     if script == "system_output.py" and subprocess.run(
             ["git", "-C", ROOT, "cat-file", "-e", "06aa966^{commit}"], capture_output=True).returncode != 0:
         pytest.skip("needs a git checkout holding commit 06aa966")

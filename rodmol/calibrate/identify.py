@@ -6,7 +6,9 @@ The residual is the difference between simulated and measured marker
 positions at every measured sample, divided by the arm length L (a system's:
 its longest rod's; so its mean norm per marker is eq. (15)'s error). Missing samples are left out. The
 Jacobian is built from forward differences, one model run per parameter,
-all at once on the executor; scipy's trust-region reflective method
+all at once on the executor, or (``jacobian="exact"``) from the forward
+sensitivities of the run itself (:mod:`rodmol.sensitivities`: one run gives
+the residual and its Jacobian); scipy's trust-region reflective method
 (``least_squares(method="trf")``) keeps the parameters within their bounds.
 """
 
@@ -15,15 +17,18 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
+from .. import _checks, named_parameters
 from ..errors import ParameterError
 from .paper_errors import ErrorTable
 from .parallel import SERIAL, check_picklable, executor
-from .runs import MarkersAt, Task, failed_run
+from .runs import MarkersAndSlopes, MarkersAt, Task, failed_run
 from .targets import of_spec
 from .variants import apply, as_spec, current, split_key
 
 #: Residual entry [-] (a fraction of L) for a sample after a run stopped early.
 FAILED_RESIDUAL = 1.0
+#: How the Jacobian is built: forward differences of runs, or the runs' own sensitivities.
+JACOBIANS = ("differences", "exact")
 
 
 @dataclass
@@ -78,7 +83,7 @@ class Fit:
 
 
 def identify(spec, measured, parameters, *, start=None, client=None, rel_step=1e-2, max_iterations=30,
-             tolerance=1e-6, progress=None, n_workers=None):
+             tolerance=1e-6, progress=None, n_workers=None, jacobian="differences"):
     """Fit ``parameters`` of ``spec`` to the measured markers.
 
     Parameters
@@ -103,14 +108,23 @@ def identify(spec, measured, parameters, *, start=None, client=None, rel_step=1e
     max_iterations, tolerance : the least-squares iterations (Jacobians) and
         the relative change of cost and parameters at which it stops.
     progress : callable ``progress(iteration, cost)``, optional
+    jacobian : "differences" or "exact"
+        ``"differences"``: one run per parameter at ``rel_step`` (all at once on
+        the executor); ``"exact"``: the forward sensitivities of each run
+        (``simulate(..., sensitivities=...)``, CVODE or RK23), so one run gives
+        the residual and its Jacobian; the parameters must then be
+        :mod:`rodmol.named_parameters` (numbers, not the run's settings).
 
     Returns
     -------
     Fit
     """
     spec = as_spec(spec)
+    exact = _checks.choice("jacobian", jacobian, JACOBIANS) == "exact"
     tracks, targets = of_spec(spec, measured)
     names, lower, upper, x0, scale = _parameters(spec, parameters, start or {})
+    if exact:
+        named_parameters.parameters(spec.model, names)  # each a number the run differentiates by
     if tracks.t[-1] > spec.t_end + 1e-12:
         spec = apply(spec, {"solver.t_end": float(tracks.t[-1])})
     if client != SERIAL:
@@ -118,7 +132,10 @@ def identify(spec, measured, parameters, *, start=None, client=None, rel_step=1e
     length = targets.length
     seen = np.isfinite(tracks.xyz)
     task = Task(spec, MarkersAt(tracks.t, targets), keep=False)
-    cache = {}
+    if exact:
+        task = Task(spec, MarkersAndSlopes(tracks.t, targets, tuple(names)), keep=False,
+                    options=(("sensitivities", tuple(names)),))
+    cache, slopes = {}, {}
 
     def overrides(x):
         return {name: float(v) for name, v in zip(names, x * scale)}
@@ -126,7 +143,11 @@ def identify(spec, measured, parameters, *, start=None, client=None, rel_step=1e
     def simulate(points, ex):
         outcomes = ex.map(task, [overrides(x) for x in points], failed=failed_run)
         for x, o in zip(points, outcomes):
-            simulated = o.value if o.value is not None else np.full(tracks.xyz.shape, np.nan)  # a failed run
+            value = o.value
+            if exact:
+                value, derivatives = value if value is not None else (None, None)
+                slopes[tuple(x)] = _slopes(derivatives, names, seen, length, scale)
+            simulated = value if value is not None else np.full(tracks.xyz.shape, np.nan)  # a failed run
             cache[tuple(x)] = _residual(simulated, tracks.xyz, seen, length)
         return [cache[tuple(x)] for x in points]
 
@@ -140,6 +161,12 @@ def identify(spec, measured, parameters, *, start=None, client=None, rel_step=1e
             return cache[tuple(x)]
 
         def jac(x):
+            if exact:
+                fun(x)
+                counter["iterations"] += 1
+                if progress:
+                    progress(counter["iterations"], 0.5 * float(cache[tuple(x)] @ cache[tuple(x)]))
+                return slopes[tuple(x)]
             f0 = fun(x)
             steps = rel_step * np.maximum(np.abs(x), 1.0)
             steps = np.where(x + steps > upper / scale, -steps, steps)  # stay inside the bounds
@@ -189,6 +216,15 @@ def _parameters(spec, parameters, start):
     # that the steps and the trust region treat all parameters alike.
     scale = np.where(x0 != 0.0, np.abs(x0), np.array(upper) - np.array(lower))
     return names, np.array(lower), np.array(upper), x0, scale
+
+
+def _slopes(derivatives, names, seen, length, scale):
+    """The Jacobian of the residual by the scaled parameters from the markers'
+    derivatives ({name: d markers / d name}); zero columns for a failed run."""
+    if derivatives is None:
+        return np.zeros((int(np.sum(seen)), len(names)))
+    columns = [np.nan_to_num(derivatives[name][seen] / length * s) for name, s in zip(names, scale)]
+    return np.column_stack(columns)
 
 
 def _residual(simulated, measured, seen, length):

@@ -35,12 +35,14 @@ class Task:
     """Run ``spec`` with one set of overrides and apply ``extract(result, spec)``.
 
     ``keep`` returns the Result too (it pickles as its raw states: the
-    client computes what it reads from it).
+    client computes what it reads from it). ``options``: (name, value) pairs of
+    :func:`rodmol.simulate`'s options for the run (e.g. its ``sensitivities``).
     """
 
     spec: object
     extract: object = None
     keep: bool = True
+    options: tuple = ()
 
     def __call__(self, overrides):
         started = time.perf_counter()
@@ -48,7 +50,7 @@ class Task:
             spec = apply(self.spec, overrides)  # the batch checked the overrides; a run may still refuse
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", RuntimeWarning)  # the outcome carries the message
-                result = spec.simulate()
+                result = spec.simulate(**dict(self.options))
             value = self.extract(result, spec) if self.extract is not None else None
         # No equilibrium, absurd values, a user function that raised: this run failed, not the batch.
         except Exception as exc:  # noqa: BLE001
@@ -83,6 +85,21 @@ class MarkersAt:
         sim = np.stack([np.interp(self.times[inside], result.t, col) for col in flat.T], axis=1)
         out[inside] = sim.reshape((int(np.sum(inside)),) + markers.shape[1:])
         return out
+
+
+@dataclass(frozen=True)
+class MarkersAndSlopes:
+    """:class:`MarkersAt`'s markers and, for each parameter of ``keys`` (a run with
+    those ``sensitivities``), their derivative by it, the same way: (markers,
+    {key: d markers / d key}) [m, m per unit of the key]."""
+
+    times: np.ndarray
+    targets: object = None
+    keys: tuple = ()
+
+    def __call__(self, result, spec):
+        at = MarkersAt(self.times, self.targets)
+        return at(result, spec), {key: at(result.sensitivity(key), spec) for key in self.keys}
 
 
 @dataclass(frozen=True)

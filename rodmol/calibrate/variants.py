@@ -20,22 +20,22 @@ one value: ``medium.Cy,Cz`` sets Cy = Cz (the paper's transverse drag).
 
 A system's run (a :class:`rodmol.System`) names the part a key changes:
 ``rods.<rod>.material.E``, ``bodies.<body>.mass`` ...
-(:mod:`rodmol.calibrate.system_variants`); the run's keys (``[solver]``,
+(:mod:`rodmol.system_variants`); the run's keys (``[solver]``,
 ``discretization.scheme``) are as above. The Model's keys are
-:mod:`rodmol.calibrate.rod_variants`'.
+:mod:`rodmol.model_variants`'.
 """
 
 import os
 from dataclasses import replace
 
-from .. import _checks
+from .. import _checks, system_variants
+from .. import model_variants as rod_variants
 from ..discretise.schemes import DEFAULT_SCHEME, get_scheme
 from ..errors import ParameterError
 from ..model import Model
+from ..model_variants import KEYS, RUN_KEYS, ScaledTension, expand, split_key  # noqa: F401 (also their home)
 from ..run_spec import RunSpec
 from ..systems import System
-from . import rod_variants, system_variants
-from .rod_variants import KEYS, RUN_KEYS, ScaledTension  # noqa: F401 (their home before rod_variants)
 
 
 def as_spec(spec):
@@ -56,24 +56,6 @@ def spec_of(model, t_end, name="model", **solver):
     if not isinstance(model, (Model, System)):
         raise ParameterError(f"`model` must be a rodmol.Model or a rodmol.System, got {model!r}")
     return RunSpec(name, "", "<python>", model, _checks.positive("t_end", t_end, " s"), dict(solver))
-
-
-def expand(overrides):
-    """{key: value} with comma-joined keys split: ``medium.Cy,Cz`` -> Cy and Cz."""
-    out = {}
-    for key, value in dict(overrides or {}).items():
-        for one in split_key(key):
-            out[one] = value
-    return out
-
-
-def split_key(key):
-    """``"medium.Cy,Cz"`` -> ``["medium.Cy", "medium.Cz"]``."""
-    if not isinstance(key, str) or not key:
-        raise ParameterError(f"an override key must be a dotted name such as 'material.E', got {key!r}")
-    first, *more = key.split(",")
-    table = first.rsplit(".", 1)[0] if "." in first else ""
-    return [first] + [k if "." in k else f"{table}.{k}" for k in (m.strip() for m in more)]
 
 
 def apply(spec, overrides):

@@ -115,6 +115,11 @@ class Discretised(Protocol):
     describe_stall(y)
         What the state ``y`` of a run that stalled says about why (a rod's
         most compressed element and largest turn), one or two sentences.
+
+    A system may also offer ``jacobian_times(scale)``: scikit-sundae's
+    ``jactimes.solvefn`` ``(t, y, fy, v, Jv)``, CVODE's GMRES then takes its
+    products J v instead of its own differences (a system with
+    sensitivities, :class:`rodmol.discretise.sensitivity_system.SensitivitySystem`).
     """
 
     size: int

@@ -19,6 +19,7 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
+from .. import model_variants
 from ..arm import paper_arm
 from ..base_motion import BaseMotion
 from ..bodies import BODY_CONTACT_UNITS, RigidBody
@@ -109,10 +110,9 @@ class Table:
         return tuple(k for k, p in self.parameters().items() if type(p.default) is bool)
 
 
-#: Model's keyword parameters set in [medium] (the rest come from other tables).
-MODEL_SWITCHES = ("drag", "added_mass", "munk_moment", "drag_law", "drag_coefficients")
-#: simulate's keywords a [solver] table sets (the others are Python's or the command line's).
-SOLVER_KEYS = ("t_end", "backend", "rtol", "atol", "output_dt", "initial", "max_wall_time")
+# Model's keywords set in [medium] and simulate's a [solver] table sets (the others are Python's or the
+# command line's): the overrides' module owns them, which sits below the scenario reader.
+MODEL_SWITCHES, SOLVER_KEYS = model_variants.MODEL_SWITCHES, model_variants.SOLVER_KEYS
 
 ROD = Table((Source(Rod, skip=("material",)),))
 MATERIAL = Table((Source(Material),))

@@ -66,23 +66,26 @@ def cvode(system, y0, t_out, *, rtol, atol, progress=None, max_wall_time=None, l
         return out.stopped(reason, error, **stats())
 
     t_end = float(t_out[-1])
+    # As Python floats: the loop below compares them at every step, where numpy's scalars cost.
+    times, frames = out.t_out.tolist(), len(out.t_out)
 
     def steps():
-        while not out.done:
+        while out.next_index < frames:
             # Towards the next output: CVODE sizes its first step by the distance to it (towards
             # t_end, a contact's damped bounce kept ringing at 1 % where it settles at rtol); at
             # the inputs' knots at the latest: a rod at rest takes long steps and would stride
             # over a short ramp that starts between two of them.
-            r, problem = stepper.step(float(out.t_out[out.next_index]), stepper.stop_time(t_end), watch)
+            r, problem = stepper.step(times[out.next_index], stepper.stop_time(t_end), watch)
             if problem:  # the frames inside a broken step are not kept either
                 return stop(problem)
-            if not out.done and out.t_out[out.next_index] <= r.t:
+            t, k = r.t, out.next_index
+            if k < frames and times[k] <= t:
                 stepper.mark()  # an output frame reached: the right-hand sides are watched afresh
-            while not out.done and out.t_out[out.next_index] <= r.t:
-                t_k = out.t_out[out.next_index]
-                out.add(r.y if t_k == r.t else stepper.interpolate(t_k))
-            slow = watch.pace(r.t, r.y)
-            if slow and not out.done:
+                while k < frames and times[k] <= t:
+                    out.add(r.y if times[k] == t else stepper.interpolate(times[k]))
+                    k += 1
+            slow = watch.pace(t, r.y)
+            if slow and k < frames:
                 return stop(slow)
 
     def now():

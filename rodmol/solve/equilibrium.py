@@ -27,7 +27,7 @@ from .rest_equations import RestEquations, continuation, damped_newton
 from .system_equilibrium import free_rest_state
 
 
-def equilibrium(model, t=0.0, *, scheme=None, tol=1e-10, max_iter=40):
+def equilibrium(model, t=0.0, *, scheme=None, tol=1e-10, max_iter=40, start=None):
     """Static equilibrium of ``model`` under its loads at time ``t``.
 
     Gravity, buoyancy, the cable tensions and the external loads at ``t`` are
@@ -55,6 +55,11 @@ def equilibrium(model, t=0.0, *, scheme=None, tol=1e-10, max_iter=40):
         load scale (:func:`rodmol.discretise.load_entries.load_scale`);
         raised to the round-off floor of the difference quotients on very
         fine grids.
+    start : array, optional
+        A nearby rest state of a rod (e.g. of the same rod at a slightly other
+        parameter value), tried first by Newton at the full loads; the
+        continuation from the undeformed rod is the fallback. Ignored for a
+        System and under feedback tensions.
 
     Returns
     -------
@@ -84,8 +89,10 @@ def equilibrium(model, t=0.0, *, scheme=None, tol=1e-10, max_iter=40):
         system = SemiDiscrete(model, DEFAULT_SCHEME if scheme is None else scheme)
     else:
         raise ParameterError(f"`model` must be a rodmol.Model or its SemiDiscrete, got {model!r}")
-    solve = _closed_loop if system.model.feedback else _rest_state
-    y = solve(system, t, tol, max_iter)
+    if system.model.feedback:
+        y = _closed_loop(system, t, tol, max_iter)
+    else:
+        y = _rest_state(system, t, tol, max_iter, start=start)
     problem = system.state_problem(t, y)
     if problem:
         raise EquilibriumError(f"the static equilibrium is not a valid state of the rod: {problem}")

@@ -19,6 +19,7 @@ own when asked.
 
 import contextlib
 import warnings
+from bisect import bisect_right
 
 import numpy as np
 from scipy import sparse
@@ -76,6 +77,7 @@ class Stepper:
             self._solver = CVODE(rates, **options)
         self.t, self.y = float(t0), np.array(y0, dtype=float)
         self.knots = np.unique(np.asarray(system.knot_times(), dtype=float))  # the inputs' kinks [s], sorted
+        self._knots = self.knots.tolist()  # for bisect: stop_time runs at every step, numpy's call costs 1 us
         #: Time [s] CVODE's steps have reached (beyond ``t`` inside an advance).
         self.reached = self.t
         self._fresh = False  # CVODE holds no history to continue from
@@ -206,8 +208,8 @@ class Stepper:
         """Where the next internal step must end at the latest [s]: the first knot of the
         inputs after the steps reached (the system's ``knot_times()``: a long step must not
         stride over a short ramp), and ``t_end`` if ``exact_end``; None: anywhere."""
-        k = np.searchsorted(self.knots, self.reached, side="right")
-        knot = float(self.knots[k]) if k < len(self.knots) else None
+        k = bisect_right(self._knots, self.reached)
+        knot = self._knots[k] if k < len(self._knots) else None
         if exact_end and (knot is None or knot > t_end):
             return float(t_end)
         return knot
@@ -246,7 +248,7 @@ def solver_options(system, rtol, atol, linsolver="auto", max_step=0.0, jacobian=
                    max_nonlin_iters=3):
     """scikit-sundae's ``CVODE`` options for ``system`` (see :func:`rodmol.solve.cvode.cvode` for the
     arguments): returns (options, the linear solver chosen, the preconditioner or None)."""
-    from sksundae.cvode import CVODEPrecond
+    from sksundae.cvode import CVODEJacTimes, CVODEPrecond
 
     linsolver = linear_solver(system, linsolver)
     if jacobian == "auto":
@@ -267,6 +269,8 @@ def solver_options(system, rtol, atol, linsolver="auto", max_step=0.0, jacobian=
         precond = system.preconditioner(scale)
         options["precond"] = CVODEPrecond(precond.setup, precond.solve, "left")
         options["krylov_dim"] = KRYLOV_DIM
+        if hasattr(system, "jacobian_times"):  # its own products J v (a system with sensitivities)
+            options["jactimes"] = CVODEJacTimes(None, system.jacobian_times(scale))
     elif linsolver in ("band", "lapackband"):
         options["lband"], options["uband"] = system.bandwidths()
     if jacobian == "compiled" and linsolver != "gmres":

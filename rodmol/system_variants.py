@@ -4,7 +4,7 @@ each routed to the part it names and the System rebuilt with the new part
 
 * ``rods.<rod>.<key>``: a key of a single rod's (``material.E``,
   ``medium.drag``, ``discretization.n_elements``, ``tension.<cable>.scale``
-  ...), applied to that rod's Model by :mod:`rodmol.calibrate.rod_variants`;
+  ...), applied to that rod's Model by :mod:`rodmol.model_variants`;
   the medium's numbers are the system's, not a rod's: ``medium.<number>``;
 * ``bodies.<body>.<field>``: ``mass`` [kg], ``volume`` [m^3], ``inertia``
   [kg m^2], ``centre_of_mass`` [m], ``added_mass``, ``drag`` (each as
@@ -16,15 +16,17 @@ each routed to the part it names and the System rebuilt with the new part
 * a rod's key without ``rods.<rod>.`` (``material.mu``, ``medium.drag``,
   ``discretization.n_elements``): every rod (a rod's own key wins over it);
   its value (:func:`value`) is the rods' common one.
+
+On the problem floor, as :mod:`rodmol.model_variants`.
 """
 
 import numpy as np
 
-from .. import _checks
-from ..bodies import RigidBody
-from ..errors import ParameterError
-from ..parameters import Medium
-from . import rod_variants
+from . import _checks
+from . import model_variants as rod_variants
+from .bodies import RigidBody
+from .errors import ParameterError
+from .parameters import Medium
 
 #: A body's numbers and its vector fields with their lengths (the fields worth fitting).
 BODY_NUMBERS = ("mass", "volume")

@@ -5,29 +5,38 @@ Model holds: the numbers of ``[material]`` and ``[medium]``, the switches of
 ``[medium]``, ``discretization.n_elements`` and ``tension.<cable>`` (with
 ``.scale`` and ``.offset``); the run's keys (``[solver]``, the scheme) are
 applied by :mod:`rodmol.calibrate.variants`, and
-:mod:`rodmol.calibrate.system_variants` routes a system's
-``rods.<name>.<key>`` here.
+:mod:`rodmol.system_variants` routes a system's ``rods.<name>.<key>`` here.
+On the problem floor (it reads the Model's own classes, not the scenario
+reader), so that :mod:`rodmol.named_parameters` and the runs below
+calibration can rebuild a model at other parameter values.
 """
 
+import inspect
 import re
-from dataclasses import replace
+from dataclasses import fields, replace
 
-from .. import _checks
-from ..cables import Tension, as_tension
-from ..errors import ParameterError
-from ..inputs import TimeInput
-from ..parameters import Material, Medium
-from ..rod import Rod
-from ..scenario import tables
+from . import _checks
+from .cables import Tension, as_tension
+from .errors import ParameterError
+from .inputs import TimeInput
+from .model import Model
+from .parameters import Material, Medium
+from .rod import Rod
 
-MATERIAL = tables.MATERIAL.numbers()
-MEDIUM = tables.MEDIUM.numbers()
-SWITCHES = tables.MEDIUM.switches()
+#: Model's keyword parameters set in the scenario's [medium] (the rest come from other tables).
+MODEL_SWITCHES = ("drag", "added_mass", "munk_moment", "drag_law", "drag_coefficients")
+#: simulate's keywords a scenario's [solver] table sets, in simulate's order.
+SOLVER_KEYS = ("t_end", "initial", "backend", "rtol", "atol", "output_dt", "max_wall_time")
+#: The numbers of [material] and [medium] (the dataclasses' float fields), the switches of [medium].
+MATERIAL = tuple(f.name for f in fields(Material) if "float" in str(f.type))
+MEDIUM = tuple(f.name for f in fields(Medium) if "float" in str(f.type))
+SWITCHES = tuple(k for k, p in inspect.signature(Model).parameters.items()
+                 if k in MODEL_SWITCHES and type(p.default) is bool)
 #: The keys of a Model.
 MODEL_KEYS = ([f"material.{k}" for k in MATERIAL] + [f"medium.{k}" for k in MEDIUM + SWITCHES]
               + ["discretization.n_elements", "tension.<cable>", "tension.<cable>.scale", "tension.<cable>.offset"])
 #: The run's keys (a RunSpec's, of a rod or a system): the scheme and [solver]'s.
-RUN_KEYS = ["discretization.scheme"] + [f"solver.{k}" for k in tables.SOLVER.names()]
+RUN_KEYS = ["discretization.scheme"] + [f"solver.{k}" for k in SOLVER_KEYS]
 #: Every key of a single rod's run.
 KEYS = MODEL_KEYS[:-3] + RUN_KEYS + MODEL_KEYS[-3:]
 
@@ -44,6 +53,24 @@ class ScaledTension(TimeInput):
 
     def __repr__(self):
         return f"ScaledTension({self.signal!r}, scale={self.scale!r}, offset={self.offset!r})"
+
+
+def expand(overrides):
+    """{key: value} with comma-joined keys split: ``medium.Cy,Cz`` -> Cy and Cz."""
+    out = {}
+    for key, value in dict(overrides or {}).items():
+        for one in split_key(key):
+            out[one] = value
+    return out
+
+
+def split_key(key):
+    """``"medium.Cy,Cz"`` -> ``["medium.Cy", "medium.Cz"]``."""
+    if not isinstance(key, str) or not key:
+        raise ParameterError(f"an override key must be a dotted name such as 'material.E', got {key!r}")
+    first, *more = key.split(",")
+    table = first.rsplit(".", 1)[0] if "." in first else ""
+    return [first] + [k if "." in k else f"{table}.{k}" for k in (m.strip() for m in more)]
 
 
 def is_key(key):
