@@ -1,6 +1,6 @@
 """rodmol/OctopusCrawl-v0's cost per simulated second, main against this tree, side by side.
 
-Two versions of the package, each in its own worker process (``_workers.py``):
+Two versions of the package, each in its own worker process (``core_speed.Version``):
 ``main``, the merge base of this branch (``--main REV``), and ``new``, this
 working tree, which also runs its environment at the scheme's default
 tolerance (``rtol=3e-5``, main's) to part what the tolerance buys from what
@@ -24,12 +24,11 @@ configuration's head positions and rewards are from a run at rtol = 3e-6.
 import importlib.util
 import os
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
 
-from _workers import Version, paired_ratio, serve
+import core_speed
 
 SCRIPT = "crawl_speed.py"
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -46,10 +45,11 @@ class _Worker:
     def __init__(self, mode="full", configs=()):
         import numpy as np
 
+        import rodmol
         from rodmol.control import crawl
         from rodmol.control.octopus import arm_angle
 
-        self.np, self.crawl = np, crawl
+        self.np, self.crawl, self.rodmol = np, crawl, rodmol
         self.periods = PERIODS if mode != "smoke" else 2
         small = {} if mode != "smoke" else dict(n_elements=3, settle=0.05)
         self.envs = {name: crawl.OctopusCrawlEnv(**small, **options) for name, options in configs}
@@ -66,6 +66,9 @@ class _Worker:
                         "random": np.random.default_rng(0).uniform(0.0, 2.0, (self.periods, 16))}
         for name in self.envs:  # compiles (or loads) the kernels before anything is timed
             self.run(name, "gait", periods=2)
+
+    def info(self):
+        return dict(rodmol_file=self.rodmol.__file__)
 
     def run(self, config, case, periods=None, trace=False):
         env, np = self.envs[config], self.np
@@ -96,33 +99,21 @@ def _example():
     return module
 
 
-def run(worker, **cmd):
-    return worker.run(**cmd)
-
-
 # --------------------------------------------------------------------------- parent
 
-
-def git(*args):
-    return subprocess.run(["git", "-C", ROOT, *args], check=True, capture_output=True, text=True).stdout.strip()
 
 
 def main(argv=None):
     import _common as C  # the parent runs with this checkout (header, file writers)
 
     np = C.np
-    argv = sys.argv[1:] if argv is None else list(argv)
-    main_rev = "main"
-    if "--main" in argv:
-        i = argv.index("--main")
-        main_rev = argv[i + 1]
-        del argv[i:i + 2]
+    argv, main_rev = core_speed.split_option(sys.argv[1:] if argv is None else list(argv), "main", "main")
     args = C.parse_args(__doc__.splitlines()[0], argv)
     if not any(a.startswith("--reps") for a in argv):
         args.reps = C.pick(args, 5, 3, 1)
-    main_tree, main_sha = C.package_tree(git("merge-base", main_rev, "HEAD"))
-    head_sha = git("rev-parse", "HEAD")
-    dirty = bool(git("status", "--porcelain", "--untracked-files=no", "--", "rodmol"))
+    main_tree, main_sha = C.package_tree(core_speed.git("merge-base", main_rev, "HEAD"))
+    head_sha = core_speed.git("rev-parse", "HEAD")
+    dirty = bool(core_speed.git("status", "--porcelain", "--untracked-files=no", "--", "rodmol"))
     header = C.header_lines(args, SCRIPT) + [
         f"main: {main_sha[:10]}; new: working tree at {head_sha[:10]}"
         + (" with uncommitted changes under rodmol/" if dirty else ""),
@@ -134,10 +125,11 @@ def main(argv=None):
     versions, runs, traces = [], [], {}
     try:
         for label, tree in (("main", main_tree), ("new", ROOT)):
-            versions.append(Version(label, tree, __file__, os.path.join(tmp, f"{label}.stderr")))
+            versions.append(core_speed.Version(label, tree, os.path.join(tmp, f"{label}.stderr"),
+                                               os.path.abspath(__file__)))
         for v in versions:
             t0 = time.perf_counter()
-            file = v.start(mode=args.mode, configs=configs[v.label])
+            file = C.started(v, mode=args.mode, configs=configs[v.label])["rodmol_file"]
             print(f"{v.label}: {file} ready in {time.perf_counter() - t0:.1f} s", flush=True)
         for case in CASES:  # the traces, and the reference (not timed)
             for v in versions:
@@ -168,7 +160,7 @@ def main(argv=None):
                 cpu_per_sim_s=float(np.median([r["cpu_per_sim_s"] for r in own])),
                 steps=int(np.median([r["steps"] for r in own])),
                 rhs_evals=int(np.median([r["rhs_evals"] for r in own])),
-                vs_main=paired_ratio(np, mine, "cpu_per_sim_s", name, "main"),
+                vs_main=C.paired_ratio(mine, "cpu_per_sim_s", name, "main"),
                 head_error_m=float(np.max(np.abs(np.subtract(trace["heads"], reference["heads"])))),
                 reward_error=float(np.max(np.abs(np.subtract(trace["rewards"], reference["rewards"])))),
                 head_travel_m=float(reference["heads"][-1][0] - reference["heads"][0][0])))
@@ -182,6 +174,6 @@ def main(argv=None):
 
 if __name__ == "__main__":
     if sys.argv[1:] == ["--worker"]:
-        serve(_Worker, dict(run=run))
+        core_speed.worker_main(_Worker)
     else:
         main()

@@ -1,7 +1,7 @@
 """A System's ``simulate`` against the old driver, and a rod's against main, side by side.
 
 Three versions of the package, each in its own long-lived worker process
-(PYTHONPATH at its tree, one BLAS thread): ``old``, the commit before the
+(``core_speed.Version``: PYTHONPATH at its tree, one BLAS thread): ``old``, the commit before the
 System's own CVODE driver (``solve/system_cvode.py``) was removed (548824c^);
 ``main``, the merge base of this branch (``--main REV``); ``new``, this
 working tree. Every round runs every case once in each version, the versions'
@@ -22,13 +22,12 @@ new / old and new / main (the two ran back to back in the round).
 
 import os
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
 import types
 
-from _workers import Version, paired_ratio, serve
+import core_speed
 
 SCRIPT = "driver_speed.py"
 OLD_COMMIT = "548824c^"  # the last commit with solve/system_cvode.py
@@ -63,6 +62,9 @@ class _Worker:
         for name in self.cases:  # compiles (or loads) every kernel before anything is timed
             self.run(name)
 
+    def info(self):
+        return dict(rodmol_file=self.rodmol.__file__)
+
     def run(self, name):
         import gc
 
@@ -78,13 +80,6 @@ class _Worker:
                     prec_solves=counters["prec_solves"])
 
 
-def run(worker, case):
-    return worker.run(case)
-
-
-def git(*args):
-    return subprocess.run(["git", "-C", ROOT, *args], check=True, capture_output=True, text=True).stdout.strip()
-
 
 def rounds(versions, reps):
     """Every case in every version per round, the versions' order alternating: the runs."""
@@ -93,14 +88,14 @@ def rounds(versions, reps):
         for case in CASES:
             order = versions if (rep + CASES.index(case)) % 2 == 0 else versions[::-1]
             for v in order:
-                runs.append(dict(rep=rep, case=case, version=v.label, **v.ask(cmd="run", case=case)))
+                runs.append(dict(rep=rep, case=case, version=v.label, **v.ask(cmd="run", name=case)))
         print(f"round {rep + 1}/{reps} done", flush=True)
     return runs
 
 
-def table(np, runs):
+def table(C, runs):
     """One row per case: medians per version, counters, and the paired ratios' medians."""
-    rows = []
+    np, rows = C.np, []
     for case in CASES:
         mine = [r for r in runs if r["case"] == case]
         by = {}
@@ -115,10 +110,10 @@ def table(np, runs):
                 row[f"{label}_{key}"] = values[0] if len(values) == 1 else "/".join(map(str, values))
         for base in ("old", "main"):
             ratios = [d["new"]["cpu_s"] / d[base]["cpu_s"] for d in by.values()]
-            row[f"new_vs_{base}"] = paired_ratio(np, mine, "cpu_s", "new", base)
+            row[f"new_vs_{base}"] = C.paired_ratio(mine, "cpu_s", "new", base)
             low, high = np.percentile(ratios, [25, 75])
             row[f"new_vs_{base}_iqr"] = f"{low:.3f}-{high:.3f}"
-        row["main_vs_old"] = paired_ratio(np, mine, "cpu_s", "main", "old")
+        row["main_vs_old"] = C.paired_ratio(mine, "cpu_s", "main", "old")
         rows.append(row)
     return rows
 
@@ -126,18 +121,13 @@ def table(np, runs):
 def main(argv=None):
     import _common as C  # the parent runs with this checkout (header, file writers)
 
-    argv = sys.argv[1:] if argv is None else list(argv)
-    main_rev = "main"
-    if "--main" in argv:
-        i = argv.index("--main")
-        main_rev = argv[i + 1]
-        del argv[i:i + 2]
+    argv, main_rev = core_speed.split_option(sys.argv[1:] if argv is None else list(argv), "main", "main")
     args = C.parse_args(__doc__.splitlines()[0], argv)
     if not any(a.startswith("--reps") for a in argv):
         args.reps = C.pick(args, 21, 7, 1)
-    trees = dict(old=C.package_tree(OLD_COMMIT), main=C.package_tree(git("merge-base", main_rev, "HEAD")))
-    head_sha = git("rev-parse", "HEAD")
-    dirty = bool(git("status", "--porcelain", "--untracked-files=no", "--", "rodmol"))
+    trees = dict(old=C.package_tree(OLD_COMMIT), main=C.package_tree(core_speed.git("merge-base", main_rev, "HEAD")))
+    head_sha = core_speed.git("rev-parse", "HEAD")
+    dirty = bool(core_speed.git("status", "--porcelain", "--untracked-files=no", "--", "rodmol"))
     header = C.header_lines(args, SCRIPT) + [
         f"old: {trees['old'][1][:10]}; main: {trees['main'][1][:10]}; new: working tree at {head_sha[:10]}"
         + (" with uncommitted changes under rodmol/" if dirty else ""),
@@ -146,17 +136,18 @@ def main(argv=None):
     versions = []
     try:
         for label, tree in (("old", trees["old"][0]), ("main", trees["main"][0]), ("new", ROOT)):
-            versions.append(Version(label, tree, __file__, os.path.join(tmp, f"{label}.stderr")))
+            versions.append(core_speed.Version(label, tree, os.path.join(tmp, f"{label}.stderr"),
+                                               os.path.abspath(__file__)))
         for v in versions:  # one after the other: compilation wants a core
             t0 = time.perf_counter()
-            file = v.start(mode=args.mode)
+            file = C.started(v, mode=args.mode)["rodmol_file"]
             print(f"{v.label}: {file} ready in {time.perf_counter() - t0:.1f} s", flush=True)
         runs = rounds(versions, args.reps)
     finally:
         for v in versions:
             v.close()
         shutil.rmtree(tmp, ignore_errors=True)
-    rows = table(C.np, runs)
+    rows = table(C, runs)
     for row in rows:
         print(row, flush=True)
     fmt = {key: ".4f" for key in rows[0] if key.endswith("_cpu_s")}
@@ -168,6 +159,6 @@ def main(argv=None):
 
 if __name__ == "__main__":
     if sys.argv[1:] == ["--worker"]:
-        serve(_Worker, dict(run=run))
+        core_speed.worker_main(_Worker)
     else:
         main()
