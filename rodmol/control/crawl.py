@@ -31,7 +31,7 @@ ARM_NAMES = tuple(f"arm{i + 1}" for i in range(ARMS))
 #: The integrator's relative tolerance over the episodes: 6.7 times the default scheme's, whose
 #: time error is meant to be a tenth of its spatial error at the paper's N = 100 (at N = 6 that
 #: is far larger). Over 2 s slack, of the example's gait or of random actions the head stays
-#: within 2 um of a run at rtol = 3e-6 (the tips within 4 um), and the environment costs 0.68-0.76
+#: within 2 um of a run at rtol = 3e-6 (the tips within 4 um), and the environment costs 0.67-0.78
 #: times what it does at the scheme's 3e-5 (solvers/crawl_speed.py, docs/performance.md).
 RTOL = 2e-4
 #: Observation size: the head's position (3), quaternion (4), velocity and angular velocity
