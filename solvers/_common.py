@@ -86,6 +86,24 @@ def package_tree(commit):
     return folder, sha
 
 
+def paired_ratio(runs, key, new, base, pair="rep"):
+    """Median over rounds (``pair``) of ``runs``' ``key`` of version ``new`` over version ``base``:
+    the two ran back to back within a round, so their ratio sees the same load."""
+    by = {}
+    for r in runs:
+        by.setdefault(r[pair], {})[r["version"]] = r[key]
+    return float(np.median([d[new] / d[base] for d in by.values() if d.get(base)]))
+
+
+def started(version, **fields):
+    """Initialise the worker ``version`` (a ``core_speed.Version``) with ``fields``; its answer,
+    after checking that it imported rodmol from its own tree."""
+    info = version.ask(cmd="init", **fields)
+    if not os.path.realpath(info["rodmol_file"]).startswith(os.path.realpath(version.tree) + os.sep):
+        raise RuntimeError(f"{version.label} worker imported {info['rodmol_file']}, not from {version.tree}")
+    return info
+
+
 def pick(args, full, quick, smoke):
     """The value of a setting for the run mode."""
     return {"full": full, "quick": quick, "smoke": smoke}[args.mode]

@@ -148,9 +148,9 @@ class _Worker:
 
 def worker_main(make=None):
     """Answer one JSON command per stdin line with one MARK-prefixed JSON line: ``init``
-    makes the worker (``make(n, t_end)``, default :class:`_Worker`) and answers its
-    ``info()``; any other command but ``quit`` calls the worker's method of that name
-    with the command's other fields."""
+    makes the worker (``make(**fields)``, the command's other fields, default
+    :class:`_Worker`: ``n``, ``t_end``) and answers its ``info()``; any other command but
+    ``quit`` calls the worker's method of that name with the command's other fields."""
     # An editable install of rodmol adds a finder that serves, for any module a
     # tree lacks, the installed checkout's (rodmol.discretise for the old tree):
     # drop it so that only the tree on PYTHONPATH is seen.
@@ -161,7 +161,7 @@ def worker_main(make=None):
         name = cmd.pop("cmd")
         try:
             if name == "init":
-                w = (make or _Worker)(cmd["n"], cmd["t_end"])
+                w = (make or _Worker)(**cmd)
                 answer = w.info()
             elif name == "quit":
                 break

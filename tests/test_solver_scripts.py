@@ -311,6 +311,25 @@ def _vtp_series_cost(out):
     assert all(row["after_collections_s"] >= 0 for row in table if row["case"] == "series")
 
 
+def _driver_speed(out):
+    table = {row["case"]: row for row in rows(out / "driver_speed.csv")}
+    assert set(table) == {"octopus ramp", "octopus pulsing", "bending N=100"}
+    for row in table.values():  # the same system through the three drivers: the same steps
+        assert row["old_steps"] == row["main_steps"] == row["new_steps"], row
+        assert row["new_vs_old"] > 0 and row["new_vs_main"] > 0
+    bending = table["bending N=100"]  # a single rod's run keeps every counter of main's
+    assert (bending["main_rhs_evals"], bending["main_linear_setups"]) == \
+        (bending["new_rhs_evals"], bending["new_linear_setups"])
+
+
+def _crawl_speed(out):
+    table = rows(out / "crawl_speed.csv")
+    assert {(row["case"], row["configuration"]) for row in table} == \
+        {(case, name) for case in ("slack", "gait", "random") for name in ("main", "new, rtol 3e-5", "new")}
+    for row in table:  # every configuration near the reference run at rtol 3e-6
+        assert row["steps"] > 0 and row["cpu_per_sim_s"] > 0 and row["head_error_m"] < 1e-4, row
+
+
 def _accuracy_per_cost(out):
     table = [row for row in rows(out / "accuracy_per_cost.csv") if row["default_rtol"]]
     errors = [row["tip_err_mm"] for row in sorted(table, key=lambda row: row["N"])]
@@ -381,6 +400,8 @@ SCRIPTS = {
     "system_output.py": (["system_output.csv", "system_output.md"], _system_output),
     "rod_contact.py": (["rod_contact.csv", "rod_contact.md"], _rod_contact),
     "vtp_series_cost.py": (["vtp_series_cost.csv", "vtp_series_cost.md"], _vtp_series_cost),
+    "driver_speed.py": (["driver_speed.csv", "driver_speed.md", "driver_speed_runs.csv"], _driver_speed),
+    "crawl_speed.py": (["crawl_speed.csv", "crawl_speed.md", "crawl_speed_runs.csv"], _crawl_speed),
     "accuracy_per_cost.py": (["accuracy_per_cost.csv", "accuracy_per_cost.md"], _accuracy_per_cost),
     "step_overhead.py": (["step_overhead.csv", "step_overhead_runs.csv", "step_overhead_calls.csv",
                           "step_overhead.md"], _step_overhead),
@@ -390,7 +411,8 @@ SCRIPTS = {
 
 
 #: Scripts that start subprocesses themselves: the trees they compare, or a fresh run each.
-SPAWNING = {"bending_vs_commit.py", "core_speed.py", "long_output.py", "rest_strains_speed.py", "system_output.py", "view_open.py"}
+SPAWNING = {"bending_vs_commit.py", "core_speed.py", "long_output.py", "rest_strains_speed.py", "system_output.py",
+            "view_open.py", "driver_speed.py", "crawl_speed.py"}
 #: The script run as a command: one of the quickest.
 COMMAND = "release.py"
 
@@ -408,7 +430,13 @@ def _skip_without_what_it_needs(script):
     if script == "rest_strains_speed.py" and subprocess.run(
             ["git", "-C", ROOT, "merge-base", "HEAD", "main"], capture_output=True).returncode != 0:
         pytest.skip("needs a git checkout with a main branch (the base it measures against)")
-    if script == "reach_scores.py":
+    if script in ("driver_speed.py", "crawl_speed.py") and subprocess.run(
+            ["git", "-C", ROOT, "merge-base", "HEAD", "main"], capture_output=True).returncode != 0:
+        pytest.skip("needs a git checkout with a main branch (the base it measures against)")
+    if script == "driver_speed.py" and subprocess.run(
+            ["git", "-C", ROOT, "cat-file", "-e", "548824c^{commit}"], capture_output=True).returncode != 0:
+        pytest.skip("needs a git checkout holding commit 548824c")
+    if script in ("reach_scores.py", "crawl_speed.py"):
         pytest.importorskip("gymnasium")
     if script == "view_open.py" and shutil.which("pvpython") is None:
         pytest.skip("needs ParaView's pvpython")

@@ -61,7 +61,7 @@ import numpy as np
 
 from ..inputs import knot_times
 from .body_joints import BodyJointPart, body_joint_frequency
-from .body_part import BodyPart, clamp_velocities, cross
+from .body_part import BodyPart, clamp_map
 from .contact_parts import contact_parts
 from .joints import JointPart, RecordedJoints, RodJointPart
 from .physics import quaternion_rate
@@ -70,7 +70,6 @@ from .rigid import clamp_wrench, free_body_rates
 from .rod_scales import field_scales
 from .rotations import from_matrix, matrices
 from .state_checks import least_stretch, parts_problem, parts_step_problem
-from .stencil import WORK_TOTAL
 from .system import DRAG_SMOOTHING_SPEED, QUATERNION_RESTORING_RATE, SemiDiscrete
 from .system_jacobian import assembly_pattern
 from .system_state_view import SystemStateView
@@ -133,6 +132,10 @@ class Assembly:
             for part in joint.parts:
                 part.body_joints.append(joint)
         self.free = [p for p in self.bodies.values() if p.body.free]
+        # What every right-hand side walks, once: each rod's system and entries, the free bodies
+        # whose penalty or body joints' reactions it sums.
+        self._rod_parts = [(sd, self.parts[name]) for name, sd in self.rods.items()]
+        self._reacting = [p.name for p in self.free if p.joints or p.body_joints]
         self.lightly_damped = any(sd.lightly_damped for sd in self.rods.values())
         self.scan_arguments = None  # the step check's compiled scan arguments, made at its first call
         self._gravity = np.ascontiguousarray(system.gravity, dtype=float)
@@ -147,8 +150,10 @@ class Assembly:
         _, point, rj = system.clamps[name]
         motion = system.bodies[body].motion
 
+        moves = clamp_map(point, np.asarray(rj)[None])
+
         def velocities(t):
-            return clamp_velocities(point[None], rj[None], *motion.velocities(t))[0]
+            return moves @ np.concatenate([np.asarray(a, dtype=float) for a in motion.velocities(t)])
 
         return type(base)(lambda t: velocities(t)[:3], lambda t: velocities(t)[3:], base.position, base.rotation)
 
@@ -250,18 +255,17 @@ class Assembly:
         if out is None:
             out = np.empty(self.size)
         for part in self.free:  # the rods' base velocities first
-            for sd, row in zip(part.systems, part.base_velocities(y[part.fields["v"]], y[part.fields["w"]])):
-                sd.base_velocities[:] = row
-        reactions = {part.name: np.zeros(6) for part in self.free if part.joints or part.body_joints}
+            part.move_bases(y)
+        reactions = {name: np.zeros(6) for name in self._reacting}
         for joint in self.joints:  # and the held points of the penalty joints, with their bodies' reactions
             f, m = joint.wrench(y, self.body_state(joint.part, t, y), joint.row, joint.value)
             if joint.part.name in reactions:
                 reactions[joint.part.name] += (*f, *m)
-        self.add_body_joints(t, y, reactions)
+        if self.body_joints:
+            self.add_body_joints(t, y, reactions)
         for joint in self.rod_joints:
             joint.wrench(y, joint.row, joint.value)
-        for name, sd in self.rods.items():
-            sl = self.parts[name]
+        for sd, sl in self._rod_parts:
             sd(t, y[sl], out[sl])
         for part in self.bodies.values():
             self.body_rates(part, t, y, out, reactions.get(part.name))
@@ -308,7 +312,7 @@ class Assembly:
         """Force and moment about the origin [N, N m] of the rods clamped to
         ``part``, body frame, after the rods' rates at ``y``
         (:func:`rodmol.discretise.rigid.clamp_wrench`)."""
-        stress = np.array([work[0, WORK_TOTAL:WORK_TOTAL + 6] for work in part.works]).reshape(-1, 6)
+        stress = np.array(part.stress_rows).reshape(-1, 6)
         return clamp_wrench(stress, np.ascontiguousarray(y[part.strains]), part.shares, part.flat_turns, part.points)
 
     # ------------------------------------------------------------------ structure
@@ -404,11 +408,11 @@ class Assembly:
             p = np.einsum("nij,nj->ni", rot, sd.sampled.mass * lay.field(y_rod, "v") * lengths)
             h = np.einsum("nij,nj->ni", rot, sd.sampled.inertia * lay.field(y_rod, "w") * lengths)
             linear += p.sum(axis=0)
-            angular += (cross(lay.field(y_rod, "u"), p) + h).sum(axis=0)
+            angular += (np.cross(lay.field(y_rod, "u"), p) + h).sum(axis=0)
         for part in self.free:
             r = matrices(y[part.fields["Q"]])
             v, w = y[part.fields["v"]], y[part.fields["w"]]
             momentum = part.rigid_mass @ np.concatenate([v, w])
             linear += r @ momentum[:3]
-            angular += cross(y[part.fields["x"]], r @ momentum[:3]) + r @ momentum[3:]
+            angular += np.cross(y[part.fields["x"]], r @ momentum[:3]) + r @ momentum[3:]
         return linear, angular

@@ -1,7 +1,7 @@
 """A rigid body's place in a system's state (:class:`BodyPart`): its block,
 its constant data with what it carries (the rods' base segments), the rods
 clamped to it and its joints; and the clamped rods' base velocities
-(:func:`clamp_velocities`). :mod:`rodmol.discretise.assembly` says the
+(:func:`clamp_map`). :mod:`rodmol.discretise.assembly` says the
 frames and the equations."""
 
 import numpy as np
@@ -12,21 +12,23 @@ from .body_contact import BodyContacts
 from .layout import BlockLayout
 from .rigid import BODY_FIELDS, NET_MASS, NET_MOMENT, POSE_FIELDS, pack_body
 from .sampling import section_masses
+from .stencil import WORK_TOTAL
 
 
-def cross(a, b):
-    """a x b over the last axis (numpy's cross costs 20 us on one pair, most of a body's rates)."""
-    a, b = np.asarray(a), np.asarray(b)
-    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1], a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
-
-
-def clamp_velocities(points, turns, v, w):
-    """(n, 6) base velocities (v0, w0) = (Rj^T (v + w x p), Rj^T w) of rods
-    clamped at ``points`` (n, 3) [m] with ``turns`` (n, 3, 3) (base to body
-    frame) to a body moving with (v, w) (body frame): local frames of the bases."""
-    return np.concatenate([np.einsum("rji,rj->ri", turns, v + cross(w, points)),
-                           np.einsum("rji,j->ri", turns, np.broadcast_to(w, 3))], axis=1)
+def clamp_map(points, turns):
+    """(6 n, 6) matrix M of the base velocities (v0, w0) = (Rj^T (v + w x p), Rj^T w) of n
+    rods clamped at ``points`` (n, 3) [m] with ``turns`` (n, 3, 3) (base to body frame) to a
+    body moving with (v, w) (body frame): the rods' rows (v0, w0) stacked are M (v, w), local
+    frames of the bases. A constant of the clamps: one product per right-hand side (the
+    same with cross products and einsum cost 27 us a call, most of the octopus's body)."""
+    points, turns = np.asarray(points, dtype=float).reshape(-1, 3), np.asarray(turns, dtype=float)
+    back = np.transpose(turns, (0, 2, 1))  # Rj^T
+    skew = np.zeros((len(points), 3, 3))  # skew(p) w = p x w, so w x p = -skew(p) w
+    skew[:, 0, 1], skew[:, 0, 2], skew[:, 1, 2] = -points[:, 2], points[:, 1], -points[:, 0]
+    skew -= np.transpose(skew, (0, 2, 1))
+    m = np.zeros((len(points), 6, 6))
+    m[:, :3, :3], m[:, :3, 3:], m[:, 3:, 3:] = back, -back @ skew, back
+    return m.reshape(-1, 6)
 
 
 def first_element(start, sd):
@@ -57,7 +59,12 @@ class BodyPart:
         self.rigid_mass = own * (body.mass_matrix - body.added_mass)
         self.rods, self.systems = [], []
         self.works = []  # each rod kernel's scratch: cell 0's total stress after a call (stencil.rhs)
+        self.stress_rows = []  # views of that stress in each of them, (6,)
         self.points, self.turns = np.zeros((0, 3)), np.zeros((0, 3, 3))
+        self.velocity_map = clamp_map(self.points, self.turns)  # (6 n, 6): :func:`clamp_map`
+        self._bases = np.zeros(0)  # (6 n,) its rods' base velocities (:meth:`move_bases`)
+        #: Its velocities (v, w), consecutive in its block (BODY_FIELDS), if free.
+        self.velocities = slice(self.fields["v"].start, self.fields["w"].stop) if body.free else None
         self.shares = np.zeros(0)  # the base node's share of cell 0 [m] (Scheme.base_share ds)
         self.strains = np.zeros((0, 6), dtype=np.int64)  # state indices of (q, k) of each rod's cell 0
         self.joints = []  # its penalty joints (JointPart)
@@ -71,9 +78,15 @@ class BodyPart:
         self.rods.append(name)
         self.systems.append(sd)
         self.works.append(sd.kernel_arguments()[-1])
+        self.stress_rows.append(self.works[-1][0, WORK_TOTAL:WORK_TOTAL + 6])
         self.points = np.vstack([self.points, point])
         self.turns = np.concatenate([self.turns, np.asarray(turn, dtype=float)[None]])
         self.flat_turns = np.ascontiguousarray(self.turns.reshape(-1, 9))  # row-major, for the kernel
+        self.velocity_map = clamp_map(self.points, self.turns)
+        # The rods' base velocities, one row each, which their systems read (one product a call).
+        self._bases = np.concatenate([self._bases, sd.base_velocities])
+        for i, system in enumerate(self.systems):
+            system.read_base_velocities_from(self._bases[6 * i:6 * i + 6])
         sl, first = sd.layout.slices(), start + sd.layout.header
         index = np.r_[first + sl["q"].start:first + sl["q"].stop, first + sl["k"].start:first + sl["k"].stop]
         self.strains = np.vstack([self.strains, index])
@@ -99,5 +112,10 @@ class BodyPart:
         self.params[NET_MOMENT:NET_MOMENT + 3] += net_mass * np.asarray(point, dtype=float)
 
     def base_velocities(self, v, w):
-        """(n, 6) base velocities of the rods for the body velocities (v, w) (:func:`clamp_velocities`)."""
-        return clamp_velocities(self.points, self.turns, v, w)
+        """(n, 6) base velocities of the rods for the body velocities (v, w) (:func:`clamp_map`)."""
+        return (self.velocity_map @ np.concatenate([v, w])).reshape(-1, 6)
+
+    def move_bases(self, y):
+        """Set its rods' base velocities (their systems' ``base_velocities``) from its
+        velocities in the state ``y`` (a free body's)."""
+        np.dot(self.velocity_map, y[self.velocities], out=self._bases)

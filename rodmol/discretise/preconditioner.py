@@ -318,6 +318,13 @@ class BlockPreconditioner:
         self.gamma = gamma
         self.setups += 1
 
+    def factor_into(self, head, fac):
+        """Keep the factors in ``head`` (HEADER, HEADER) and ``fac`` (N, N_FACTORS) from now on:
+        views of a system's rods' stacked factors, solved in one compiled call
+        (:class:`rodmol.discretise.rod_blocks.RodBlocks`)."""
+        head[:], fac[:] = self._head, self._fac
+        self._head, self._fac = head, fac
+
     @property
     def factors(self):
         """(gamma, head, fac, (y_x, y_p, h)): the last factorisation and the

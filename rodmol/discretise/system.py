@@ -119,6 +119,13 @@ class SemiDiscrete:
     def __reduce__(self):
         return SemiDiscrete, (self.model, self.scheme.name)
 
+    def read_base_velocities_from(self, row):
+        """Keep the base velocities (v0, w0) in ``row`` (6,) from now on: a view of the rows a
+        body writes for all the rods clamped to it in one product (``BodyPart.move_bases``)."""
+        row[:] = self.base_velocities
+        old, self.base_velocities = self.base_velocities, row
+        self._args = tuple(row if a is old else a for a in self._args)
+
     # ------------------------------------------------------------------ inputs
 
     def _setup_cables(self, s_cells):

@@ -44,11 +44,9 @@ complement (:mod:`rodmol.discretise.rod_joint_coupling`).
 import numpy as np
 
 from .body_part import first_element
-from .jacobian import read_only
 from .joints import JOINT_COLUMNS, JOINT_ROWS, block_entries
-from .physics import jit
-from .preconditioner import block_solve
 from .rigid import FREE_BODY
+from .rod_blocks import RodBlocks
 from .rod_joint_coupling import RodJointCoupling
 
 #: What a body reads of a rod clamped to it, within the rod's first element block: the stress of
@@ -57,13 +55,6 @@ CLAMP_COLUMNS = block_entries("q", "k", "v", "w")
 
 #: Relative step of the body blocks' differences, times each entry's scale.
 BODY_STEP = 1e-7
-
-
-@jit
-def _solve_rows(gamma, head, fac, rhs, out, y_x, y_p, h):
-    """out[j] = (I - gamma J)^-1 rhs[j] for each row j, with a rod's factors (:func:`block_solve`)."""
-    for j in range(rhs.shape[0]):
-        block_solve(gamma, head, fac, rhs[j], out[j], y_x, y_p, h)
 
 
 class Link:
@@ -120,11 +111,31 @@ class SystemPreconditioner:
         size = FREE_BODY.size * len(self.coupled)
         self._schur = np.eye(size)
         # Per linked rod, N_rr^-1 N_rb (its columns: S's); all links' rod entries and N_br over them.
-        linked = dict.fromkeys(link.rod for p in self.coupled for link in self.links[p.name])
-        self._solved = {rod: np.zeros((assembly.rods[rod].size, size)) for rod in linked}
+        # All of them rows of one matrix (one product per solve, not one per rod).
+        linked = list(dict.fromkeys(link.rod for p in self.coupled for link in self.links[p.name]))
+        self._solved_rows = np.concatenate([np.arange(assembly.parts[rod].start, assembly.parts[rod].stop)
+                                            for rod in linked] or [np.zeros(0, dtype=int)])
+        self._all_solved = np.zeros((len(self._solved_rows), size))
+        if len(self._solved_rows) and np.all(np.diff(self._solved_rows) == 1):  # a slice costs 3 us less
+            self._solved_rows = slice(int(self._solved_rows[0]), int(self._solved_rows[-1]) + 1)
+        self._where_solved, first = {}, 0  # each linked rod's first row of _all_solved
+        for rod in linked:
+            self._where_solved[rod] = first
+            first += assembly.rods[rod].size
         self._reads = np.concatenate([link.columns for p in self.coupled for link in self.links[p.name]]
                                      or [np.zeros(0, dtype=int)])
+        where = np.full(assembly.size, -1)
+        where[self._solved_rows] = np.arange(len(self._all_solved))
+        self._reads_solved = where[self._reads]  # each read entry's row of _all_solved
         self._n_br = np.zeros((size, len(self._reads)))
+        self._body_rows = np.concatenate([np.arange(p.slice.start, p.slice.stop) for p in self.coupled]
+                                         or [np.zeros(0, dtype=int)])  # S's rows, state indices
+        self._n_br_jac = np.zeros_like(self._n_br)  # N_br / -gamma
+        self._s_jac = np.zeros((size, size))  # (I - S) / gamma before the rods' part
+        # Per rod size and count of body entries moving a rod: (the rods, their rows and columns
+        # of _all_solved, N_rb / -gamma in those entries); after each Jacobian (_moved).
+        self._couplings = []
+        self.rod_blocks = RodBlocks(self.rods, assembly.parts)  # the rods' blocks, solved together
         self.rod_joints = RodJointCoupling(assembly, BODY_STEP * np.maximum(scale, 1e-300), JOINT_ROWS)
         self.jac_evals = self.setups = self.solves = 0
 
@@ -166,10 +177,10 @@ class SystemPreconditioner:
             assembly(t, y, self._out)  # leave the rods as at y
             if self.rod_joints.sides:
                 self.rod_joints.evaluate(t, y, fy)
+            self._moved()
             self.jac_evals += 1
             jnew[0] = 1
-        for prec in self.rods.values():
-            prec.factor(gamma)
+        self.rod_blocks.factor(gamma)
         for part in self.bodies:
             if part not in self.coupled:
                 self._inverse[part.name] = np.linalg.inv(np.eye(part.layout.size) - gamma * self._jac[part.name])
@@ -197,42 +208,47 @@ class SystemPreconditioner:
 
     def _factor_schur(self, gamma):
         """S = N_bb - N_br N_rr^-1 N_rb over the coupled bodies, inverted; N_rr^-1 N_rb and N_br kept."""
-        schur, size = np.zeros_like(self._schur), FREE_BODY.size
+        self._n_br = -gamma * self._n_br_jac
+        for names, rows, columns, coupling in self._couplings:
+            self._all_solved[rows, columns] = self.rod_blocks.solve_rows(names, gamma * coupling).transpose(0, 2, 1)
+        # every body linked to a rod reads N_rr^-1 N_rb at its links' columns
+        schur = np.eye(len(self._schur)) - gamma * self._s_jac - self._n_br @ self._all_solved[self._reads_solved]
+        self._schur = np.linalg.inv(schur)
+
+    def _moved(self):
+        """After a Jacobian: its parts of S and N_br over -gamma, and per coupled body and rod the
+        body entries that move the rod (a clamp's: its velocities) with N_rb / -gamma in them,
+        stacked by rod size and count (one compiled call of rod solves each at a factorisation)."""
+        size = FREE_BODY.size
+        self._s_jac[:] = 0.0
+        self._n_br_jac[:] = 0.0
         column = 0
         for part in self.coupled:
             o = self._offset[part.name]
-            schur[o:o + size, o:o + size] = np.eye(size) - gamma * self._jac[part.name]
+            self._s_jac[o:o + size, o:o + size] = self._jac[part.name]
             for link in self.links[part.name]:
-                self._n_br[:, column:column + len(link.columns)] = 0.0
-                self._n_br[o:o + size, column:column + len(link.columns)] = -gamma * link.from_rod
+                self._n_br_jac[o:o + size, column:column + len(link.columns)] = link.from_rod
                 column += len(link.columns)
         for (name, other), block in self._pairs.items():  # the body joints' coupling of two free bodies
             o, oo = self._offset[name], self._offset[other]
-            schur[oo:oo + size, o:o + size] -= gamma * block
-        for solved in self._solved.values():
-            solved[:] = 0.0
+            self._s_jac[oo:oo + size, o:o + size] += block
+        self._all_solved[:] = 0.0  # the columns no body entry moves stay zero
+        stacks = {}
         for part in self.coupled:
-            o = self._offset[part.name]
             by_rod = {}
             for link in self.links[part.name]:
                 by_rod.setdefault(link.rod, []).append(link)
             for rod, rod_links in by_rod.items():
-                # The body entries that move the rod (a clamp's: its velocities), one rod solve each.
                 moving = np.flatnonzero(np.any([link.to_body.any(axis=0) for link in rod_links], axis=0))
-                start = self.assembly.parts[rod].start
-                rhs = np.zeros((len(moving), self.assembly.rods[rod].size))
+                start, n = self.assembly.parts[rod].start, self.assembly.rods[rod].size
+                coupling = np.zeros((len(moving), n))
                 for link in rod_links:
-                    rhs[:, link.rows - start] -= gamma * link.to_body[:, moving].T
-                out = np.empty_like(rhs)
-                g, head, fac, scratch = self.rods[rod].factors
-                _solve_rows(g, head, fac, rhs, out, *scratch)
-                self._solved[rod][:, o + moving] = out.T
-        reads = self._reads  # every body linked to a rod reads N_rr^-1 N_rb at its links' columns
-        for rod, solved in self._solved.items():
-            sl = self.assembly.parts[rod]
-            inside = (reads >= sl.start) & (reads < sl.stop)
-            schur -= self._n_br[:, inside] @ solved[reads[inside] - sl.start]
-        self._schur = np.linalg.inv(schur)
+                    coupling[:, link.rows - start] -= link.to_body[:, moving].T
+                rows = self._where_solved[rod] + np.arange(n)
+                stacks.setdefault((n, len(moving)), []).append((rod, rows, self._offset[part.name] + moving, coupling))
+        self._couplings = [([s[0] for s in stack], np.array([s[1] for s in stack])[:, :, None],
+                            np.array([s[2] for s in stack])[:, None, :], np.array([s[3] for s in stack]))
+                           for stack in stacks.values()]
 
     def solve(self, t, y, fy, r, z, gamma, delta, lr):
         """z = P^-1 r with the last factors."""
@@ -243,19 +259,11 @@ class SystemPreconditioner:
 
     def _solve_blocks(self, r, z):
         """z = P^-1 r without the rod-rod joints' coupling: the rods', the bodies' blocks and S."""
-        parts = self.assembly.parts
-        for name, prec in self.rods.items():
-            sl = parts[name]
-            g, head, fac, scratch = prec.factors
-            block_solve(g, head, fac, read_only(r[sl]), z[sl], *scratch)
+        self.rod_blocks.solve(r, z)
         for part in self.bodies:
             if part not in self.coupled:
                 z[part.slice] = self._inverse[part.name] @ r[part.slice]
         if self.coupled:
-            rhs = np.concatenate([r[part.slice] for part in self.coupled]) - self._n_br @ z[self._reads]
-            z_b = self._schur @ rhs
-            for part in self.coupled:
-                o = self._offset[part.name]
-                z[part.slice] = z_b[o:o + FREE_BODY.size]
-            for rod, solved in self._solved.items():
-                z[parts[rod]] -= solved @ z_b
+            z_b = self._schur @ (r[self._body_rows] - self._n_br @ z[self._reads])
+            z[self._body_rows] = z_b
+            z[self._solved_rows] -= self._all_solved @ z_b

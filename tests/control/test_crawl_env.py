@@ -65,7 +65,7 @@ def test_same_seed_same_trajectory_and_reward_as_documented(env):
 @pytest.mark.parametrize("option, value", [
     ("n_elements", 1), ("n_elements", 2.5), ("period", 0.0), ("period", float("nan")), ("episode_steps", 0),
     ("max_tension", -1.0), ("max_tension", float("inf")), ("effort_weight", -1.0), ("settle", 0.0),
-    ("record", 3), ("record", " "), ("overwrite", "yes"),
+    ("record", 3), ("record", " "), ("overwrite", "yes"), ("rtol", 0.0), ("rtol", 1.0),
 ])
 def test_every_option_is_checked_at_construction_naming_it(monkeypatch, option, value):
     def no_work(*args, **kwargs):
@@ -154,3 +154,16 @@ def test_vectorised_in_parallel_processes():
         assert np.all(np.isfinite(reward)) and truncated.all()
     finally:
         vec.close()
+
+
+def test_rtol_is_the_episodes_tolerance():
+    """The env's rtol reaches the integrator (a tighter one changes the trajectory, by less than
+    the looser one's error) and not the settled start state (the same for both)."""
+    traces = {}
+    for rtol in (crawl.RTOL, 1e-7):
+        made = crawl.OctopusCrawlEnv(rtol=rtol, **SMALL)
+        traces[rtol], _, _ = rollout(made, seed=5)
+    loose, tight = traces[crawl.RTOL], traces[1e-7]
+    np.testing.assert_array_equal(loose[0], tight[0])
+    assert not np.array_equal(loose[-1][:3], tight[-1][:3])
+    np.testing.assert_allclose(loose[-1][:3], tight[-1][:3], rtol=0.0, atol=1e-5)
