@@ -141,7 +141,7 @@ class OctopusCrawlEnv(gymnasium.Env):
             raise ParameterError(f"`options` {_checks.short(options)}: {type(self).__name__}.reset "
                                  "takes none (None or {})")
         super().reset(seed=seed)
-        self.sim = self._recording.next_episode(self.sim, self._start, self.system, self._y0)
+        self.sim = self._recording.next_episode(self.sim, self._start, self.system, self._y0, rtol=self.rtol)
         self._steps, self._ended = 0, None
         return self._observation(self.sim.state), {}
 

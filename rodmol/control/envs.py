@@ -284,14 +284,15 @@ class Recording:
             with contextlib.suppress(OSError):  # holds files not rodmol's
                 folder.rmdir()
 
-    def next_episode(self, sim, start, model, initial):
+    def next_episode(self, sim, start, model, initial, **options):
         """The simulator of the next episode: ``sim`` reset to its copy ``start`` or, recording,
         ``sim`` closed and a new Simulator of ``model`` (sim's) from the state ``initial`` (at
-        t = 0, as ``start``) streaming into the next episode's folder."""
+        t = 0, as ``start``) with the Simulator's ``options`` (sim's, e.g. ``rtol``)
+        streaming into the next episode's folder."""
         if self.record is None:
             sim.reset(start)
             return sim
         sim.close()
         self.episodes += 1
         return Simulator(model, initial=initial, out=self.record / f"episode_{self.episodes:04d}",
-                         overwrite=self.overwrite)
+                         overwrite=self.overwrite, **options)
