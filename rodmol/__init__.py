@@ -33,6 +33,7 @@ from .calibrate import (
     worsened_models,
 )
 from .contacts import Contact
+from .rod_contacts import RodContact
 from .control import Simulator, StaticFit, SystemFit, inverse_statics, inverse_statics_path
 from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
@@ -70,7 +71,7 @@ from .systems import Joint, System
 __all__ = [
     "BACKENDS", "Base", "BaseMotion", "Cable", "CapsuleContact", "Contact", "DistributedForce",
     "DistributedMoment", "Hold", "PlaneContact", "PointForce", "PointMoment", "SphereContact", "EquilibriumError", "IntegrationError", "MEDIA",
-    "Joint", "Marker", "Material", "Medium", "Model", "NotSupportedYet", "RigidBody", "System", "ParameterError", "Result", "Rod", "RodmolError",
+    "Joint", "Marker", "RodContact", "Material", "Medium", "Model", "NotSupportedYet", "RigidBody", "System", "ParameterError", "Result", "Rod", "RodmolError",
     "SCHEMES", "ScenarioError", "SemiDiscrete", "Simulator", "StateLayout", "StateView", "UserFunctionError",
     "default_atol", "energy",
     "equilibrium", "load_result", "load_scenario", "marker_errors", "oscillation_period", "paper_arm",

@@ -66,6 +66,7 @@ from .contact_parts import contact_parts
 from .joints import JointPart, RecordedJoints, RodJointPart
 from .physics import quaternion_rate
 from .protocol import pattern_bandwidths
+from .rod_contact import RodPairs
 from .rigid import clamp_wrench, free_body_rates
 from .rod_scales import field_scales
 from .rotations import from_matrix, matrices
@@ -133,6 +134,7 @@ class Assembly:
             for part in joint.parts:
                 part.body_joints.append(joint)
         self.free = [p for p in self.bodies.values() if p.body.free]
+        self.rod_pairs = RodPairs(self) if system.rod_pairs else None
         self.lightly_damped = any(sd.lightly_damped for sd in self.rods.values())
         self.scan_arguments = None  # the step check's compiled scan arguments, made at its first call
         self._gravity = np.ascontiguousarray(system.gravity, dtype=float)
@@ -260,6 +262,8 @@ class Assembly:
         self.add_body_joints(t, y, reactions)
         for joint in self.rod_joints:
             joint.wrench(y, joint.row, joint.value)
+        if self.rod_pairs is not None:  # after the base velocities: the base nodes' move
+            self.rod_pairs.apply(y)
         for name, sd in self.rods.items():
             sl = self.parts[name]
             sd(t, y[sl], out[sl])

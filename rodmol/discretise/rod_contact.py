@@ -1,0 +1,147 @@
+"""Contact between rods of a system (:class:`rodmol.RodContact`), as the
+assembly evaluates it (:mod:`rodmol.discretise.rod_contact_law` holds the
+compiled law).
+
+Every rod of a rod contact carries one load, a global force density at
+each of its velocity nodes (``rodmol.rod_contacts.LOAD_NAME``, added by the
+System): before each right-hand side :meth:`RodPairs.apply` gathers the
+rods' centrelines and velocities, finds the candidate segment pairs of each
+contact (sort and sweep of their boxes, at every call: the pairs come and
+go without a step missing one) and writes each node's contact force over
+its node length into that load's value. A share on a rod's base node goes
+into the base's support, as a point load's does. The rod's Result then
+records the contact forces as part of its external force.
+"""
+
+import numpy as np
+
+from ..rod_contacts import LOAD_NAME
+from .layout import QUAT, U, V
+from .load_entries import count
+from .physics import jit, rotation, to_global
+from .rod_contact_law import ACTIVE, ENERGY, LEAST_GAP, boxes, pair_forces, sweep
+
+#: Sample spacing along a segment, as a fraction of the two rods' summed radii: a
+#: crossing between samples sinks at most spacing^2 / (8 (r_a + r_b)) deeper, 1/128 of r_a + r_b.
+SAMPLE_SPACING = 0.25
+
+
+@jit
+def gather(y, start, header, block, n_blocks, base_velocity, pos, vel, first):
+    """Write the centreline nodes 0..n_blocks of the rod whose state starts at
+    ``y[start]`` into ``pos``, their velocities (global) into ``vel``, from row
+    ``first`` on; node 0 is the base, moving with ``base_velocity`` (its local frame)."""
+    r = rotation((y[start + 3], y[start + 4], y[start + 5], y[start + 6]))
+    v = to_global(r, (base_velocity[0], base_velocity[1], base_velocity[2]))
+    for x in range(3):
+        pos[first, x], vel[first, x] = y[start + x], v[x]
+    for i in range(n_blocks):
+        b = start + header + block * i
+        r = rotation((y[b + QUAT], y[b + QUAT + 1], y[b + QUAT + 2], y[b + QUAT + 3]))
+        v = to_global(r, (y[b + V], y[b + V + 1], y[b + V + 2]))
+        for x in range(3):
+            pos[first + 1 + i, x], vel[first + 1 + i, x] = y[b + U + x], v[x]
+
+
+class _Rod:
+    """A rod of the rod contacts: its system ``sd``, where its state starts,
+    its first row in the node arrays and the entries of its contact load."""
+
+    def __init__(self, name, sd, start, first):
+        model = sd.model
+        load = next(k for k, item in enumerate(model.loads) if getattr(item, "name", None) == LOAD_NAME)
+        entry = sum(count(item, model.s_nodes) for item in model.loads[:load])
+        self.name, self.sd, self.start, self.first = name, sd, start, first
+        self.n = sd.layout.n_blocks
+        self.entries = slice(entry, entry + self.n)
+        self.rmax = float(np.max(model.rod.radius_at(model.s_nodes)))
+
+
+class RodPairs:
+    """The rod contacts of ``assembly``'s system (``System.rod_pairs``).
+
+    Attributes
+    ----------
+    force : (nodes, 3)
+        The last call's contact force [N] on each node, global (the rods' nodes 0..N in turn).
+    stats : (3,)
+        The last call's elastic energy [J], least surface gap [m] (inf if no
+        pair was within reach) and number of touching segment pairs.
+    """
+
+    def __init__(self, assembly):
+        system = assembly.system
+        names = list(dict.fromkeys(name for _, c in system.rod_pairs for name in c.rods))
+        self.rods, first = {}, 0
+        for name in names:
+            self.rods[name] = _Rod(name, assembly.rods[name], assembly.parts[name].start, first)
+            first += self.rods[name].n + 1
+        self.pos, self.vel, self.force = np.zeros((first, 3)), np.zeros((first, 3)), np.zeros((first, 3))
+        self.radius, self.arc, self.rest = np.zeros(first), np.zeros(first), np.zeros(first)
+        for rod in self.rods.values():
+            model, nodes = rod.sd.model, slice(rod.first, rod.first + rod.n + 1)
+            self.radius[nodes] = model.rod.radius_at(model.s_nodes)
+            self.arc[nodes] = model.s_nodes
+            self.rest[rod.first:rod.first + rod.n] = np.diff(model.s_nodes)
+        self.pairs = []
+        for _, contact in system.rod_pairs:
+            a, b = self.rods[contact.a], self.rods[contact.b]
+            law = np.array(contact.law(a.sd.model, b.sd.model))
+            spacing = SAMPLE_SPACING * (a.rmax + b.rmax)
+            samples = [max(1, int(np.ceil(float(np.max(r.sd.model.ds)) / spacing))) for r in (a, b)]
+            self.pairs.append(dict(a=a, b=b, law=law, same=a is b, cutoff=np.pi * max(a.rmax, b.rmax),
+                                   samples=samples, box_a=np.zeros((a.n, 6)), box_b=np.zeros((b.n, 6)),
+                                   candidates=np.zeros((4 * (a.n + b.n), 2), dtype=np.int64)))
+        self.stats = np.array([0.0, np.inf, 0.0])
+
+    def gather(self, y):
+        """Read every rod's centreline and velocities from the state ``y``."""
+        for rod in self.rods.values():
+            lay = rod.sd.layout
+            gather(y, rod.start, lay.header, lay.block, rod.n, rod.sd.base_velocities, self.pos, self.vel, rod.first)
+
+    def evaluate(self, y, margin=0.0):
+        """The contact forces (:attr:`force`) and :attr:`stats` at the state ``y``;
+        pairs within ``margin`` [m] of touching count toward the least gap."""
+        self.gather(y)
+        self.force[:] = 0.0
+        self.stats[:] = (0.0, np.inf, 0.0)
+        for p in self.pairs:
+            a, b = p["a"], p["b"]
+            boxes(self.pos, a.first, a.n, a.rmax + 0.5 * margin, p["box_a"])
+            boxes(self.pos, b.first, b.n, b.rmax + 0.5 * margin, p["box_b"])
+            found = sweep(p["box_a"], p["box_b"], p["same"], p["candidates"])
+            if found < 0:  # grow the buffer and sweep again
+                p["candidates"] = np.zeros((2 * -found, 2), dtype=np.int64)
+                found = sweep(p["box_a"], p["box_b"], p["same"], p["candidates"])
+            pair_forces(self.pos, self.vel, self.radius, self.arc, self.rest, self.force, p["candidates"], found,
+                        a.first, a.n, b.first, b.n, p["samples"][0], p["samples"][1], p["same"], p["law"],
+                        p["cutoff"], self.stats)
+        return self.force
+
+    def apply(self, y):
+        """Write every rod's contact force densities at the state ``y`` into its contact load's values."""
+        self.evaluate(y)
+        for rod in self.rods.values():
+            rod.sd.entry_values[rod.entries] = (self.force[rod.first + 1:rod.first + rod.n + 1]
+                                                / rod.sd.node_lengths[:, None])
+
+    def node_forces(self, name):
+        """Rod ``name``'s nodes' contact forces [N], global, (N + 1, 3), of the last evaluation (zeros if
+        the rod is in no rod contact)."""
+        rod = self.rods.get(name)
+        if rod is None:
+            return None
+        return self.force[rod.first:rod.first + rod.n + 1].copy()
+
+    @property
+    def energy(self):
+        return float(self.stats[ENERGY])
+
+    @property
+    def least_gap(self):
+        return float(self.stats[LEAST_GAP])
+
+    @property
+    def active(self):
+        return int(self.stats[ACTIVE])
