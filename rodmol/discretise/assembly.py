@@ -341,8 +341,22 @@ class Assembly:
           differences of :meth:`jacobian`, run by Python);
         * ``"dense"``: small systems and cross-checks.
 
-        No band solver: a body's rows couple entries far apart in the state."""
-        return {"gmres": "compiled", "sparse": "sundials", "dense": "sundials"}
+        No band solver: a body's rows couple entries far apart in the state. With rod
+        contacts (:class:`rodmol.RodContact`) no "sparse" either (:attr:`refused_solvers`)."""
+        return {name: jacobian for name, jacobian in
+                {"gmres": "compiled", "sparse": "sundials", "dense": "sundials"}.items()
+                if name not in self.refused_solvers}
+
+    @property
+    def refused_solvers(self):
+        """{linear solver: why this system refuses it}: with rod contacts the sparse
+        solver's pattern would leave out the coupling of nodes that come into contact
+        during the run (GMRES's products and the dense differences see it)."""
+        if self.rod_pairs is None:
+            return {}
+        return {"sparse": "its Jacobian pattern leaves out the rod contacts' coupling, which comes and "
+                          "goes with the rods' motion (`contacts` holds a rodmol.RodContact): use 'gmres' "
+                          "(default) or 'dense'"}
 
     def jacobian(self, scale, matrix="sparse"):
         """The Jacobian by coloured differences on :meth:`pattern`
