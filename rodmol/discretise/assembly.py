@@ -199,13 +199,15 @@ class Assembly:
     def recorded_rod(self, name, t, states, sd=None):
         """Rod ``name``'s system (or ``sd``, a copy of it) for rebuilding its
         Result from the frames ``states`` (n_t, size) at ``t``: if penalty
-        joints hold it to bodies, a :class:`RecordedJoints` replaying their
-        held points at the frames, else ``sd`` itself."""
+        joints hold it to bodies or it touches rods (:class:`rodmol.RodContact`),
+        a :class:`RecordedJoints` replaying their held points and contact forces
+        at the frames, else ``sd`` itself."""
         sd = self.rods[name] if sd is None else sd
         joints = [joint for joint in self.joints + self.rod_joints if joint.joint.rod == name]
-        if not joints:
+        touching = self.rod_pairs is not None and name in self.rod_pairs.rods
+        if not joints and not touching:
             return sd
-        replay = []
+        replay = self.rod_pairs.replay(name, t, states) if touching else []
         for joint in joints:
             rows, values = np.tile(joint.row, (len(t), 1)), np.zeros((len(t), 3))
             for i, (ti, yi) in enumerate(zip(t, states)):

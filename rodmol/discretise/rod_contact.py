@@ -134,6 +134,28 @@ class RodPairs:
             return None
         return self.force[rod.first:rod.first + rod.n + 1].copy()
 
+    def history(self, states):
+        """At the frames ``states`` (n_t, size): each rod's nodes' contact forces
+        {name: (n_t, N + 1, 3)} [N], global, the least surface gap (n_t,) [m]
+        (inf with no pair within the two rods' radii) and the touching segment pairs (n_t,)."""
+        forces = {name: np.zeros((len(states), rod.n + 1, 3)) for name, rod in self.rods.items()}
+        gaps, active = np.full(len(states), np.inf), np.zeros(len(states), dtype=int)
+        reach = max(rod.rmax for rod in self.rods.values())
+        for k, y in enumerate(states):
+            self.evaluate(np.ascontiguousarray(y), margin=2.0 * reach)
+            for name, rod in self.rods.items():
+                forces[name][k] = self.force[rod.first:rod.first + rod.n + 1]
+            gaps[k], active[k] = self.least_gap, self.active
+        return forces, gaps, active
+
+    def replay(self, name, t, states):
+        """Rod ``name``'s contact load entries at the frames ``states`` (n_t, size) at ``t``:
+        (entry, rows (n_t, N_PARAMS), values (n_t, 3)) each, as :class:`RecordedJoints` takes them."""
+        rod = self.rods[name]
+        forces = self.history(states)[0][name][:, 1:] / rod.sd.node_lengths[None, :, None]
+        rows = rod.sd.entry_params[rod.entries]
+        return [(rod.entries.start + i, np.tile(rows[i], (len(t), 1)), forces[:, i]) for i in range(rod.n)]
+
     @property
     def energy(self):
         return float(self.stats[ENERGY])
