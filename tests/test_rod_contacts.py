@@ -72,7 +72,6 @@ def test_a_rod_resting_across_another_carries_the_propped_cantilevers_share_at_r
     _check_resting(assembly, y)
 
 
-@pytest.mark.slow
 def test_a_rod_released_across_another_settles_where_the_statics_put_it():
     run = rodmol.simulate(_crossing(), 2.0, output_dt=0.5)  # released straight: it sags onto the support
     assert run.success
