@@ -159,12 +159,14 @@ def test_bad_rod_contacts_are_refused_naming_the_parameter(bad, key):
             {"upper": _rod(SOFT)}, contacts=[rodmol.RodContact("upper", bad["b"])])
 
 
-def test_a_pair_declared_twice_and_the_sparse_solver_are_refused():
+def test_a_pair_declared_twice_and_the_solvers_on_the_pattern_are_refused():
     twice = [rodmol.RodContact("upper", "lower"), rodmol.RodContact("lower", "upper")]
     with pytest.raises(ParameterError, match=r"contacts\[1\]"):
         _crossing().replace(contacts=twice)
     with pytest.raises(ParameterError, match="sparse.*RodContact"):
         rodmol.simulate(_crossing(), 0.01, linsolver="sparse")
+    with pytest.raises(ParameterError, match="galpha.*RodContact"):  # its Newton matrix: a sparse LU on the pattern
+        rodmol.simulate(_crossing(), 0.01, backend="galpha")
 
 
 def test_the_penalty_is_the_obstacles_law():
