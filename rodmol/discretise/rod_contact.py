@@ -14,6 +14,7 @@ records the contact forces as part of its external force.
 """
 
 import numpy as np
+from numba.typed import List
 
 from ..rod_contacts import LOAD_NAME
 from .layout import QUAT, U, V
@@ -41,6 +42,46 @@ def gather(y, start, header, block, n_blocks, base_velocity, pos, vel, first):
         v = to_global(r, (y[b + V], y[b + V + 1], y[b + V + 2]))
         for x in range(3):
             pos[first + 1 + i, x], vel[first + 1 + i, x] = y[b + U + x], v[x]
+
+
+#: The columns of :func:`contact_pass`'s rod table: where its state starts, its segments,
+#: its first node row, its state's header and block sizes, its first contact entry, its first box row.
+START, SEGMENTS, FIRST, HEADER, BLOCK, ENTRY, BOX = range(7)
+
+
+@jit
+def contact_pass(y, rods, reach, base, pos, vel, radius, arc, rest, force, pairs, laws, box, candidates, margin,
+                 stats, values, lengths, write):
+    """One evaluation of every rod contact at the state ``y``, compiled in one call:
+    gather the rods (table ``rods``, base velocities ``base`` (rods, 3)), sweep each pair of
+    ``pairs`` (rod a, rod b, samples of a, of b, self) for candidates within ``reach`` (rods,)
+    plus half ``margin`` [m] of each rod, add their forces (law rows ``laws``: k, c, mu, v_s,
+    h, cut-off) into ``force`` and ``stats``; if ``write``, each rod's nodes' forces over their
+    ``lengths`` into its load values ``values`` (from its first contact entry). Returns 0, or
+    minus the candidates a pair needs if ``candidates`` is too small (nothing written)."""
+    for r in range(rods.shape[0]):
+        gather(y, rods[r, START], rods[r, HEADER], rods[r, BLOCK], rods[r, SEGMENTS], base[r], pos, vel,
+               rods[r, FIRST])
+    force[:] = 0.0
+    stats[ENERGY], stats[LEAST_GAP], stats[ACTIVE] = 0.0, np.inf, 0.0
+    for k in range(pairs.shape[0]):
+        a, b, same = pairs[k, 0], pairs[k, 1], pairs[k, 4] == 1
+        na, nb, ba, bb = rods[a, SEGMENTS], rods[b, SEGMENTS], rods[a, BOX], rods[b, BOX]
+        boxes(pos, rods[a, FIRST], na, reach[a] + 0.5 * margin, box[ba:ba + na])
+        if not same:
+            boxes(pos, rods[b, FIRST], nb, reach[b] + 0.5 * margin, box[bb:bb + nb])
+        found = sweep(box[ba:ba + na], box[bb:bb + nb], same, candidates)
+        if found < 0:
+            return found
+        pair_forces(pos, vel, radius, arc, rest, force, candidates, found, rods[a, FIRST], na, rods[b, FIRST], nb,
+                    pairs[k, 2], pairs[k, 3], same, laws[k], laws[k, 5], stats)
+    if write:
+        for r in range(rods.shape[0]):
+            into, length, entry, first = values[r], lengths[r], rods[r, ENTRY], rods[r, FIRST]
+            for i in range(rods[r, SEGMENTS]):
+                for x in range(3):
+                    into[entry + i, x] = force[first + 1 + i, x] / length[i]
+    return 0
 
 
 class _Rod:
@@ -83,48 +124,49 @@ class RodPairs:
             self.radius[nodes] = model.rod.radius_at(model.s_nodes)
             self.arc[nodes] = model.s_nodes
             self.rest[rod.first:rod.first + rod.n] = np.diff(model.s_nodes)
-        self.pairs = []
+        self.pairs, pairs, laws = [], [], []
+        index = {name: k for k, name in enumerate(self.rods)}
         for _, contact in system.rod_pairs:
             a, b = self.rods[contact.a], self.rods[contact.b]
-            law = np.array(contact.law(a.sd.model, b.sd.model))
             spacing = SAMPLE_SPACING * (a.rmax + b.rmax)
             samples = [max(1, int(np.ceil(float(np.max(r.sd.model.ds)) / spacing))) for r in (a, b)]
-            self.pairs.append(dict(a=a, b=b, law=law, same=a is b, cutoff=np.pi * max(a.rmax, b.rmax),
-                                   samples=samples, box_a=np.zeros((a.n, 6)), box_b=np.zeros((b.n, 6)),
-                                   candidates=np.zeros((4 * (a.n + b.n), 2), dtype=np.int64)))
+            law = (*contact.law(a.sd.model, b.sd.model), np.pi * max(a.rmax, b.rmax))
+            pairs.append((index[contact.a], index[contact.b], *samples, int(a is b)))
+            laws.append(law)
+            self.pairs.append(dict(a=a, b=b, samples=samples, law=np.array(law[:5]), cutoff=law[5]))
+        self._pairs, self._laws = np.array(pairs, dtype=np.int64), np.array(laws)
+        rods = list(self.rods.values())
+        boxes_first = np.cumsum([0] + [rod.n for rod in rods])
+        self._table = np.array([(rod.start, rod.n, rod.first, rod.sd.layout.header, rod.sd.layout.block,
+                                 rod.entries.start, boxes_first[k]) for k, rod in enumerate(rods)], dtype=np.int64)
+        self._reach = np.array([rod.rmax for rod in rods])
+        self._base = np.zeros((len(rods), 3))
+        self._box = np.zeros((boxes_first[-1], 6))
+        self._candidates = np.zeros((4 * int(boxes_first[-1]), 2), dtype=np.int64)
+        self._values, self._lengths = List([rod.sd.entry_values for rod in rods]), List(
+            [np.ascontiguousarray(rod.sd.node_lengths, dtype=float) for rod in rods])
         self.stats = np.array([0.0, np.inf, 0.0])
 
-    def gather(self, y):
-        """Read every rod's centreline and velocities from the state ``y``."""
-        for rod in self.rods.values():
-            lay = rod.sd.layout
-            gather(y, rod.start, lay.header, lay.block, rod.n, rod.sd.base_velocities, self.pos, self.vel, rod.first)
+    def _pass(self, y, margin, write):
+        for k, rod in enumerate(self.rods.values()):  # the bases' velocities, as the last call set them
+            self._base[k] = rod.sd.base_velocities[:3]
+        while True:
+            found = contact_pass(y, self._table, self._reach, self._base, self.pos, self.vel, self.radius, self.arc,
+                                 self.rest, self.force, self._pairs, self._laws, self._box, self._candidates,
+                                 float(margin), self.stats, self._values, self._lengths, write)
+            if found == 0:
+                return
+            self._candidates = np.zeros((2 * -found, 2), dtype=np.int64)  # grown, and the pass again
 
     def evaluate(self, y, margin=0.0):
         """The contact forces (:attr:`force`) and :attr:`stats` at the state ``y``;
         pairs within ``margin`` [m] of touching count toward the least gap."""
-        self.gather(y)
-        self.force[:] = 0.0
-        self.stats[:] = (0.0, np.inf, 0.0)
-        for p in self.pairs:
-            a, b = p["a"], p["b"]
-            boxes(self.pos, a.first, a.n, a.rmax + 0.5 * margin, p["box_a"])
-            boxes(self.pos, b.first, b.n, b.rmax + 0.5 * margin, p["box_b"])
-            found = sweep(p["box_a"], p["box_b"], p["same"], p["candidates"])
-            if found < 0:  # grow the buffer and sweep again
-                p["candidates"] = np.zeros((2 * -found, 2), dtype=np.int64)
-                found = sweep(p["box_a"], p["box_b"], p["same"], p["candidates"])
-            pair_forces(self.pos, self.vel, self.radius, self.arc, self.rest, self.force, p["candidates"], found,
-                        a.first, a.n, b.first, b.n, p["samples"][0], p["samples"][1], p["same"], p["law"],
-                        p["cutoff"], self.stats)
+        self._pass(y, margin, False)
         return self.force
 
     def apply(self, y):
         """Write every rod's contact force densities at the state ``y`` into its contact load's values."""
-        self.evaluate(y)
-        for rod in self.rods.values():
-            rod.sd.entry_values[rod.entries] = (self.force[rod.first + 1:rod.first + rod.n + 1]
-                                                / rod.sd.node_lengths[:, None])
+        self._pass(y, 0.0, True)
 
     def node_forces(self, name):
         """Rod ``name``'s nodes' contact forces [N], global, (N + 1, 3), of the last evaluation (zeros if

@@ -56,7 +56,8 @@ def boxes(pos, first, n_segments, reach, out):
 @jit
 def sweep(box_a, box_b, same, pairs):
     """The pairs (segment of a, segment of b) whose boxes overlap, by sort and
-    sweep along the axis of largest spread; ``same``: a rod with itself (each
+    sweep along the axis of largest spread, each box tested against the other
+    rod's boxes still open there only; ``same``: a rod with itself (each
     unordered pair once, neighbours left out). Writes them into ``pairs``
     (capacity, 2) and returns their number, or minus it if ``pairs`` is too small."""
     na, nb = box_a.shape[0], box_b.shape[0]
@@ -68,20 +69,25 @@ def sweep(box_a, box_b, same, pairs):
         owner[k], index[k] = 0 if k < na else 1, g
         for i in range(3):
             lo[k, i], hi[k, i] = src[g, i], src[g, 3 + i]
-    spread = np.zeros(3)
+    axis, spread = 0, -1.0
     for i in range(3):
-        spread[i] = np.max(hi[:, i]) - np.min(lo[:, i])
-    axis = int(np.argmax(spread))
+        extent = np.max(hi[:, i]) - np.min(lo[:, i])
+        if extent > spread:
+            axis, spread = i, extent
     order = np.argsort(lo[:, axis])
+    open_boxes = np.empty((2, n), np.int64)  # each owner's boxes not yet passed
+    opened = np.zeros(2, np.int64)
     count, capacity = 0, pairs.shape[0]
     for x in range(n):
         k = order[x]
-        for z in range(x + 1, n):
-            m = order[z]
-            if lo[m, axis] > hi[k, axis]:
-                break
-            if not same and owner[k] == owner[m]:
-                continue
+        other = owner[k] if same else 1 - owner[k]
+        kept = 0
+        for z in range(opened[other]):
+            m = open_boxes[other, z]
+            if hi[m, axis] < lo[k, axis]:
+                continue  # passed: closed for every later box too
+            open_boxes[other, kept] = m
+            kept += 1
             if same and abs(index[k] - index[m]) < 2:
                 continue
             if (lo[m, 0] > hi[k, 0] or lo[k, 0] > hi[m, 0] or lo[m, 1] > hi[k, 1] or lo[k, 1] > hi[m, 1]
@@ -93,7 +99,17 @@ def sweep(box_a, box_b, same, pairs):
                     i, j = j, i
                 pairs[count, 0], pairs[count, 1] = index[i], index[j]
             count += 1
+        opened[other] = kept
+        open_boxes[owner[k], opened[owner[k]]] = k
+        opened[owner[k]] += 1
     return count if count <= capacity else -count
+
+
+@jit
+def _point(pos, node, t):
+    """The point at parameter ``t`` of segment ``node``, ``node + 1`` of ``pos`` (a 3-tuple)."""
+    return ((1.0 - t) * pos[node, 0] + t * pos[node + 1, 0], (1.0 - t) * pos[node, 1] + t * pos[node + 1, 1],
+            (1.0 - t) * pos[node, 2] + t * pos[node + 1, 2])
 
 
 @jit
@@ -129,15 +145,13 @@ def _side(pos, vel, radius, arc, rest, force, pa, na, ga, pb, nb, gb, samples, s
     ``force`` and their energy, least gap and activity to ``stats``; returns
     True if a sample touches."""
     k, c, mu, slip, h = law[0], law[1], law[2], law[3], law[4]
-    i0, i1, j0 = pa + ga, pa + ga + 1, pb + gb
+    i0, j0 = pa + ga, pb + gb
     w = rest[i0] / samples
     touched = False
-    p = np.empty(3)
     for m in range(samples):
         sigma = (m + 0.5) / samples
-        for x in range(3):
-            p[x] = (1.0 - sigma) * pos[i0, x] + sigma * pos[i1, x]
-        s_p = (1.0 - sigma) * arc[i0] + sigma * arc[i1]
+        p = _point(pos, i0, sigma)
+        s_p = (1.0 - sigma) * arc[i0] + sigma * arc[i0 + 1]
         if not _eligible(arc, pb, nb, gb, s_p, same, cutoff):
             continue
         dist, t = nearest(pos, j0, p)
@@ -145,24 +159,18 @@ def _side(pos, vel, radius, arc, rest, force, pa, na, ga, pb, nb, gb, samples, s
             continue
         if _eligible(arc, pb, nb, gb + 1, s_p, same, cutoff) and nearest(pos, j0 + 1, p)[0] < dist:
             continue
-        reach = (1.0 - sigma) * radius[i0] + sigma * radius[i1] + (1.0 - t) * radius[j0] + t * radius[j0 + 1]
+        reach = (1.0 - sigma) * radius[i0] + sigma * radius[i0 + 1] + (1.0 - t) * radius[j0] + t * radius[j0 + 1]
         depth = reach - dist
         stats[LEAST_GAP] = min(stats[LEAST_GAP], -depth)
         measure, ramp = penalty(depth, h)
         if measure <= 0.0:
             continue
-        n = np.zeros(3)
-        q = np.empty(3)
-        for x in range(3):
-            q[x] = (1.0 - t) * pos[j0, x] + t * pos[j0 + 1, x]
+        q = _point(pos, j0, t)
+        n = (0.0, 1.0, 0.0)
         if dist > 0.0:
-            for x in range(3):
-                n[x] = (p[x] - q[x]) / dist
-        else:
-            n[1] = 1.0
-        rel = np.empty(3)
-        for x in range(3):
-            rel[x] = ((1.0 - sigma) * vel[i0, x] + sigma * vel[i1, x]) - ((1.0 - t) * vel[j0, x] + t * vel[j0 + 1, x])
+            n = ((p[0] - q[0]) / dist, (p[1] - q[1]) / dist, (p[2] - q[2]) / dist)
+        vp, vq = _point(vel, i0, sigma), _point(vel, j0, t)
+        rel = (vp[0] - vq[0], vp[1] - vq[1], vp[2] - vq[2])
         vn = rel[0] * n[0] + rel[1] * n[1] + rel[2] * n[2]
         normal = 0.5 * w * (k * measure - ramp * c * vn)
         # Phi(d): the integral of P over the depth (external.contact_energy's density).
@@ -173,15 +181,12 @@ def _side(pos, vel, radius, arc, rest, force, pa, na, ga, pb, nb, gb, samples, s
         touched = True
         if normal <= 0.0:
             continue
-        vt2 = 0.0
+        vt = (rel[0] - vn * n[0], rel[1] - vn * n[1], rel[2] - vn * n[2])
+        drag = mu * normal / np.sqrt(vt[0] * vt[0] + vt[1] * vt[1] + vt[2] * vt[2] + slip * slip)
         for x in range(3):
-            rel[x] -= vn * n[x]
-            vt2 += rel[x] * rel[x]
-        drag = mu * normal / np.sqrt(vt2 + slip * slip)
-        for x in range(3):
-            f = normal * n[x] - drag * rel[x]
+            f = normal * n[x] - drag * vt[x]
             force[i0, x] += (1.0 - sigma) * f
-            force[i1, x] += sigma * f
+            force[i0 + 1, x] += sigma * f
             force[j0, x] -= (1.0 - t) * f
             force[j0 + 1, x] -= t * f
     return touched
