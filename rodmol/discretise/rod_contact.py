@@ -14,7 +14,6 @@ records the contact forces as part of its external force.
 """
 
 import numpy as np
-from numba.typed import List
 
 from ..rod_contacts import LOAD_NAME
 from .layout import QUAT, U, V
@@ -50,17 +49,17 @@ START, SEGMENTS, FIRST, HEADER, BLOCK, ENTRY, BOX = range(7)
 
 
 @jit
-def contact_pass(y, rods, reach, base, pos, vel, radius, arc, rest, force, pairs, laws, box, candidates, margin,
+def contact_pass(y, rods, reach, bases, pos, vel, radius, arc, rest, force, pairs, laws, box, candidates, margin,
                  stats, values, lengths, write):
     """One evaluation of every rod contact at the state ``y``, compiled in one call:
-    gather the rods (table ``rods``, base velocities ``base`` (rods, 3)), sweep each pair of
+    gather the rods (table ``rods``, the base velocities ``bases``, each rod's), sweep each pair of
     ``pairs`` (rod a, rod b, samples of a, of b, self) for candidates within ``reach`` (rods,)
     plus half ``margin`` [m] of each rod, add their forces (law rows ``laws``: k, c, mu, v_s,
     h, cut-off) into ``force`` and ``stats``; if ``write``, each rod's nodes' forces over their
     ``lengths`` into its load values ``values`` (from its first contact entry). Returns 0, or
     minus the candidates a pair needs if ``candidates`` is too small (nothing written)."""
     for r in range(rods.shape[0]):
-        gather(y, rods[r, START], rods[r, HEADER], rods[r, BLOCK], rods[r, SEGMENTS], base[r], pos, vel,
+        gather(y, rods[r, START], rods[r, HEADER], rods[r, BLOCK], rods[r, SEGMENTS], bases[r], pos, vel,
                rods[r, FIRST])
     force[:] = 0.0
     stats[ENERGY], stats[LEAST_GAP], stats[ACTIVE] = 0.0, np.inf, 0.0
@@ -140,18 +139,18 @@ class RodPairs:
         self._table = np.array([(rod.start, rod.n, rod.first, rod.sd.layout.header, rod.sd.layout.block,
                                  rod.entries.start, boxes_first[k]) for k, rod in enumerate(rods)], dtype=np.int64)
         self._reach = np.array([rod.rmax for rod in rods])
-        self._base = np.zeros((len(rods), 3))
+        # Tuples of the rods' own arrays: the pass reads their base velocities as the last
+        # call set them and writes their load values in place.
+        self._bases = tuple(rod.sd.base_velocities for rod in rods)
         self._box = np.zeros((boxes_first[-1], 6))
         self._candidates = np.zeros((4 * int(boxes_first[-1]), 2), dtype=np.int64)
-        self._values, self._lengths = List([rod.sd.entry_values for rod in rods]), List(
-            [np.ascontiguousarray(rod.sd.node_lengths, dtype=float) for rod in rods])
+        self._values = tuple(rod.sd.entry_values for rod in rods)
+        self._lengths = tuple(np.ascontiguousarray(rod.sd.node_lengths, dtype=float) for rod in rods)
         self.stats = np.array([0.0, np.inf, 0.0])
 
     def _pass(self, y, margin, write):
-        for k, rod in enumerate(self.rods.values()):  # the bases' velocities, as the last call set them
-            self._base[k] = rod.sd.base_velocities[:3]
         while True:
-            found = contact_pass(y, self._table, self._reach, self._base, self.pos, self.vel, self.radius, self.arc,
+            found = contact_pass(y, self._table, self._reach, self._bases, self.pos, self.vel, self.radius, self.arc,
                                  self.rest, self.force, self._pairs, self._laws, self._box, self._candidates,
                                  float(margin), self.stats, self._values, self._lengths, write)
             if found == 0:
