@@ -1,12 +1,14 @@
 """What does contact between rods cost (rodmol.RodContact)?
 
 1. A system without rod contacts is not slower than before: the two arms on
-   a free head (examples/two_arms.toml, N = 8 and 10, t_end 0.5 s) run by
+   a free head (examples/two_arms.toml, N = 8 and 10, t_end 2 s) run by
    this tree and by the tree of ``--base`` (default ``main``), each in its own
    worker process, alternately (target: ratio <= 1).
-2. With a rod contact declared but never active (the two arms' tips stay
-   apart): the same system with ``RodContact("right", "left")`` and with
-   ``RodContact("right", "right")`` (self-contact) against none (target <= 1.2x).
+2. With a rod contact declared but never active (the arms stay apart): the
+   two arms with ``RodContact("right", "left")`` and with
+   ``RodContact("right", "right")`` (self-contact), and solvers/octopus.py's
+   eight arms (N = 30, pulsing, 1 s) with each arm declared in contact with
+   its neighbour, against none (target <= 1.2x).
 3. A rod resting across another (tests/test_rod_contacts.py's crossing, N =
    12 and 48 per rod, released straight from rest to t_end): wall time,
    steps, right-hand sides, CVODE's linear iterations per nonlinear one (the
@@ -72,12 +74,20 @@ def before_after(args, t_end, base):
     return rows
 
 
-def declared(args, t_end):
-    base = rodmol.load_scenario(TWO_ARMS).model
-    cases = {"none": [], "right-left": [rodmol.RodContact("right", "left")],
-             "right-right (self)": [rodmol.RodContact("right", "right")]}
+def declared(args, t_end, octopus_n, octopus_t):
+    import octopus as O
+
+    two = rodmol.load_scenario(TWO_ARMS).model
+    eight = O.octopus(octopus_n, O.pulsing)
+    neighbours = [rodmol.RodContact(f"arm{i + 1}", f"arm{(i + 1) % O.ARMS + 1}") for i in range(O.ARMS)]
+    cases = {"two arms: none": (two, [], t_end), "two arms: right-left": (two, [rodmol.RodContact("right", "left")], t_end),
+             "two arms: right-right (self)": (two, [rodmol.RodContact("right", "right")], t_end),
+             f"octopus N={octopus_n}: none": (eight, [], octopus_t),
+             f"octopus N={octopus_n}: each arm with its neighbours": (eight, neighbours, octopus_t)}
     rows, first = [], None
-    for name, contacts in cases.items():
+    for name, (base, contacts, t_end) in cases.items():
+        if contacts == []:
+            first = None
         system = base.replace(contacts=list(base.contacts) + contacts)
         rodmol.simulate(system, 0.002)
         walls, cpus = [], []
@@ -86,7 +96,7 @@ def declared(args, t_end):
             run = rodmol.simulate(system, t_end, output_dt=0.05)
             walls.append(time.perf_counter() - wall)
             cpus.append(time.process_time() - cpu)
-        row = dict(case=f"two arms, declared: {name}", wall_s=float(np.median(walls)), cpu_s=float(np.median(cpus)),
+        row = dict(case=f"declared, {name}", wall_s=float(np.median(walls)), cpu_s=float(np.median(cpus)),
                    steps=run.stats["steps"], success=run.success,
                    least_gap_mm=1e3 * run.stats.get("rod_contact_least_gap", np.inf),
                    pairs=run.stats.get("rod_contact_pairs", 0))
@@ -156,10 +166,10 @@ def main(argv=None):
     base = next((a.split("=", 1)[1] for a in argv if a.startswith("--base=")), "main")
     args = C.parse_args(__doc__.splitlines()[0], [a for a in argv if not a.startswith("--base=")])
     header = C.header_lines(args, SCRIPT)
-    t_end = C.pick(args, 0.5, 0.2, 0.05)
+    t_end = C.pick(args, 2.0, 0.5, 0.05)
     first = before_after(args, t_end, base)
     print(first, flush=True)
-    second = declared(args, t_end)
+    second = declared(args, t_end, C.pick(args, 30, 30, 8), C.pick(args, 1.0, 0.3, 0.05))
     print(second, flush=True)
     third = resting(args, C.pick(args, [12, 48], [12, 24], [12]), C.pick(args, 1.0, 0.5, 0.1), C.pick(args, 2000, 500, 20))
     fmt = {"wall_s": ".3g", "cpu_s": ".3g", "ratio": ".3f", "prec_solves_per_step": ".2f", "rhs_us": ".0f",

@@ -174,3 +174,15 @@ def test_the_penalty_is_the_obstacles_law():
     h = 1e-4
     assert penalty(0.5 * h, h)[0] == pytest.approx(0.125 * h)
     assert penalty(2 * h, h)[0] == pytest.approx(1.5 * h)
+
+
+def test_a_streamed_run_records_the_rod_contacts_and_reads_them_back(tmp_path):
+    system = _crossing()
+    run = rodmol.simulate(system, 0.2, output_dt=0.1, out=tmp_path / "run")
+    back = rodmol.load_result(tmp_path / "run")
+    for key in ("rod_contact_least_gap", "rod_contact_pairs"):
+        assert back.stats[key] == run.stats[key]
+    assert run.stats["rod_contact_pairs"] >= 1
+    forces, _, _ = run.rod_contacts()
+    recorded = np.einsum("tni,n->ti", back["upper"].external_force, back["upper"].node_length)
+    np.testing.assert_allclose(recorded, forces["upper"][:, 1:].sum(axis=1), rtol=0, atol=1e-6)
