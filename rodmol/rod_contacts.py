@@ -19,7 +19,7 @@ from . import _checks
 from .errors import ParameterError
 from .loads import SMOOTHING_FRACTION
 
-#: The name of the load through which a rod feels its rod contacts (a global force density at every node).
+#: The name of the load through which a rod feels its rod contacts (a follower force density at every node).
 LOAD_NAME = "rod contacts"
 
 

@@ -129,7 +129,7 @@ class System:
         check_rods(self.contacts, self.rods)
         self.rod_pairs = [(i, c) for i, c in enumerate(self.contacts) if isinstance(c, RodContact)]
         touching = {name for _, c in self.rod_pairs for name in c.rods}
-        self.rods = {name: m.replace(loads=tuple(m.loads) + (DistributedForce((0.0, 0.0, 0.0), name=LOAD_NAME),))
+        self.rods = {name: m.replace(loads=tuple(m.loads) + (DistributedForce((0.0, 0.0, 0.0), "local", LOAD_NAME),))
                      if name in touching else m for name, m in self.rods.items()}
 
     def replace(self, *, rods=None, bodies=None, **changes):

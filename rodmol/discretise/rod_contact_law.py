@@ -54,54 +54,49 @@ def boxes(pos, first, n_segments, reach, out):
 
 
 @jit
-def sweep(box_a, box_b, same, pairs):
-    """The pairs (segment of a, segment of b) whose boxes overlap, by sort and
-    sweep along the axis of largest spread, each box tested against the other
-    rod's boxes still open there only; ``same``: a rod with itself (each
-    unordered pair once, neighbours left out). Writes them into ``pairs``
-    (capacity, 2) and returns their number, or minus it if ``pairs`` is too small."""
-    na, nb = box_a.shape[0], box_b.shape[0]
-    n = na if same else na + nb
-    lo, hi = np.empty((n, 3)), np.empty((n, 3))
-    owner, index = np.empty(n, np.int64), np.empty(n, np.int64)
-    for k in range(n):
-        src, g = (box_a, k) if k < na else (box_b, k - na)
-        owner[k], index[k] = 0 if k < na else 1, g
-        for i in range(3):
-            lo[k, i], hi[k, i] = src[g, i], src[g, 3 + i]
+def sweep(box, owner, index, contact_of, contact_rods, candidates):
+    """The candidate segment pairs of every contact: the boxes ``box`` (n, 6) of
+    every rod's segments (rod ``owner``, segment ``index``, each (n,)) that
+    overlap, of two rods in contact (``contact_of`` (rods, rods): the contact's
+    number, -1 for none; ``contact_rods`` (contacts, 2): its rods a and b), by
+    sort and sweep along the axis of largest spread, each box tested against
+    the boxes still open there only; a rod with itself: each unordered pair
+    once, neighbours left out. Writes (contact, segment of a, segment of b)
+    into ``candidates`` (capacity, 3) and returns their number, or minus it if
+    ``candidates`` is too small."""
+    n = box.shape[0]
     axis, spread = 0, -1.0
     for i in range(3):
-        extent = np.max(hi[:, i]) - np.min(lo[:, i])
+        extent = np.max(box[:, 3 + i]) - np.min(box[:, i])
         if extent > spread:
             axis, spread = i, extent
-    order = np.argsort(lo[:, axis])
-    open_boxes = np.empty((2, n), np.int64)  # each owner's boxes not yet passed
-    opened = np.zeros(2, np.int64)
-    count, capacity = 0, pairs.shape[0]
+    order = np.argsort(box[:, axis])
+    open_boxes = np.empty(n, np.int64)  # the boxes not yet passed
+    opened, count, capacity = 0, 0, candidates.shape[0]
     for x in range(n):
         k = order[x]
-        other = owner[k] if same else 1 - owner[k]
         kept = 0
-        for z in range(opened[other]):
-            m = open_boxes[other, z]
-            if hi[m, axis] < lo[k, axis]:
+        for z in range(opened):
+            m = open_boxes[z]
+            if box[m, 3 + axis] < box[k, axis]:
                 continue  # passed: closed for every later box too
-            open_boxes[other, kept] = m
+            open_boxes[kept] = m
             kept += 1
-            if same and abs(index[k] - index[m]) < 2:
+            c = contact_of[owner[k], owner[m]]
+            if c < 0 or (owner[k] == owner[m] and abs(index[k] - index[m]) < 2):
                 continue
-            if (lo[m, 0] > hi[k, 0] or lo[k, 0] > hi[m, 0] or lo[m, 1] > hi[k, 1] or lo[k, 1] > hi[m, 1]
-                    or lo[m, 2] > hi[k, 2] or lo[k, 2] > hi[m, 2]):
+            if (box[m, 0] > box[k, 3] or box[k, 0] > box[m, 3] or box[m, 1] > box[k, 4] or box[k, 1] > box[m, 4]
+                    or box[m, 2] > box[k, 5] or box[k, 2] > box[m, 5]):
                 continue
+            i, j = (k, m) if owner[k] == contact_rods[c, 0] else (m, k)
+            if owner[k] == owner[m] and index[i] > index[j]:
+                i, j = j, i
             if count < capacity:
-                i, j = (k, m) if owner[k] == 0 else (m, k)
-                if same and index[i] > index[j]:
-                    i, j = j, i
-                pairs[count, 0], pairs[count, 1] = index[i], index[j]
+                candidates[count, 0], candidates[count, 1], candidates[count, 2] = c, index[i], index[j]
             count += 1
-        opened[other] = kept
-        open_boxes[owner[k], opened[owner[k]]] = k
-        opened[owner[k]] += 1
+        opened = kept
+        open_boxes[opened] = k
+        opened += 1
     return count if count <= capacity else -count
 
 
@@ -193,17 +188,22 @@ def _side(pos, vel, radius, arc, rest, force, pa, na, ga, pb, nb, gb, samples, s
 
 
 @jit
-def pair_forces(pos, vel, radius, arc, rest, force, pairs, count, pa, na, pb, nb, samples_a, samples_b, same,
-                law, cutoff, stats):
+def candidate_forces(pos, vel, radius, arc, rest, force, candidates, count, first, segments, contact_rods, samples,
+                     laws, stats):
     """Add to ``force`` (nodes, 3) [N], global, the contact forces of the
-    candidate segment pairs ``pairs[:count]`` of rods a and b (nodes from
-    ``pa``, ``pb``; ``na``, ``nb`` segments, sampled ``samples_a``,
-    ``samples_b`` times each), law (k, c, mu, v_s, h); ``stats`` (3,):
-    energy, least gap and active pairs (added to, the gap lowered)."""
+    candidates ``candidates[:count]`` (contact, segment of a, segment of b):
+    rod r's nodes from ``first[r]``, ``segments[r]`` segments; contact c
+    between rods ``contact_rods[c]``, sampled ``samples[c]`` (of a, of b)
+    times a segment, law ``laws[c]`` (k, c, mu, v_s, h, self-contact
+    cut-off); ``stats`` (3,): energy, least gap and touching pairs (added
+    to, the gap lowered)."""
     for x in range(count):
-        ga, gb = pairs[x, 0], pairs[x, 1]
-        one = _side(pos, vel, radius, arc, rest, force, pa, na, ga, pb, nb, gb, samples_a, same, law, cutoff, stats)
-        other = _side(pos, vel, radius, arc, rest, force, pb, nb, gb, pa, na, ga, samples_b, same, law, cutoff,
-                      stats)
+        c, ga, gb = candidates[x, 0], candidates[x, 1], candidates[x, 2]
+        a, b = contact_rods[c, 0], contact_rods[c, 1]
+        same, law = a == b, laws[c]
+        one = _side(pos, vel, radius, arc, rest, force, first[a], segments[a], ga, first[b], segments[b], gb,
+                    samples[c, 0], same, law, law[5], stats)
+        other = _side(pos, vel, radius, arc, rest, force, first[b], segments[b], gb, first[a], segments[a], ga,
+                      samples[c, 1], same, law, law[5], stats)
         if one or other:
             stats[ACTIVE] += 1.0

@@ -7,7 +7,7 @@ finds."""
 import numpy as np
 import pytest
 
-from rodmol.discretise.rod_contact_law import ACTIVE, ENERGY, boxes, pair_forces, sweep
+from rodmol.discretise.rod_contact_law import ACTIVE, ENERGY, boxes, candidate_forces, sweep
 
 R_A, R_B, N = 0.01, 0.012, 10
 SAMPLES = 4
@@ -30,17 +30,29 @@ def _rods(seed):
     return pos, radius, arc, rest
 
 
+def _swept(pos, same):
+    """(candidates, count, first, segments, contact_rods) of rods a (nodes 0..N) and b (N+1..2N+1)
+    in contact, or of rod a with itself."""
+    first, segments = np.array([0, N + 1]), np.array([N, N])
+    box = np.zeros((2 * N, 6))
+    boxes(pos, 0, N, R_A, box[:N])
+    boxes(pos, N + 1, N, R_B, box[N:])
+    owner, index = np.repeat([0, 1], N), np.tile(np.arange(N), 2)
+    contact_of = np.full((2, 2), -1)
+    contact_rods = np.array([[0, 0]]) if same else np.array([[0, 1]])
+    contact_of[tuple(contact_rods[0])] = contact_of[tuple(contact_rods[0][::-1])] = 0
+    candidates = np.zeros((4 * N * N, 3), dtype=np.int64)
+    count = sweep(box, owner, index, contact_of, contact_rods, candidates)
+    return candidates, count, first, segments, contact_rods
+
+
 def _evaluate(pos, vel, radius, arc, rest, law, same=False):
     """(forces (nodes, 3), stats) of rods a (nodes 0..N) and b (N+1..2N+1), or of rod a with itself."""
-    nb = N if not same else N
-    box_a, box_b = np.zeros((N, 6)), np.zeros((nb, 6))
-    boxes(pos, 0, N, R_A, box_a)
-    boxes(pos, 0 if same else N + 1, nb, R_B if not same else R_A, box_b)
-    pairs = np.zeros((4 * N * N, 2), dtype=np.int64)
-    found = sweep(box_a, box_b, same, pairs)
+    candidates, count, first, segments, contact_rods = _swept(pos, same)
     force, stats = np.zeros_like(pos), np.array([0.0, np.inf, 0.0])
-    pair_forces(pos, vel, radius, arc, rest, force, pairs, found, 0, N, 0 if same else N + 1, nb, SAMPLES, SAMPLES,
-                same, np.asarray(law, dtype=float), np.pi * R_A, stats)
+    laws = np.array([[*law, np.pi * R_A]], dtype=float)
+    candidate_forces(pos, vel, radius, arc, rest, force, candidates, count, first, segments, contact_rods,
+                     np.array([[SAMPLES, SAMPLES]]), laws, stats)
     return force, stats
 
 
@@ -81,16 +93,18 @@ def test_the_broad_phase_finds_every_pair_within_reach():
     box_a, box_b = np.zeros((N, 6)), np.zeros((N, 6))
     boxes(pos, 0, N, R_A, box_a)
     boxes(pos, N + 1, N, R_B, box_b)
-    pairs = np.zeros((2, 2), dtype=np.int64)
-    found = sweep(box_a, box_b, False, pairs)
-    if found < 0:  # too small a buffer: it says how many it needs
-        pairs = np.zeros((-found, 2), dtype=np.int64)
-        found = sweep(box_a, box_b, False, pairs)
-    brute = {(i, j) for i in range(N) for j in range(N)
-             if np.all(box_a[i, :3] <= box_b[j, 3:]) and np.all(box_b[j, :3] <= box_a[i, 3:])}
-    assert {tuple(p) for p in pairs[:found]} == brute and found == len(brute) > 0
-    same = np.zeros((N * N, 2), dtype=np.int64)
-    found = sweep(box_a, box_a, True, same)
-    mine = {tuple(p) for p in same[:found]}
-    assert mine == {(i, j) for i in range(N) for j in range(i + 2, N)
-                    if np.all(box_a[i, :3] <= box_a[j, 3:]) and np.all(box_a[j, :3] <= box_a[i, 3:])}
+
+    def overlap(p, q):
+        return np.all(p[:3] <= q[3:]) and np.all(q[:3] <= p[3:])
+
+    candidates, count, *_ = _swept(pos, False)
+    brute = {(0, i, j) for i in range(N) for j in range(N) if overlap(box_a[i], box_b[j])}
+    assert {tuple(c) for c in candidates[:count]} == brute and count == len(brute) > 0
+    candidates, count, *_ = _swept(pos, True)
+    assert {tuple(c) for c in candidates[:count]} == {(0, i, j) for i in range(N) for j in range(i + 2, N)
+                                                      if overlap(box_a[i], box_a[j])}
+    box = np.concatenate([box_a, box_b])
+    short = np.zeros((1, 3), dtype=np.int64)  # too small a buffer: it says how many it needs
+    contact_of = np.array([[-1, 0], [0, -1]])
+    assert sweep(box, np.repeat([0, 1], N), np.tile(np.arange(N), 2), contact_of, np.array([[0, 1]]), short) \
+        == -len(brute)
