@@ -33,7 +33,6 @@ from .calibrate import (
     worsened_models,
 )
 from .contacts import Contact
-from .rod_contacts import RodContact
 from .control import Simulator, StaticFit, SystemFit, inverse_statics, inverse_statics_path
 from .discretise.layout import StateLayout
 from .discretise.schemes import SCHEMES
@@ -62,6 +61,7 @@ from .output.formats import load_result, write_series
 from .parameters import MEDIA, Material, Medium
 from .result import Result
 from .rod import Rod
+from .rod_contacts import RodContact
 from .scenario.file import ScenarioError, load_scenario
 from .simulate import default_atol, simulate
 from .solve.backends import BACKENDS

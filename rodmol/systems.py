@@ -33,8 +33,8 @@ from .contacts import Contact, attach
 from .errors import ParameterError
 from .holds import Hold
 from .load_kinds import KERNELS
-from .model import Model
 from .loads import DistributedForce
+from .model import Model
 from .parameters import Medium
 from .rod_contacts import LOAD_NAME, RodContact, check_rods
 from .system_joints import BodyJoint, Joint, PenaltyJoint

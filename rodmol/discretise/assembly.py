@@ -66,8 +66,8 @@ from .contact_parts import contact_parts
 from .joints import JointPart, RecordedJoints, RodJointPart
 from .physics import quaternion_rate
 from .protocol import pattern_bandwidths
-from .rod_contact import RodPairs
 from .rigid import clamp_wrench, free_body_rates
+from .rod_contact import RodPairs
 from .rod_scales import field_scales
 from .rotations import from_matrix, matrices
 from .state_checks import least_stretch, parts_problem, parts_step_problem

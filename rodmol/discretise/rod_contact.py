@@ -23,8 +23,8 @@ from ..rod_contacts import LOAD_NAME
 from .layout import QUAT, U, V
 from .load_entries import count
 from .physics import jit, rotation, to_global, to_local
-from .rotations import matrices
 from .rod_contact_law import ACTIVE, ENERGY, LEAST_GAP, boxes, candidate_forces, sweep
+from .rotations import matrices
 
 #: Sample spacing along a segment, as a fraction of the two rods' summed radii: a
 #: crossing between samples sinks at most spacing^2 / (8 (r_a + r_b)) deeper, 1/128 of r_a + r_b.

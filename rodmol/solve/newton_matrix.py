@@ -23,11 +23,11 @@ from scipy.sparse.linalg import splu
 
 from ..discretise.physics import jit
 from ..discretise.preconditioner import BlockPreconditioner, block_solve
-from ..errors import ParameterError
 
 # The right-hand side is a global, not an argument, so that numba caches the
 # loop (see rodmol/discretise/jacobian.py).
 from ..discretise.stencil import rhs
+from ..errors import ParameterError
 
 #: Outcomes of a Newton iteration.
 CONVERGED, DIVERGED, SLOW, NOT_FINITE = range(4)
