@@ -2,7 +2,8 @@
 
 1. A system without rod contacts is not slower than before: the two arms on
    a free head (examples/two_arms.toml, N = 8 and 10, t_end 2 s) run by
-   this tree and by the tree of ``--base`` (default ``main``), each in its own
+   this tree and by the tree of ``--base`` (default: where this branch left
+   ``main``, ``git merge-base HEAD main``), each in its own
    worker process, alternately (target: ratio <= 1).
 2. With a rod contact declared but never active (the arms stay apart): the
    two arms with ``RodContact("right", "left")`` and with
@@ -163,7 +164,10 @@ def resting(args, sizes, t_end, calls):
 
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else argv
-    base = next((a.split("=", 1)[1] for a in argv if a.startswith("--base=")), "main")
+    base = next((a.split("=", 1)[1] for a in argv if a.startswith("--base=")), None)
+    if base is None:  # where this branch left main: the same code but for its own changes
+        base = subprocess.run(["git", "-C", C.ROOT, "merge-base", "HEAD", "main"], check=True, capture_output=True,
+                              text=True).stdout.strip()
     args = C.parse_args(__doc__.splitlines()[0], [a for a in argv if not a.startswith("--base=")])
     header = C.header_lines(args, SCRIPT)
     t_end = C.pick(args, 2.0, 0.5, 0.05)
