@@ -10,8 +10,8 @@
    ``RodContact("right", "right")`` (self-contact), and solvers/octopus.py's
    eight arms (N = 30, pulsing, 1 s) with each arm declared in contact with
    its neighbour, against none (target <= 1.2x).
-3. A rod resting across another (tests/test_rod_contacts.py's crossing, N =
-   12 and 48 per rod, released straight from rest to t_end): wall time,
+3. A rod resting across another (examples/rods_crossing.py, N = 12 and 48
+   per rod, released straight from rest to t_end): wall time,
    steps, right-hand sides, CVODE's linear iterations per nonlinear one (the
    preconditioner leaves the contact's coupling out) against the same
    system with the contact held by the lower rod's Hold at the crossing
@@ -108,18 +108,17 @@ def declared(args, t_end, octopus_n, octopus_t):
 
 
 def crossing(n, held=False):
-    """tests/test_rod_contacts.py's crossing at ``n`` elements per rod; ``held``: the lower rod's
-    node at the crossing held by a pin instead of the contact (a reference of the same stiffness scale)."""
-    sys.path.insert(0, os.path.join(C.ROOT, "tests"))
-    import test_rod_contacts as T
+    """examples/rods_crossing.py's crossing at ``n`` elements per rod; ``held``: the upper rod
+    pinned where it crosses instead of the contact (a reference of the same stiffness scale)."""
+    sys.path.append(os.path.join(C.ROOT, "examples"))  # last: solvers/ holds namesakes (octopus.py)
+    import rods_crossing as X
 
-    system = T._crossing()
-    rods = {name: m.replace(n_elements=n) for name, m in system.given_rods.items()}
-    if held:  # the upper rod pinned where it crosses: no rod contact
-        s = round(T.CROSS / (T.L / n)) * T.L / n
-        return system.replace(rods=rods, contacts=[], joints=list(system.joints) + [
-            rodmol.Joint(("upper", s), "world", kind="pin")])
-    return system.replace(rods=rods)
+    system = X.crossing(n)
+    if held:
+        s = round(X.CROSS / (X.L / n)) * X.L / n
+        return system.replace(contacts=[], joints=list(system.joints) + [rodmol.Joint(("upper", s), "world",
+                                                                                        kind="pin")])
+    return system
 
 
 def rhs_share(system, y, calls):
