@@ -4,7 +4,8 @@
    a free head (examples/two_arms.toml, N = 8 and 10, t_end 2 s) run by
    this tree and by the tree of ``--base`` (default: where this branch left
    ``main``, ``git merge-base HEAD main``), each in its own
-   worker process, alternately (target: ratio <= 1).
+   worker process, alternately, and the CPU time of one right-hand side at
+   the run's last state, a timed loop (target: ratio <= 1).
 2. With a rod contact declared but never active (the arms stay apart): the
    two arms with ``RodContact("right", "left")`` and with
    ``RodContact("right", "right")`` (self-contact), and solvers/octopus.py's
@@ -35,10 +36,13 @@ from _common import np, rodmol
 SCRIPT = "rods_touching.py"
 TWO_ARMS = os.path.join(C.ROOT, "examples", "two_arms.toml")
 
-# Runs in a worker process, with the tree under test first on PYTHONPATH.
+# Runs in a worker process, with the tree under test first on PYTHONPATH: ``reps`` runs of the
+# two arms, then the right-hand side's cost at their last state (a timed loop of ``calls``).
 WORKER = """
 import json, sys, time
+import numpy as np
 import rodmol
+from rodmol.discretise.assembly import Assembly
 spec = json.loads(sys.argv[1])
 system = rodmol.load_scenario(spec["file"]).model
 rodmol.simulate(system, 0.002)  # compiled, warm
@@ -47,31 +51,41 @@ for _ in range(spec["reps"]):
     wall, cpu = time.perf_counter(), time.process_time()
     run = rodmol.simulate(system, spec["t_end"], output_dt=0.05)
     out.append((time.perf_counter() - wall, time.process_time() - cpu, run.stats["steps"], bool(run.success)))
-print(json.dumps(out))
+assembly, y = Assembly(system), np.ascontiguousarray(run.states[-1])
+rates = np.empty(assembly.size)
+assembly(0.0, y, rates)
+cpu = time.process_time()
+for _ in range(spec["calls"]):
+    assembly(0.0, y, rates)
+print(json.dumps([out, (time.process_time() - cpu) / spec["calls"]]))
 """
 
 
-def worker(tree, t_end, reps):
-    """[(wall, cpu, steps, success)] of the two arms run ``reps`` times by the rodmol of ``tree``."""
+def worker(tree, t_end, reps, calls):
+    """([(wall, cpu, steps, success)] of the two arms run ``reps`` times, the CPU time [s] of one
+    right-hand side) by the rodmol of ``tree``."""
     env = {**os.environ, "PYTHONPATH": tree}
-    spec = json.dumps({"file": TWO_ARMS, "t_end": t_end, "reps": reps})
+    spec = json.dumps({"file": TWO_ARMS, "t_end": t_end, "reps": reps, "calls": calls})
     done = subprocess.run([sys.executable, "-c", WORKER, spec], env=env, check=True, capture_output=True, text=True)
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
-def before_after(args, t_end, base):
+def before_after(args, t_end, base, calls):
     old_tree, old_sha = C.package_tree(base)
     rows = []
-    samples = {"before": [], "after": []}
+    samples = {"before": ([], []), "after": ([], [])}
     for _ in range(args.reps):  # alternate, so that a neighbour's load falls on both
-        samples["before"] += worker(old_tree, t_end, 1)
-        samples["after"] += worker(C.ROOT, t_end, 1)
-    for label, runs in samples.items():
+        for label, tree in (("before", old_tree), ("after", C.ROOT)):
+            runs, rhs = worker(tree, t_end, 1, calls)
+            samples[label][0].extend(runs)
+            samples[label][1].append(rhs)
+    for label, (runs, rhs) in samples.items():
         rows.append(dict(case=f"two arms, no rod contact ({label}: {old_sha[:8] if label == 'before' else 'this tree'})",
                          wall_s=float(np.median([r[0] for r in runs])), cpu_s=float(np.median([r[1] for r in runs])),
-                         steps=runs[-1][2], success=all(r[3] for r in runs)))
+                         steps=runs[-1][2], success=all(r[3] for r in runs), rhs_us=1e6 * float(np.median(rhs))))
     for row in rows:
         row["ratio"] = row["cpu_s"] / rows[0]["cpu_s"]
+        row["rhs_ratio"] = row["rhs_us"] / rows[0]["rhs_us"]
     return rows
 
 
@@ -170,12 +184,12 @@ def main(argv=None):
     args = C.parse_args(__doc__.splitlines()[0], [a for a in argv if not a.startswith("--base=")])
     header = C.header_lines(args, SCRIPT)
     t_end = C.pick(args, 2.0, 0.5, 0.05)
-    first = before_after(args, t_end, base)
+    first = before_after(args, t_end, base, C.pick(args, 20000, 5000, 100))
     print(first, flush=True)
     second = declared(args, t_end, C.pick(args, 30, 30, 8), C.pick(args, 1.0, 0.3, 0.05))
     print(second, flush=True)
     third = resting(args, C.pick(args, [12, 48], [12, 24], [12]), C.pick(args, 1.0, 0.5, 0.1), C.pick(args, 2000, 500, 20))
-    fmt = {"wall_s": ".3g", "cpu_s": ".3g", "ratio": ".3f", "prec_solves_per_step": ".2f", "rhs_us": ".0f",
+    fmt = {"wall_s": ".3g", "cpu_s": ".3g", "ratio": ".3f", "rhs_ratio": ".3f", "prec_solves_per_step": ".2f", "rhs_us": ".0f",
            "contact_share": ".2f", "least_gap_mm": ".3g", "least_gap_um": ".3g"}
     rows = first + second + third
     C.write_results(args, "rods_touching", "Contact between rods: cost", header, rows,
