@@ -238,3 +238,11 @@ def test_a_rod_rolled_up_by_a_tip_moment_past_a_full_turn_does_not_pass_through_
         if contacts:
             assert run.stats["rod_contact_least_gap"] > -0.05 * R  # between the samples (measured -0.035 R)
     assert gaps[0] > -0.1 * R and gaps[1] < -R  # measured -0.068 R and -1.96 R
+
+
+def test_the_dense_solver_differences_the_contact_and_agrees_with_gmres():
+    runs = [rodmol.simulate(_crossing(), 0.3, output_times=[0.0, 0.3], rtol=1e-7, linsolver=solver)
+            for solver in ("gmres", "dense")]
+    assert all(run.success for run in runs)
+    carried = [run.rod_contacts()[0]["upper"][-1].sum(axis=0)[1] for run in runs]
+    assert carried[1] == pytest.approx(carried[0], rel=1e-3)  # measured 4e-5
