@@ -72,6 +72,7 @@ from .output.formats import load_result, write_series
 from .parameters import MEDIA, Material, Medium
 from .result import Result
 from .rod import Rod
+from .rod_contacts import RodContact
 from .scenario.file import ScenarioError, load_scenario
 from .simulate import default_atol, simulate
 from .solve.backends import BACKENDS
@@ -81,7 +82,7 @@ from .systems import Joint, System
 __all__ = [
     "BACKENDS", "Base", "BaseMotion", "Cable", "CapsuleContact", "Contact", "DistributedForce",
     "DistributedMoment", "Hold", "PlaneContact", "PointForce", "PointMoment", "SphereContact", "EquilibriumError", "IntegrationError", "MEDIA",
-    "Joint", "Marker", "Material", "Medium", "Model", "NotSupportedYet", "RigidBody", "System", "ParameterError", "Result", "Rod", "RodmolError",
+    "Joint", "Marker", "RodContact", "Material", "Medium", "Model", "NotSupportedYet", "RigidBody", "System", "ParameterError", "Result", "Rod", "RodmolError",
     "SCHEMES", "ScenarioError", "SemiDiscrete", "Simulator", "StateLayout", "StateView", "UserFunctionError",
     "default_atol", "energy",
     "equilibrium", "load_result", "load_scenario", "marker_errors", "oscillation_period", "paper_arm",

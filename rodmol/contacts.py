@@ -71,6 +71,8 @@ def attach(contacts, rods, bodies):
     RigidBody), and the :class:`RodContact` of each (contact, rod)."""
     added, records = {name: [] for name in rods}, []
     for i, contact in enumerate(contacts):
+        if not isinstance(contact, Contact):  # a rodmol.RodContact: between rods (rodmol.rod_contacts)
+            continue
         if contact.body not in bodies:
             raise ParameterError(f"`contacts[{i}]` names the body {contact.body!r}, which is not in `bodies`"
                                  f"{_checks.did_you_mean(contact.body, bodies)}")

@@ -88,6 +88,26 @@ class SystemResult:
         self.assembly, self.t, self.states = assembly, np.asarray(t, dtype=float), np.asarray(states)
         self.success, self.message, self.stats, self.error = success, message, stats, error
         self._parts, self._saved = {}, saved
+        self._touching = None
+        if assembly is not None and assembly.rod_pairs is not None and len(self.t) and isinstance(stats, dict):
+            _, gaps, active = self.rod_contacts()
+            self.stats = {**stats, "rod_contact_least_gap": float(gaps.min()),
+                          "rod_contact_pairs": int(active.max())}
+
+    def rod_contacts(self):
+        """The rods' contacts with each other (:class:`rodmol.RodContact`) at the frames:
+        ({rod name: (n_t, N + 1, 3) contact force [N] on each node 0..N, global},
+        least surface gap (n_t,) [m], negative where they overlap (inf where no two
+        rods come within their radii of each other), number of touching segment
+        pairs (n_t,)). The stats hold the run's least gap (``rod_contact_least_gap``)
+        and most pairs (``rod_contact_pairs``). A rod's Result records the same
+        forces (its nodes 1..N) in its ``external_force``, as densities."""
+        assembly = self._system("rod_contacts")
+        if assembly.rod_pairs is None:
+            return {}, np.full(len(self.t), np.inf), np.zeros(len(self.t), dtype=int)
+        if self._touching is None:
+            self._touching = assembly.rod_pairs.history(self.states)
+        return self._touching
 
     def __getstate__(self):
         # The parts built on access are left behind (a rod's replays its body's recorded

@@ -33,8 +33,10 @@ from .contacts import Contact, attach
 from .errors import ParameterError
 from .holds import Hold
 from .load_kinds import KERNELS
+from .loads import DistributedForce
 from .model import Model
 from .parameters import Medium
+from .rod_contacts import LOAD_NAME, RodContact, check_rods
 from .system_joints import BodyJoint, Joint, PenaltyJoint
 
 __all__ = ["BodyJoint", "Joint", "PenaltyJoint", "System"]
@@ -57,8 +59,9 @@ class System:
         The fluid around every rod and body (a preset name as for Model).
     gravity : (3,) float
         Gravitational acceleration [m/s^2], global.
-    contacts : sequence of Contact
-        Bodies' shapes that rods touch (:class:`rodmol.Contact`).
+    contacts : sequence of Contact or RodContact
+        Bodies' shapes that rods touch (:class:`rodmol.Contact`), and rods that
+        touch each other or themselves (:class:`rodmol.RodContact`).
 
     Attributes
     ----------
@@ -82,6 +85,9 @@ class System:
     rod_contacts : list of rodmol.contacts.RodContact
         Each rod's side of each contact; the rod's Model carries the shape
         (named ``"contacts[i]"``, placed at the body's initial pose) after the holds.
+    rod_pairs : list of (int, RodContact)
+        The rod contacts with their index in ``contacts``; each rod in one carries
+        the load ``rodmol.rod_contacts.LOAD_NAME`` (its nodes' contact forces) last.
     """
 
     def __init__(self, rods, bodies=None, joints=(), *, medium=None, gravity=(0.0, -9.81, 0.0), contacts=()):
@@ -117,8 +123,14 @@ class System:
         self.joints = _checks.items("joints", joints, Joint, "a rodmol.Joint")
         self.body_joints, self.base_bodies = [], {}
         self.clamps, self.penalty_joints = self._joints()
-        self.contacts = _checks.items("contacts", contacts, Contact, "a rodmol.Contact")
+        self.contacts = _checks.items("contacts", contacts, (Contact, RodContact),
+                                      "a rodmol.Contact or rodmol.RodContact")
         self.rods, self.rod_contacts = attach(self.contacts, self.rods, self.bodies)
+        check_rods(self.contacts, self.rods)
+        self.rod_pairs = [(i, c) for i, c in enumerate(self.contacts) if isinstance(c, RodContact)]
+        touching = {name for _, c in self.rod_pairs for name in c.rods}
+        self.rods = {name: m.replace(loads=tuple(m.loads) + (DistributedForce((0.0, 0.0, 0.0), "local", LOAD_NAME),))
+                     if name in touching else m for name, m in self.rods.items()}
 
     def replace(self, *, rods=None, bodies=None, **changes):
         """A new System with ``changes`` (``joints``, ``medium``, ``gravity``,

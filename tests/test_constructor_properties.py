@@ -1,6 +1,6 @@
 """Property: any Python value thrown at any argument of the public
-constructors (Model, Rod, Material, Medium, Cable, Marker, BaseMotion and the
-loads) gives a valid object or a rodmol error saying what is wrong, never a
+constructors (Model, Rod, Material, Medium, Cable, Marker, BaseMotion, the
+loads and RodContact) gives a valid object or a rodmol error saying what is wrong, never a
 raw Python error (TypeError, AttributeError, LinAlgError, ...)."""
 
 import numpy as np
@@ -60,6 +60,8 @@ SENSIBLE = {
                                 damping=0.0, friction=0.2, slip_speed=1e-4, smoothing_depth=None, name="bar"),
     rodmol.SphereContact: dict(centre=(0.1, -0.1, 0.0), radius=0.02, stiffness=1e3, damping=0.0,
                                friction=0.2, slip_speed=1e-4, smoothing_depth=None, name="ball"),
+    rodmol.RodContact: dict(a="left", b="right", stiffness=None, damping=None, friction=0.2, slip_speed=1e-4,
+                            smoothing_depth=None),
 }
 
 

@@ -167,3 +167,15 @@ def test_the_branch_example_swings_with_the_compound_pendulum_period():
     expected = branch.compound_pendulum() * (1.0 + branch.SWING**2 / 16.0)
     assert branch.period(result) == pytest.approx(expected, rel=1e-2)  # measured 4.7e-3
     assert result["arm"].tip[:, 1].min() < -0.9 * branch.ARM_L * np.sin(branch.SWING)  # it swings through
+
+
+def test_the_rods_crossing_example_carries_the_propped_cantilevers_share():
+    """examples/rods_crossing.py at N = 12: the upper rod settles across the lower one, which
+    carries the share of its weight a cantilever propped there has (Euler-Bernoulli)."""
+    import rodmol
+
+    crossing = example("rods_crossing.py")
+    result = rodmol.simulate(crossing.crossing(12), 1.0, output_times=[0.0, 1.0])
+    assert result.success
+    assert crossing.carried(result) == pytest.approx(crossing.propped_cantilever(), rel=5e-3)  # measured 1.3e-3
+    assert -2e-4 < result.rod_contacts()[1][-1] < 0.0  # overlapping by the law's penetration only

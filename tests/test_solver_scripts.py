@@ -292,6 +292,15 @@ def _rod_contact(out):
     assert all(abs(row["force_over_weight"] - 1.0) < 5e-3 for row in table), table
 
 
+def _rods_touching(out):
+    table = {row["case"]: row for row in rows(out / "rods_touching.csv")}
+    assert all(row["success"] is True for row in table.values())
+    crossing = [row for case, row in table.items() if case.endswith(": contact")]
+    assert crossing and all(row["least_gap_um"] < 0.0 for row in crossing)  # resting on the other rod
+    declared = [row for case, row in table.items() if case.startswith("declared")]
+    assert declared and all(row["pairs"] == 0 for row in declared)  # never touching
+
+
 def _reach_scores(out):
     table = {row["policy"]: row for row in rows(out / "reach_scores.csv")}
     assert set(table) == {"random", "proportional", "inverse statics, open loop", "linear MPC", "successive linear MPC"}
@@ -399,6 +408,7 @@ SCRIPTS = {
     "body_joints.py": (["body_joints.csv", "body_joints.md"], _body_joints),
     "system_output.py": (["system_output.csv", "system_output.md"], _system_output),
     "rod_contact.py": (["rod_contact.csv", "rod_contact.md"], _rod_contact),
+    "rods_touching.py": (["rods_touching.csv", "rods_touching.md"], _rods_touching),
     "vtp_series_cost.py": (["vtp_series_cost.csv", "vtp_series_cost.md"], _vtp_series_cost),
     "driver_speed.py": (["driver_speed.csv", "driver_speed.md", "driver_speed_runs.csv"], _driver_speed),
     "crawl_speed.py": (["crawl_speed.csv", "crawl_speed.md", "crawl_speed_runs.csv"], _crawl_speed),
@@ -411,8 +421,8 @@ SCRIPTS = {
 
 
 #: Scripts that start subprocesses themselves: the trees they compare, or a fresh run each.
-SPAWNING = {"bending_vs_commit.py", "core_speed.py", "long_output.py", "rest_strains_speed.py", "system_output.py",
-            "view_open.py", "driver_speed.py", "crawl_speed.py"}
+SPAWNING = {"bending_vs_commit.py", "core_speed.py", "long_output.py", "rest_strains_speed.py", "rods_touching.py",
+            "system_output.py", "view_open.py", "driver_speed.py", "crawl_speed.py"}
 #: The script run as a command: one of the quickest.
 COMMAND = "release.py"
 
@@ -427,7 +437,7 @@ def _skip_without_what_it_needs(script):
     if script == "system_output.py" and subprocess.run(
             ["git", "-C", ROOT, "cat-file", "-e", "06aa966^{commit}"], capture_output=True).returncode != 0:
         pytest.skip("needs a git checkout holding commit 06aa966")
-    if script == "rest_strains_speed.py" and subprocess.run(
+    if script in ("rest_strains_speed.py", "rods_touching.py") and subprocess.run(
             ["git", "-C", ROOT, "merge-base", "HEAD", "main"], capture_output=True).returncode != 0:
         pytest.skip("needs a git checkout with a main branch (the base it measures against)")
     if script in ("driver_speed.py", "crawl_speed.py") and subprocess.run(

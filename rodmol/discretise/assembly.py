@@ -67,6 +67,7 @@ from .joints import JointPart, RecordedJoints, RodJointPart
 from .physics import quaternion_rate
 from .protocol import pattern_bandwidths
 from .rigid import clamp_wrench, free_body_rates
+from .rod_contact import RodPairs
 from .rod_scales import field_scales
 from .rotations import from_matrix, matrices
 from .state_checks import least_stretch, parts_problem, parts_step_problem
@@ -136,6 +137,7 @@ class Assembly:
         # whose penalty or body joints' reactions it sums.
         self._rod_parts = [(sd, self.parts[name]) for name, sd in self.rods.items()]
         self._reacting = [p.name for p in self.free if p.joints or p.body_joints]
+        self.rod_pairs = RodPairs(self) if system.rod_pairs else None
         self.lightly_damped = any(sd.lightly_damped for sd in self.rods.values())
         self.scan_arguments = None  # the step check's compiled scan arguments, made at its first call
         self._gravity = np.ascontiguousarray(system.gravity, dtype=float)
@@ -202,13 +204,15 @@ class Assembly:
     def recorded_rod(self, name, t, states, sd=None):
         """Rod ``name``'s system (or ``sd``, a copy of it) for rebuilding its
         Result from the frames ``states`` (n_t, size) at ``t``: if penalty
-        joints hold it to bodies, a :class:`RecordedJoints` replaying their
-        held points at the frames, else ``sd`` itself."""
+        joints hold it to bodies or it touches rods (:class:`rodmol.RodContact`),
+        a :class:`RecordedJoints` replaying their held points and contact forces
+        at the frames, else ``sd`` itself."""
         sd = self.rods[name] if sd is None else sd
         joints = [joint for joint in self.joints + self.rod_joints if joint.joint.rod == name]
-        if not joints:
+        touching = self.rod_pairs is not None and name in self.rod_pairs.rods
+        if not joints and not touching:
             return sd
-        replay = []
+        replay = self.rod_pairs.replay(name, t, states) if touching else []
         for joint in joints:
             rows, values = np.tile(joint.row, (len(t), 1)), np.zeros((len(t), 3))
             for i, (ti, yi) in enumerate(zip(t, states)):
@@ -265,6 +269,8 @@ class Assembly:
             self.add_body_joints(t, y, reactions)
         for joint in self.rod_joints:
             joint.wrench(y, joint.row, joint.value)
+        if self.rod_pairs is not None:  # after the base velocities: the base nodes' move
+            self.rod_pairs.apply(y)
         for sd, sl in self._rod_parts:
             sd(t, y[sl], out[sl])
         for part in self.bodies.values():
@@ -341,8 +347,22 @@ class Assembly:
           differences of :meth:`jacobian`, run by Python);
         * ``"dense"``: small systems and cross-checks.
 
-        No band solver: a body's rows couple entries far apart in the state."""
-        return {"gmres": "compiled", "sparse": "sundials", "dense": "sundials"}
+        No band solver: a body's rows couple entries far apart in the state. With rod
+        contacts (:class:`rodmol.RodContact`) no "sparse" either (:attr:`refused_solvers`)."""
+        return {name: jacobian for name, jacobian in
+                {"gmres": "compiled", "sparse": "sundials", "dense": "sundials"}.items()
+                if name not in self.refused_solvers}
+
+    @property
+    def refused_solvers(self):
+        """{linear solver: why this system refuses it}: with rod contacts the sparse
+        solver's pattern would leave out the coupling of nodes that come into contact
+        during the run (GMRES's products and the dense differences see it)."""
+        if self.rod_pairs is None:
+            return {}
+        return {"sparse": "its Jacobian pattern leaves out the rod contacts' coupling, which comes and "
+                          "goes with the rods' motion (`contacts` holds a rodmol.RodContact): use 'gmres' "
+                          "(default) or 'dense'"}
 
     def jacobian(self, scale, matrix="sparse"):
         """The Jacobian by coloured differences on :meth:`pattern`

@@ -16,6 +16,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..inputs import knot_times
+from ..rod_contacts import LOAD_NAME as REACTION_LOAD
 from . import external, load_entries, stencil
 from .layout import StateLayout, merge
 from .physics import compile_signatures
@@ -169,6 +170,11 @@ class SemiDiscrete:
         self._entry_params = np.ascontiguousarray(entries.params, dtype=float).reshape(-1, external.N_PARAMS)
         self.entry_values = np.ascontiguousarray(entries.initial, dtype=float).reshape(-1, 3)
         self._hold_entries = np.isin(self._kinds, external.HOLDS)  # rodmol.Hold
+        # A system's rod contacts write their forces here (rodmol.RodContact): a reaction, not a load to ramp.
+        self._reaction_entries = np.zeros(len(self._kinds), dtype=bool)
+        for load, rows in zip(self.model.loads, np.split(np.arange(len(self._kinds)), np.cumsum(
+                [load_entries.count(item, self.model.s_nodes) for item in self.model.loads])[:-1])):
+            self._reaction_entries[rows] = getattr(load, "name", None) == REACTION_LOAD
         self.grid_loads = entries
 
     @property
@@ -325,7 +331,7 @@ class SemiDiscrete:
 
     def rest_rates(self, t, y, out, load_factor=1.0, tensions=None, held_factor=None):
         """dy/dt at (t, y) with every applied load (gravity, tensions, external
-        load values) scaled by ``load_factor`` and the held points'
+        load values but a system's rod contacts) scaled by ``load_factor`` and the held points'
         displacements from rest (rodmol.Hold) by ``held_factor`` (default:
         ``load_factor``), for the equilibrium's continuation. ``tensions``
         (n_cables,) [N] replace the cables' inputs (the equilibrium of a
@@ -337,6 +343,7 @@ class SemiDiscrete:
             inputs *= load_factor
         if held_factor is not None:  # a hold's value is its held displacement
             self.entry_values[self._hold_entries] = saved[2][self._hold_entries] * held_factor
+        self.entry_values[self._reaction_entries] = saved[2][self._reaction_entries]
         try:
             stencil.rhs(y, out, *self.kernel_arguments())
         finally:

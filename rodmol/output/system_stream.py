@@ -135,9 +135,10 @@ class SystemRunWriter:
         if not self.t:  # stopped before its first frame was stored: nothing to list
             return SystemResult(self.assembly, np.empty(0), np.empty((0, self.assembly.size)), success, message,
                                 dict(stats))
-        self._write_index(success, message, stats, complete=True)
-        return SystemResult(self.assembly, np.array(self.t), read_series(self.directory, dict(chunks=self.chunks),
-                                                                         "states"), success, message, dict(stats))
+        result = SystemResult(self.assembly, np.array(self.t), read_series(self.directory, dict(chunks=self.chunks),
+                                                                           "states"), success, message, dict(stats))
+        self._write_index(success, message, result.stats, complete=True)  # with what the result adds (rod contacts)
+        return result
 
     def resume_point(self):
         """(planned output times, index of the restart frame, its state) of the run being resumed."""

@@ -14,7 +14,7 @@ from .. import _checks
 from ..contacts import Contact
 from .arm import build_table, entries
 from .problems import FAILED, failed
-from .tables import BODY_CONTACTS, CONTACTS, LOADS
+from .tables import BODY_CONTACTS, CONTACTS, LOADS, ROD_CONTACT_TYPE
 
 
 def loads(data, ctx, at=()):
@@ -32,13 +32,17 @@ def contacts(data, ctx, at=()):
 def rod_contacts(data, ctx):
     """The :class:`rodmol.Contact` of a system file's ``[[contact]]`` tables: a
     ``body``, its ``rods`` and a contact [[load]] type's shape in the body frame;
-    FAILED if any has a problem."""
+    or, ``type = "rods"``, a :class:`rodmol.RodContact` (``a``, ``b`` and its
+    law); FAILED if any has a problem."""
     return _typed(data, ctx, (), "contact", CONTACTS, _contact)
 
 
 def _contact(table):
     """The builder of a [[contact]] table ``table``: its shape's keyword
-    arguments (``table.sources[0]``) made the shape of a Contact."""
+    arguments (``table.sources[0]``) made the shape of a Contact; of rods touching
+    rods, the :class:`rodmol.RodContact` itself."""
+    if table is CONTACTS[ROD_CONTACT_TYPE]:
+        return table.sources[0].build
     shape = table.sources[0].build
 
     def build(body, rods, **keys):

@@ -32,6 +32,7 @@ from ..model import Model
 from ..output.options import OutputOptions
 from ..parameters import Material, Medium
 from ..rod import Rod
+from ..rod_contacts import RodContact
 from ..simulate import simulate
 from ..systems import Joint, System
 
@@ -149,6 +150,10 @@ BODY_CONTACTS = {kind: Table(LOADS[kind].sources, own=("type",), units={**LOADS[
 CONTACTS = {kind: Table((Source(LOADS[kind].sources[0].build, skip=("name",)), Source(Contact, only=("body", "rods"))),
                         own=("type",), units=LOADS[kind].units)
             for kind in CONTACT_TYPES}
+#: The ``[[contact]]`` type of rods touching rods (:class:`rodmol.RodContact`: ``a``, ``b`` and its law).
+ROD_CONTACT_TYPE = "rods"
+CONTACTS[ROD_CONTACT_TYPE] = Table((Source(RodContact),), own=("type",),
+                                   units={"stiffness": "N/m^2", "damping": "N s/m^2", "smoothing_depth": "m"})
 #: A driven body's ``motion`` table (its position and rotation are the body's).
 BODY_MOTION = Table((Source(BaseMotion, only=("velocity", "angular_velocity")),))
 JOINT = Table((Source(Joint),))

@@ -114,7 +114,7 @@ def system_rest_state(system, t=0.0, *, scheme=None, tol=1e-10, max_iter=40):
     elif scheme is not None and get_scheme(scheme) != system.scheme:
         raise ParameterError(f"`scheme` {scheme!r}: the system given is built with the "
                              f"{system.scheme.name!r} scheme (leave `scheme` out, or pass the System)")
-    if system.free or system.rod_joints:  # coupled
+    if system.free or system.rod_joints or system.rod_pairs is not None:  # coupled
         return free_rest_state(system, t, tol, max_iter)
     y = system.undeformed_state()
     for name, rod in system.rods.items():

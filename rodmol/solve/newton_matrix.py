@@ -27,13 +27,19 @@ from ..discretise.preconditioner import BlockPreconditioner, block_solve
 # The right-hand side is a global, not an argument, so that numba caches the
 # loop (see rodmol/discretise/jacobian.py).
 from ..discretise.stencil import rhs
+from ..errors import ParameterError
 
 #: Outcomes of a Newton iteration.
 CONVERGED, DIVERGED, SLOW, NOT_FINITE = range(4)
 
 
 def newton_matrix(system, scale):
-    """The factorable I - g J of ``system`` (``scale``: typical size of each entry)."""
+    """The factorable I - g J of ``system`` (``scale``: typical size of each entry); a system
+    that refuses the sparse solver (its pattern misses a coupling: rod contacts) is refused."""
+    why = getattr(system, "refused_solvers", {}).get("sparse")
+    if why:
+        raise ParameterError("backend='galpha' is refused for this system: its Newton matrix is a sparse LU on "
+                             f"the Jacobian's pattern, and {why} (with backend='cvode', or 'rk23')")
     try:
         return BlockNewton(system, scale)
     except ValueError:  # a coupling the block elimination cannot take

@@ -239,6 +239,10 @@ def linear_solver(system, linsolver):
     if linsolver == "auto":
         return next(iter(offered))
     if linsolver not in offered:
+        why = getattr(system, "refused_solvers", {}).get(linsolver)
+        if why:
+            raise ParameterError(f"`linsolver` {linsolver!r} is refused for this system: {why}; valid: "
+                                 f"{['auto', *offered]}")
         which = "" if set(offered) == set(LINEAR_SOLVERS) else " for this system"
         raise ParameterError(f"unknown `linsolver` {linsolver!r}{which}; valid: {['auto', *offered]}")
     return linsolver

@@ -64,9 +64,12 @@ class CoupledDifferences:
                 nodes.setdefault(rod, set()).add((node - assembly.parts[rod].start - equations.rods[rod].system.
                                                   layout.header) // equations.rods[rod].system.layout.block)
         grouped = []  # per rod: (columns, rows, cols) of each group, columns shifted to the unknowns
+        touching = set() if assembly.rod_pairs is None else set(assembly.rod_pairs.rods)
         for name, eq in equations.rods.items():
             start, block = equations.slices[name].start, eq.static.block
             blocks = {0} | nodes.get(name, set())
+            if name in touching:  # any block may touch any other: every column alone
+                blocks = set(range(eq.static.n_blocks))
             alone = np.concatenate([start + b * block + np.arange(block) for b in sorted(blocks)])
             coupled.append(alone)
             groups = []
@@ -205,6 +208,8 @@ class FreeRestEquations:
             if joint.part.name in reactions:
                 reactions[joint.part.name] += np.concatenate([force, moment])
         assembly.add_body_joints(self.t, y, reactions)  # the free bodies' velocities in y are zero
+        if assembly.rod_pairs is not None:  # at rest: the penalties alone (velocities zero)
+            assembly.rod_pairs.apply(y)
         out = np.empty(self.size)
         for name, eq in self.rods.items():  # held=1: a joint's gap is where the bodies are, not a load
             out[self.slices[name]] = eq.residual(z[self.slices[name]], lam, held=1.0)

@@ -189,3 +189,62 @@ def test_the_arm_pushing_a_ball_example_runs_coarse_and_pushes_it():
     assert np.abs(on_ball[:, 2]).max() > 1e-3  # the arm touched it, pushing toward +z
     np.testing.assert_allclose(on_ball, -on_arm, rtol=0, atol=1e-9)
     assert ball.position[-1, 2] > ball.position[0, 2]
+
+
+#: Two rods crossing, the upper one resting across the lower one: [[contact]] type "rods".
+CROSSING = """\
+[solver]
+t_end = 0.1
+
+[system]
+gravity = [0.0, -9.81, 0.0]
+
+[[rod]]
+name = "upper"
+length = 0.3
+radius = 0.01
+n_elements = 6
+[rod.material]
+E = 1e7
+nu = 0.5
+mu = 2e4
+rho = 1000.0
+[rod.base]
+position = [0.0, 0.02, 0.0]
+
+[[rod]]
+name = "lower"
+length = 0.3
+radius = 0.01
+n_elements = 6
+[rod.material]
+E = 1e8
+nu = 0.5
+mu = 2e4
+rho = 1000.0
+[rod.base]
+position = [0.2, 0.0, -0.15]
+rotation = [[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]
+
+[[contact]]
+type = "rods"
+a = "upper"
+b = "lower"
+friction = 0.3
+"""
+
+
+def test_a_rods_contact_table_is_the_systems_rod_contact():
+    system = parse_scenario(CROSSING).model
+    assert system.rod_pairs == [(0, rodmol.RodContact("upper", "lower", friction=0.3))]
+    law = system.rod_pairs[0][1].law(system.rods["upper"], system.rods["lower"])
+    assert law[0] == 1e7  # the softer rod's E
+
+
+@pytest.mark.parametrize("change, words", [
+    (('b = "lower"', 'b = "lowr"'), r"contact.*'lowr'.*not in `rods`"),
+    (("friction = 0.3", "stiffness = -1.0"), r"contact.*stiffness` must be > 0"),
+])
+def test_a_bad_rods_contact_table_is_refused_naming_it(change, words):
+    with pytest.raises(ScenarioError, match=f"(?s){words}"):
+        parse_scenario(CROSSING.replace(*change))
