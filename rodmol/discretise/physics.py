@@ -30,13 +30,33 @@ def jit(fn=None, *, signature=None):
     the compilation. error_model="numpy" drops Python's zero-division checks
     from the inner loops. An explicit ``signature`` is compiled by
     :func:`compile_signatures` (not at import, so that ``import rodmol``
-    stays quick and a run can announce the wait).
+    stays quick and a run can announce the wait). A kernel called from another
+    with a constant argument is compiled for its type, not its value
+    (:func:`_one_per_type`).
     """
     if fn is None:
         return lambda f: jit(f, signature=signature)
-    dispatcher = numba.njit(cache=True, error_model="numpy")(fn)
+    dispatcher = _one_per_type(numba.njit(cache=True, error_model="numpy")(fn))
     if signature is not None:
         _UNCOMPILED.append((dispatcher, signature))
+    return dispatcher
+
+
+def _one_per_type(dispatcher):
+    """Type the calls of ``dispatcher`` from compiled code by their arguments' types only.
+
+    numba types a constant argument (``_vec(row, 12)``, a block size) as its literal value
+    and compiles the callee once per value: a fresh cache compiled the stencil's helpers
+    sixteen times more than needed. The callee's machine code is inlined into its caller,
+    where LLVM folds the constant just the same, so one compilation per type loses nothing.
+    """
+    by_literal = dispatcher.get_call_template
+
+    def get_call_template(args, kws):
+        return by_literal([numba.types.unliteral(a) for a in args],
+                          {k: numba.types.unliteral(v) for k, v in kws.items()})
+
+    dispatcher.get_call_template = get_call_template
     return dispatcher
 
 
