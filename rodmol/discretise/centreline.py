@@ -8,9 +8,10 @@ the strains (the midpoint rule, second order), which is exact at rest. The stati
 so at rest both positions agree.
 """
 
+import numba
 import numpy as np
 
-from .physics import chord, jit
+from .physics import chord, jit, strided
 
 
 def chords(quat, q, k, ds):
@@ -28,7 +29,7 @@ def chords(quat, q, k, ds):
     return out
 
 
-@jit
+@jit(signature=numba.types.void(strided(3), strided(3), strided(3), numba.types.float64, strided(3, writes=True)))
 def _chords(quat, q, k, ds, out):
     for f in range(q.shape[0]):
         for j in range(q.shape[1]):

@@ -39,6 +39,8 @@ def jit(fn=None, *, signature=None):
     dispatcher = _one_per_type(numba.njit(cache=True, error_model="numpy")(fn))
     if signature is not None:
         _UNCOMPILED.append((dispatcher, signature))
+        # A call before compile_signatures compiles the signature too, not the call's types.
+        dispatcher._compile_for_args = lambda *args, **kws: _compile(dispatcher, signature)
     return dispatcher
 
 
@@ -60,13 +62,27 @@ def _one_per_type(dispatcher):
     return dispatcher
 
 
+def strided(ndim, writes=False):
+    """numba's type of a float64 array of ``ndim`` dimensions in any layout, read only unless
+    it ``writes``: for a kernel's explicit signature when it takes strided views of the
+    states, so that one compilation takes contiguous arrays too (numba alone compiles a
+    second one for them)."""
+    return numba.types.float64[(slice(None),) * ndim].copy(readonly=not writes)
+
+
 def compile_signatures():
     """Compile (or load from the disk cache) the kernels with explicit
     signatures, and allow no other: every later call converts to them."""
     while _UNCOMPILED:
-        dispatcher, signature = _UNCOMPILED.pop()
-        dispatcher.compile(signature)
-        dispatcher.disable_compile()
+        _compile(*_UNCOMPILED.pop())
+
+
+def _compile(dispatcher, signature):
+    """``dispatcher`` compiled for ``signature`` alone; returns it (numba calls it again
+    with the arguments, converted to that signature's types)."""
+    dispatcher.compile(signature)
+    dispatcher.disable_compile()
+    return dispatcher
 
 
 # --------------------------------------------------------------------------- vectors

@@ -25,3 +25,30 @@ def test_a_helper_called_with_two_constants_is_compiled_once(tmp_path):
     # cache compiled the stencil's helpers sixteen times more than needed).
     assert len(module.triple.signatures) == 1
     assert "Literal" not in str(module.triple.signatures)
+
+
+def test_kernels_of_strided_views_are_compiled_once_for_any_layout():
+    """Post-processing reads strided views of the states and contiguous arrays: one
+    compilation serves both (numba alone compiled each of these kernels twice)."""
+    from rodmol.discretise import centreline, rotations
+
+    rng = np.random.default_rng(0)
+    quat = rng.normal(size=(3, 5, 4))
+    states = rng.normal(size=(3, 5, 11))  # strain fields are strided views of states
+    q, k = states[..., 4:7], states[..., 7:10]
+    for quat_in in (quat, quat[:, :, :]):  # contiguous, then a strided view with the others
+        chords = centreline.chords(quat_in, q, k, 0.01)
+    strided = np.concatenate([quat, quat], axis=-1)[..., :4]
+    assert np.allclose(centreline.chords(strided, q, k, 0.01), chords)
+    matrices = rotations.matrices(quat)
+    vectors = rng.normal(size=(3, 5, 3))
+    turned = rotations.rotate(matrices, vectors)
+    assert np.allclose(rotations.rotate(matrices, states[..., :3].copy()), np.einsum("fnij,fnj->fni", matrices, states[..., :3]))
+    assert np.allclose(turned, np.einsum("fnij,fnj->fni", matrices, vectors))
+    unit = quat.copy()
+    rotations.normalise(unit)
+    view = states[..., :4]
+    rotations.normalise(view)
+    assert np.allclose(np.linalg.norm(unit, axis=-1), 1.0) and np.allclose(np.linalg.norm(view, axis=-1), 1.0)
+    for kernel in (centreline._chords, rotations._rotate, rotations._normalise):
+        assert len(kernel.signatures) == 1, kernel
