@@ -11,7 +11,8 @@ so at rest both positions agree.
 import numba
 import numpy as np
 
-from .physics import chord, jit, strided
+from .compiling import jit, strided
+from .physics import chord
 
 
 def chords(quat, q, k, ds):
@@ -29,7 +30,8 @@ def chords(quat, q, k, ds):
     return out
 
 
-@jit(signature=numba.types.void(strided(3), strided(3), strided(3), numba.types.float64, strided(3, writes=True)))
+@jit(signature=numba.types.void(strided(3), strided(3), strided(3), numba.types.float64, strided(3, writes=True)),
+     ahead=True)
 def _chords(quat, q, k, ds, out):
     for f in range(q.shape[0]):
         for j in range(q.shape[1]):

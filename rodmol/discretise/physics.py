@@ -12,77 +12,9 @@ moments [N m/m].
 equations, used only to test these.
 """
 
-import numba
 import numpy as np
 
-from . import kernel_cache
-
-kernel_cache.install()  # before any kernel is compiled or loaded
-#: Kernels with an explicit signature, compiled by :func:`compile_signatures`.
-_UNCOMPILED = []
-
-
-def jit(fn=None, *, signature=None):
-    """numba.njit with the project's options.
-
-    cache=True: the machine code is stored next to this package (or in
-    numba's user cache if that is read-only), so only the first process pays
-    the compilation. error_model="numpy" drops Python's zero-division checks
-    from the inner loops. An explicit ``signature`` is compiled by
-    :func:`compile_signatures` (not at import, so that ``import rodmol``
-    stays quick and a run can announce the wait). A kernel called from another
-    with a constant argument is compiled for its type, not its value
-    (:func:`_one_per_type`).
-    """
-    if fn is None:
-        return lambda f: jit(f, signature=signature)
-    dispatcher = _one_per_type(numba.njit(cache=True, error_model="numpy")(fn))
-    if signature is not None:
-        _UNCOMPILED.append((dispatcher, signature))
-        # A call before compile_signatures compiles the signature too, not the call's types.
-        dispatcher._compile_for_args = lambda *args, **kws: _compile(dispatcher, signature)
-    return dispatcher
-
-
-def _one_per_type(dispatcher):
-    """Type the calls of ``dispatcher`` from compiled code by their arguments' types only.
-
-    numba types a constant argument (``_vec(row, 12)``, a block size) as its literal value
-    and compiles the callee once per value: a fresh cache compiled the stencil's helpers
-    sixteen times more than needed. The callee's machine code is inlined into its caller,
-    where LLVM folds the constant just the same, so one compilation per type loses nothing.
-    """
-    by_literal = dispatcher.get_call_template
-
-    def get_call_template(args, kws):
-        return by_literal([numba.types.unliteral(a) for a in args],
-                          {k: numba.types.unliteral(v) for k, v in kws.items()})
-
-    dispatcher.get_call_template = get_call_template
-    return dispatcher
-
-
-def strided(ndim, writes=False):
-    """numba's type of a float64 array of ``ndim`` dimensions in any layout, read only unless
-    it ``writes``: for a kernel's explicit signature when it takes strided views of the
-    states, so that one compilation takes contiguous arrays too (numba alone compiles a
-    second one for them)."""
-    return numba.types.float64[(slice(None),) * ndim].copy(readonly=not writes)
-
-
-def compile_signatures():
-    """Compile (or load from the disk cache) the kernels with explicit
-    signatures, and allow no other: every later call converts to them."""
-    while _UNCOMPILED:
-        _compile(*_UNCOMPILED.pop())
-
-
-def _compile(dispatcher, signature):
-    """``dispatcher`` compiled for ``signature`` alone; returns it (numba calls it again
-    with the arguments, converted to that signature's types)."""
-    dispatcher.compile(signature)
-    dispatcher.disable_compile()
-    return dispatcher
+from .compiling import jit
 
 
 # --------------------------------------------------------------------------- vectors
