@@ -1,14 +1,18 @@
-"""Numba's disk cache of rodmol's kernels, invalidated by any kernel source.
+"""Numba's disk cache of rodmol's kernels, invalidated by every source a kernel reads.
 
 Numba keys a cached function on its own file's time stamp only, but rodmol's
 kernels inline functions and freeze constants from other modules (the load
 kinds' codes of :mod:`rodmol.load_kinds`, the parameter columns of :mod:`rodmol.loads`, the layout's
 offsets, the compiled physics): after an edit or an upgrade that changed
 only those, the old machine code was loaded and ran silently wrong physics.
-Here every rodmol kernel's stamp also carries one digest of all the sources
-its code can read, so any change to them recompiles every kernel once.
+Here every rodmol kernel's stamp also carries a digest of the sources its code can
+read: its own module and every rodmol module that one imports, transitively
+(:func:`reads`). An edit recompiles the kernels whose modules reach the edited file
+and no other (an edit of ``solve/stepping.py`` leaves the stencil's machine code be).
 """
 
+import ast
+import functools
 import hashlib
 import pickle
 from pathlib import Path
@@ -16,13 +20,13 @@ from pathlib import Path
 from numba.core import caching
 
 PACKAGE = Path(__file__).resolve().parents[1]
-#: The sources whose code or constants a compiled kernel can read.
+#: The sources whose code or constants a compiled kernel can read (all kernels together).
 SOURCES = (*sorted((PACKAGE / "discretise").glob("*.py")), *sorted((PACKAGE / "solve").glob("*.py")),
            PACKAGE / "load_kinds.py", PACKAGE / "loads.py", PACKAGE / "holds.py")
 
 
 def sources_digest(paths=SOURCES):
-    """SHA-1 of the contents of ``paths``, in order."""
+    """SHA-1 of the names and contents of ``paths``, in order."""
     digest = hashlib.sha1()
     for path in paths:
         digest.update(path.name.encode())
@@ -30,14 +34,63 @@ def sources_digest(paths=SOURCES):
     return digest.hexdigest()
 
 
-DIGEST = sources_digest()
+def _module_file(stem, package):
+    """The source of module or package ``stem`` (a path without suffix) inside ``package``, or None."""
+    for candidate in (stem.with_suffix(".py"), stem / "__init__.py"):
+        if candidate.is_file() and candidate.resolve().is_relative_to(package):
+            return candidate.resolve()
+    return None
+
+
+def _imported(path, package):
+    """The rodmol modules that the module at ``path`` imports at its top level (not
+    transitively; imports inside functions run after compilation, kernels cannot read them)."""
+    found = set()
+    for node in ast.parse(path.read_bytes(), str(path)).body:
+        if isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = path.parent.parents[node.level - 2] if node.level > 1 else path.parent
+            elif (node.module or "").split(".")[0] == package.name:
+                base = package.parent
+            else:
+                continue
+            stem = base.joinpath(*node.module.split(".")) if node.module else base
+            # A submodule imported by name, or else a name from the module (or package) itself.
+            names = [_module_file(stem / alias.name, package) for alias in node.names]
+            found.update(n for n in names if n)
+            if not all(names):
+                found.add(_module_file(stem, package))
+        elif isinstance(node, ast.Import):
+            found.update(_module_file(package.parent.joinpath(*alias.name.split(".")), package)
+                         for alias in node.names if alias.name.split(".")[0] == package.name)
+    found.discard(None)
+    return found
+
+
+@functools.cache
+def reads(path, package=PACKAGE):
+    """The sources a kernel defined in the module at ``path`` can read: that module and the
+    modules of ``package`` (rodmol) it imports at their top level, transitively, sorted."""
+    seen, todo = set(), [Path(path).resolve()]
+    while todo:
+        current = todo.pop()
+        if current not in seen:
+            seen.add(current)
+            todo += _imported(current, package) - seen
+    return tuple(sorted(seen))
+
+
+@functools.cache
+def kernel_digest(path, package=PACKAGE):
+    """The digest of :func:`reads` of ``path``: a kernel's cache stamp carries it."""
+    return sources_digest(reads(path, package))
 
 
 class _KernelSources:
-    """A locator mixin: rodmol's own files only, stamped with :data:`DIGEST` too."""
+    """A locator mixin: rodmol's own files only, stamped with :func:`kernel_digest` too."""
 
     def get_source_stamp(self):
-        return super().get_source_stamp(), DIGEST
+        return super().get_source_stamp(), kernel_digest(self._py_file)
 
     @classmethod
     def from_function(cls, py_func, py_file):
