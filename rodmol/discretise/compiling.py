@@ -80,6 +80,11 @@ def compile_signatures():
     _compile_entries(lambda ahead: True)
 
 
+def helper_wanted():
+    """True if :func:`compile_signatures` will start the helper process (for the progress line)."""
+    return compile_ahead.wanted([d for d, _, ahead in _UNCOMPILED if ahead])
+
+
 def compile_ahead_here():
     """Compile (or load) the kernels marked ``ahead``: the helper process's work."""
     _compile_entries(lambda ahead: ahead)
