@@ -11,10 +11,10 @@ read: its own module and every rodmol module that one imports, transitively
 and no other (an edit of ``solve/stepping.py`` leaves the stencil's machine code be).
 """
 
-import ast
 import functools
 import hashlib
 import pickle
+import re
 from pathlib import Path
 
 from numba.core import caching
@@ -42,29 +42,38 @@ def _module_file(stem, package):
     return None
 
 
+#: A top-level import statement (at the start of a line): ``from .x import a, b`` (names
+#: possibly in parentheses over several lines) or ``import rodmol.x``.
+_IMPORT = re.compile(r"^(?:from[ \t]+(\.*)([\w.]*)[ \t]+import[ \t]+(\([^)]*\)|[^\n]*)|import[ \t]+([\w., \t]+))",
+                     re.MULTILINE)
+
+
+@functools.cache
 def _imported(path, package):
     """The rodmol modules that the module at ``path`` imports at its top level (not
-    transitively; imports inside functions run after compilation, kernels cannot read them)."""
+    transitively; imports inside functions run after compilation, kernels cannot read them).
+    Read with a pattern, not parsed: a run's start stamps every kernel with these."""
     found = set()
-    for node in ast.parse(path.read_bytes(), str(path)).body:
-        if isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = path.parent.parents[node.level - 2] if node.level > 1 else path.parent
-            elif (node.module or "").split(".")[0] == package.name:
-                base = package.parent
-            else:
-                continue
-            stem = base.joinpath(*node.module.split(".")) if node.module else base
-            # A submodule imported by name, or else a name from the module (or package) itself.
-            names = [_module_file(stem / alias.name, package) for alias in node.names]
-            found.update(n for n in names if n)
-            if not all(names):
-                found.add(_module_file(stem, package))
-        elif isinstance(node, ast.Import):
-            found.update(_module_file(package.parent.joinpath(*alias.name.split(".")), package)
-                         for alias in node.names if alias.name.split(".")[0] == package.name)
+    for level, module, names, plain in _IMPORT.findall(path.read_text()):
+        if plain:
+            found.update(_module_file(package.parent.joinpath(*name.split()[0].split(".")), package)
+                         for name in plain.split(",") if name.split() and name.split()[0].split(".")[0] == package.name)
+            continue
+        if level:
+            base = path.parent.parents[len(level) - 2] if len(level) > 1 else path.parent
+        elif module.split(".")[0] == package.name:
+            base = package.parent
+        else:
+            continue
+        stem = base.joinpath(*module.split(".")) if module else base
+        listed = [n.split()[0] for n in re.sub(r"#[^\n]*", "", names).strip("()").split(",") if n.split()]
+        # A submodule imported by name, or else a name from the module (or package) itself.
+        submodules = [_module_file(stem / name, package) for name in listed]
+        found.update(submodules)
+        if not all(submodules):
+            found.add(_module_file(stem, package))
     found.discard(None)
-    return found
+    return frozenset(found)
 
 
 @functools.cache
@@ -83,7 +92,16 @@ def reads(path, package=PACKAGE):
 @functools.cache
 def kernel_digest(path, package=PACKAGE):
     """The digest of :func:`reads` of ``path``: a kernel's cache stamp carries it."""
-    return sources_digest(reads(path, package))
+    digest = hashlib.sha1()
+    for source in reads(path, package):
+        digest.update(source.relative_to(package).as_posix().encode())
+        digest.update(_file_digest(source))
+    return digest.hexdigest()
+
+
+@functools.cache
+def _file_digest(path):
+    return hashlib.sha1(path.read_bytes()).digest()
 
 
 class _KernelSources:

@@ -29,6 +29,11 @@ def _package_copy(tmp_path):
     return copy
 
 
+def _forget():
+    for memo in (kernel_cache.reads, kernel_cache.kernel_digest, kernel_cache._imported, kernel_cache._file_digest):
+        memo.cache_clear()
+
+
 def _digests(package, modules):
     return {m: kernel_cache.kernel_digest(package / m, package) for m in modules}
 
@@ -42,15 +47,13 @@ def test_an_edit_recompiles_the_kernels_that_read_the_edited_source_and_no_other
 
     kinds = package / "load_kinds.py"
     kinds.write_text(kinds.read_text().replace("Kernel(4,", "Kernel(5,", 1))  # e.g. a load kind's code edited
-    kernel_cache.reads.cache_clear()
-    kernel_cache.kernel_digest.cache_clear()
+    _forget()
     kinds_edited = _digests(package, modules)
     assert {m for m in modules if kinds_edited[m] != before[m]} == set(modules) - {"discretise/rotations.py"}
 
     stepping = package / "solve" / "stepping.py"
     stepping.write_text(stepping.read_text() + "\n# an edit of the solver's Python\n")
-    kernel_cache.reads.cache_clear()
-    kernel_cache.kernel_digest.cache_clear()
+    _forget()
     assert _digests(package, modules) == kinds_edited  # no kernel reads stepping.py
 
 
