@@ -13,7 +13,7 @@ kernel_cache.install()  # before any kernel is compiled or loaded
 _UNCOMPILED = []
 
 
-def jit(fn=None, *, signature=None, ahead=False):
+def jit(fn=None, *, signature=None, ahead=False, by_value=False):
     """numba.njit with the project's options.
 
     cache=True: the machine code is stored next to this package (or in
@@ -24,11 +24,14 @@ def jit(fn=None, *, signature=None, ahead=False):
     stays quick and a run can announce the wait), or by its first call if that
     comes earlier; ``ahead``: in the helper process while this one compiles the
     others. A kernel called from another with a constant argument is compiled
-    for its type, not its value (:func:`_one_per_type`).
+    for its type, not its value (:func:`_one_per_type`), unless ``by_value``: the
+    preconditioner's small inverses, whose loops run faster unrolled for each block size.
     """
     if fn is None:
-        return lambda f: jit(f, signature=signature, ahead=ahead)
-    dispatcher = _one_per_type(numba.njit(cache=True, error_model="numpy")(fn), signature)
+        return lambda f: jit(f, signature=signature, ahead=ahead, by_value=by_value)
+    dispatcher = numba.njit(cache=True, error_model="numpy")(fn)
+    if not by_value:
+        dispatcher = _one_per_type(dispatcher, signature)
     if signature is not None:
         _UNCOMPILED.append((dispatcher, signature, ahead))
         # A call before compile_signatures compiles the signature too, not the call's types.
