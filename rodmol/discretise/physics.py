@@ -16,7 +16,6 @@ import numpy as np
 
 from .compiling import jit
 
-
 # --------------------------------------------------------------------------- vectors
 
 @jit

@@ -27,9 +27,9 @@ plus a positive second-difference operator.
 import numba
 import numpy as np
 
+from .compiling import jit
 from .jacobian import read_only
 from .layout import BLOCK, HEADER, span
-from .compiling import jit
 
 _POSE, _STRAIN, _VELOCITY = ("u", "Q"), ("q", "k"), ("v", "w")
 #: The couplings the elimination handles exactly: row fields -> offset -> allowed columns.

@@ -17,8 +17,8 @@ import numpy as np
 
 from ..inputs import knot_times
 from . import external, load_entries, stencil
-from .layout import StateLayout, merge
 from .compiling import compile_signatures
+from .layout import StateLayout, merge
 from .preconditioner import check_structure
 from .rod_scales import field_scales, first_bending_frequency, grid_damping_ratio
 from .routing import CableRouting
