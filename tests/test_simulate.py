@@ -81,7 +81,8 @@ def test_a_state_sized_argument_is_refused_before_compiling_and_a_system_compile
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300, check=False)
     assert out.returncode == 0, out.stderr
     refused, before, built, evaluated = out.stdout.split()
-    assert (refused, evaluated) == ("refused", "0") and int(before) == int(built) > 0
+    # Evaluated: the right-hand side is compiled (the helper's kernels at their first call).
+    assert refused == "refused" and int(before) == int(built) > int(evaluated)
 
 
 def _arm(n):

@@ -8,10 +8,12 @@ fails or is killed leaves no half-written entry), and this process then loads th
 instead of compiling them. It is started only where it can help: a machine with a second
 core, a kernel the cache lacks and a cache this user can write (a read-only installation
 whose kernels are not in numba's user-wide cache compiles in this process alone), and
-not when ``RODMOL_COMPILE_AHEAD=0``. It is waited for at most :data:`TIMEOUT` and
-stopped with this process; whatever it did not finish is compiled here.
+not when ``RODMOL_COMPILE_AHEAD=0``. This process goes on meanwhile and waits for it
+(at most :data:`TIMEOUT`) at the first call of a kernel it compiles; it is stopped with
+this process; whatever it did not finish is compiled here.
 """
 
+import atexit
 import os
 import subprocess
 import sys
@@ -23,6 +25,7 @@ from .kernel_cache import cached
 TIMEOUT = 120.0
 #: The environment variable that turns the helper off ("0").
 SWITCH = "RODMOL_COMPILE_AHEAD"
+_helper = None  # this process's running helper, if any
 _PARENT = str(Path(__file__).resolve().parents[2])  # the directory holding the rodmol package
 _CODE = ("import sys; sys.path.insert(0, {parent!r}); "
          "from rodmol.discretise import compile_ahead; compile_ahead.main()")
@@ -50,22 +53,30 @@ def wanted(dispatchers):
 
 
 def start(dispatchers):
-    """The helper process compiling the kernels marked ``ahead``, or None where it would
-    not help (:func:`wanted`) or cannot start."""
-    if not wanted(dispatchers):
-        return None
+    """Start the helper process compiling the kernels marked ``ahead``, unless one is running
+    or it would not help (:func:`wanted`) or cannot start."""
+    global _helper
+    if _helper is not None or not wanted(dispatchers):
+        return
     env = dict(os.environ, **{SWITCH: "0"})  # a helper starts no helper
     try:
-        return subprocess.Popen([sys.executable, "-c", _CODE.format(parent=_PARENT)], env=env,
-                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                stderr=subprocess.DEVNULL)
+        _helper = subprocess.Popen([sys.executable, "-c", _CODE.format(parent=_PARENT)], env=env,
+                                   stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                   stderr=subprocess.DEVNULL)
     except OSError:
-        return None
+        _helper = None
 
 
-def finish(helper, timeout=TIMEOUT):
-    """Wait for ``helper`` (from :func:`start`, or None) at most ``timeout`` [s], and stop it
-    if it is still running then."""
+def running():
+    """True while a helper started by :func:`start` has not been waited for."""
+    return _helper is not None
+
+
+def finish(timeout=TIMEOUT):
+    """Wait for the helper (if one runs) at most ``timeout`` [s], and stop it if it is still
+    running then; what it did not finish, this process compiles."""
+    global _helper
+    helper, _helper = _helper, None
     if helper is None:
         return
     try:
@@ -73,6 +84,9 @@ def finish(helper, timeout=TIMEOUT):
     except subprocess.TimeoutExpired:
         helper.kill()
         helper.wait()
+
+
+atexit.register(finish, 0.0)  # a run that ends (or fails) before it needs the helper's work
 
 
 def main():

@@ -31,15 +31,15 @@ def jit(fn=None, *, signature=None, ahead=False, by_value=False):
         return lambda f: jit(f, signature=signature, ahead=ahead, by_value=by_value)
     dispatcher = numba.njit(cache=True, error_model="numpy")(fn)
     if not by_value:
-        dispatcher = _one_per_type(dispatcher, signature)
+        dispatcher = _one_per_type(dispatcher, signature, ahead)
     if signature is not None:
         _UNCOMPILED.append((dispatcher, signature, ahead))
         # A call before compile_signatures compiles the signature too, not the call's types.
-        dispatcher._compile_for_args = lambda *args, **kws: _compile(dispatcher, signature)
+        dispatcher._compile_for_args = lambda *args, **kws: _compile(dispatcher, signature, ahead)
     return dispatcher
 
 
-def _one_per_type(dispatcher, signature):
+def _one_per_type(dispatcher, signature, ahead):
     """Type the calls of ``dispatcher`` from compiled code by their arguments' types only
     (by its explicit ``signature`` if it has one).
 
@@ -52,7 +52,7 @@ def _one_per_type(dispatcher, signature):
 
     def get_call_template(args, kws):
         if signature is not None and dispatcher._can_compile:
-            _compile(dispatcher, signature)
+            _compile(dispatcher, signature, ahead)
         return by_literal([numba.types.unliteral(a) for a in args],
                           {k: numba.types.unliteral(v) for k, v in kws.items()})
 
@@ -71,16 +71,18 @@ def strided(ndim, writes=False):
 def compile_signatures():
     """Compile (or load from the disk cache) the kernels with explicit signatures, and allow
     no other: every later call converts to them. Those marked ``ahead`` that the cache lacks
-    are compiled meanwhile by a helper process, where the machine has a second core, and
-    then loaded from the cache it wrote (:mod:`rodmol.discretise.compile_ahead`)."""
-    helper = compile_ahead.start([d for d, _, ahead in _UNCOMPILED if ahead])
+    are compiled meanwhile by a helper process, where the machine has a second core
+    (:mod:`rodmol.discretise.compile_ahead`); each is loaded from the cache it wrote at its
+    first call, which waits for the helper if it is still at work: the run goes on in the
+    meantime (the Jacobian's kernel, the initial state)."""
+    compile_ahead.start([d for d, _, ahead in _UNCOMPILED if ahead])
     try:
         _compile_entries(lambda ahead: not ahead)
     except BaseException:  # interrupted or failed: stop the helper, do not wait for it
-        compile_ahead.finish(helper, timeout=0.0)
+        compile_ahead.finish(timeout=0.0)
         raise
-    compile_ahead.finish(helper)
-    _compile_entries(lambda ahead: True)
+    if not compile_ahead.running():
+        _compile_entries(lambda ahead: True)
 
 
 def helper_wanted():
@@ -95,13 +97,16 @@ def compile_ahead_here():
 
 def _compile_entries(chosen):
     for entry in [e for e in _UNCOMPILED if chosen(e[2])]:
-        _compile(*entry[:2])
-        _UNCOMPILED.remove(entry)
+        _compile(*entry)
 
 
-def _compile(dispatcher, signature):
-    """``dispatcher`` compiled for ``signature`` alone; returns it (numba calls it again
-    with the arguments, converted to that signature's types)."""
+def _compile(dispatcher, signature, ahead=False):
+    """``dispatcher`` compiled for ``signature`` alone (``ahead``: loaded from the cache the
+    helper writes, once it is done); returns it (numba calls it again with the arguments,
+    converted to that signature's types)."""
+    if ahead:
+        compile_ahead.finish()
     dispatcher.compile(signature)
     dispatcher.disable_compile()
+    _UNCOMPILED[:] = [e for e in _UNCOMPILED if e[0] is not dispatcher]
     return dispatcher

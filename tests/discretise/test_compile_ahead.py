@@ -29,25 +29,28 @@ def test_the_helper_starts_only_where_it_helps(tmp_path, monkeypatch):
     monkeypatch.setattr(compile_ahead, "cores", lambda: 2)
     assert not compile_ahead.wanted([_dispatcher(tmp_path / "absent")])  # a cache it cannot write
     monkeypatch.setenv(compile_ahead.SWITCH, "0")
-    assert not compile_ahead.wanted([missing]) and compile_ahead.start([missing]) is None
+    compile_ahead.start([missing])
+    assert not compile_ahead.wanted([missing]) and not compile_ahead.running()
     monkeypatch.delenv(compile_ahead.SWITCH)
     monkeypatch.setattr(compile_ahead, "cached", lambda d: True)
     assert not compile_ahead.wanted([missing])  # all in the cache already
 
 
-def test_a_helper_past_its_time_is_stopped_and_the_run_goes_on():
+def test_a_helper_past_its_time_is_stopped_and_the_run_goes_on(monkeypatch):
     helper = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    monkeypatch.setattr(compile_ahead, "_helper", helper)
     started = time.perf_counter()
-    compile_ahead.finish(helper, timeout=0.2)
+    compile_ahead.finish(timeout=0.2)
     assert time.perf_counter() - started < 10.0 and helper.returncode is not None
-    compile_ahead.finish(None)  # no helper: nothing to do
+    assert not compile_ahead.running()
+    compile_ahead.finish()  # no helper: nothing to do
 
 
 def test_an_interrupted_compilation_stops_the_helper_without_waiting(monkeypatch):
     helper = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
-    monkeypatch.setattr(compile_ahead, "start", lambda dispatchers: helper)
+    monkeypatch.setattr(compile_ahead, "start", lambda dispatchers: setattr(compile_ahead, "_helper", helper))
 
-    def interrupted(dispatcher, signature):
+    def interrupted(dispatcher, signature, ahead):
         raise KeyboardInterrupt
 
     monkeypatch.setattr(compiling, "_compile", interrupted)
@@ -56,6 +59,7 @@ def test_an_interrupted_compilation_stops_the_helper_without_waiting(monkeypatch
     with pytest.raises(KeyboardInterrupt):
         compiling.compile_signatures()
     assert time.perf_counter() - started < 10.0 and helper.returncode is not None
+    assert not compile_ahead.running()
 
 
 def test_the_progress_line_says_when_a_helper_compiles_too(monkeypatch):
