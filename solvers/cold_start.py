@@ -4,8 +4,9 @@ job again (warm cache), for this checkout's last commit and an older one, side b
 ``rodmol run examples/fetching.toml --out DIR`` in a new process, from a tree extracted by
 ``git archive`` (the package and examples as a fresh clone holds them; numba's cache goes
 to that tree's ``__pycache__``): cold in a fresh tree, then warm in the same tree. Variants:
-the older commit (default ``1c57c53``, the start of this work), this commit, and this commit
-with the helper process off (``RODMOL_COMPILE_AHEAD=0``). The repetitions alternate the
+the older commit (default ``1c57c53``, the start of this work), this commit as it decides
+(its helper process only where a core looks idle), and this commit with the helper on
+however busy the machine (``RODMOL_COMPILE_AHEAD=1``) and off (``=0``). The repetitions alternate the
 variants so they see the same load. Reported per run: the wall time from the process's
 start, the CPU time of the run's own process (``self``: its critical path on a quiet
 machine) and of its helper (``helper``: the children it waited for); medians over the
@@ -47,11 +48,13 @@ def _tree(root, sha, folder):
     return folder
 
 
-def _run(tree, t_end, helper=True):
-    """(wall [s], self CPU [s], helper CPU [s]) of the job in ``tree``."""
+def _run(tree, t_end, helper=None):
+    """(wall [s], self CPU [s], helper CPU [s]) of the job in ``tree``; ``helper``: the value
+    of ``RODMOL_COMPILE_AHEAD`` ("0" off, "1" on however busy the machine, None: rodmol decides)."""
     env = dict(os.environ, PYTHONPATH=tree, OPENBLAS_NUM_THREADS="1")
-    if not helper:
-        env["RODMOL_COMPILE_AHEAD"] = "0"
+    env.pop("RODMOL_COMPILE_AHEAD", None)
+    if helper is not None:
+        env["RODMOL_COMPILE_AHEAD"] = helper
     out = os.path.join(tree, "out")
     record = os.path.join(tree, "cpu.json")
     command = [sys.executable, "-c", f"import sys; sys.path.insert(0, {tree!r})\n" + _RUNNER, record,
@@ -80,8 +83,8 @@ def main(argv=None):
         return subprocess.run(["git", "-C", C.ROOT, "rev-parse", "--verify", rev + "^{commit}"], check=True,
                               capture_output=True, text=True).stdout.strip()
 
-    variants = [(f"{commit} (before)", sha_of(commit), True), ("this commit", sha_of("HEAD"), True),
-                ("this commit, no helper", sha_of("HEAD"), False)]
+    variants = [(f"{commit} (before)", sha_of(commit), None), ("this commit", sha_of("HEAD"), None),
+                ("this commit, helper on", sha_of("HEAD"), "1"), ("this commit, helper off", sha_of("HEAD"), "0")]
     if args.mode == "smoke":
         variants = variants[1:2]
     rows = []

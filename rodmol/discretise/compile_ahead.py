@@ -6,9 +6,10 @@ The helper imports rodmol from the same place, compiles the kernels marked ``ahe
 cache (index and data, each to a temporary file renamed into place, so a helper that
 fails or is killed leaves no half-written entry), and this process then loads them
 instead of compiling them. It is started only where it can help: a machine with a second
-core, a kernel the cache lacks and a cache this user can write (a read-only installation
-whose kernels are not in numba's user-wide cache compiles in this process alone), and
-not when ``RODMOL_COMPILE_AHEAD=0``. This process goes on meanwhile and waits for it
+core that looks idle (:func:`idle_core`), a kernel the cache lacks and a cache this user
+can write (a read-only installation whose kernels are not in numba's user-wide cache
+compiles in this process alone). ``RODMOL_COMPILE_AHEAD=0`` turns it off, ``=1`` starts
+it on a busy machine too. This process goes on meanwhile and waits for it
 (at most :data:`TIMEOUT`) at the first call of a kernel it compiles; it is stopped with
 this process; whatever it did not finish is compiled here.
 """
@@ -23,7 +24,7 @@ from .kernel_cache import cached
 
 #: Longest wait [s] for the helper once this process's own kernels are compiled.
 TIMEOUT = 120.0
-#: The environment variable that turns the helper off ("0").
+#: The environment variable that turns the helper off ("0") or on however busy the machine ("1").
 SWITCH = "RODMOL_COMPILE_AHEAD"
 _helper = None  # this process's running helper, if any
 _PARENT = str(Path(__file__).resolve().parents[2])  # the directory holding the rodmol package
@@ -44,9 +45,19 @@ def _writable(dispatcher):
     return path is not None and os.access(path, os.W_OK)
 
 
+def idle_core():
+    """True if a core looks free: the load average (1 min) leaves one beside this process
+    (on a machine busy with other jobs a helper only competes with them and this process)."""
+    try:
+        return os.getloadavg()[0] < cores() - 0.5
+    except OSError:
+        return True
+
+
 def wanted(dispatchers):
     """True if a helper would compile some of ``dispatchers`` (see the module docstring)."""
-    if os.environ.get(SWITCH, "1") == "0" or cores() < 2:
+    switch = os.environ.get(SWITCH, "")
+    if switch == "0" or cores() < 2 or (switch != "1" and not idle_core()):
         return False
     missing = [d for d in dispatchers if cached(d) is False]
     return bool(missing) and all(_writable(d) for d in missing)
