@@ -32,6 +32,8 @@ def jit(fn=None, *, signature=None, ahead=False, by_value=False):
     dispatcher = numba.njit(cache=True, error_model="numpy")(fn)
     if not by_value:
         dispatcher = _one_per_type(dispatcher, signature, ahead)
+    if signature is None:
+        _twin(dispatcher, fn, by_value)
     if signature is not None:
         _UNCOMPILED.append((dispatcher, signature, ahead))
         # A call before compile_signatures compiles the signature too, not the call's types.
@@ -58,6 +60,30 @@ def _one_per_type(dispatcher, signature, ahead):
 
     dispatcher.get_call_template = get_call_template
     return dispatcher
+
+
+class _Twinned(type(numba.njit(lambda: None))):
+    """A kernel that compiled code calls through its twin (:func:`_twin`)."""
+
+    @property
+    def _numba_type_(self):
+        return numba.types.Dispatcher(getattr(self, "_nested", self))
+
+
+def _twin(dispatcher, fn, by_value):
+    """Let compiled callers of ``dispatcher`` call a twin compiled without a Python wrapper.
+
+    numba compiles every function a kernel calls as a function of its own, with a wrapper
+    for calls from Python and the machine code for it, and caches it: for the stencil's ~30
+    helpers that was most of the right-hand side's compilation, for code inlined into its
+    callers. The twin skips the wrapper and the cache (its code lives in its callers'
+    cached machine code); Python calls still go to ``dispatcher`` itself.
+    """
+    nested = numba.njit(error_model="numpy", no_cpython_wrapper=True)(fn)
+    if not by_value:
+        _one_per_type(nested, None, False)
+    dispatcher._nested = nested
+    dispatcher.__class__ = _Twinned
 
 
 def strided(ndim, writes=False):

@@ -18,13 +18,38 @@ def _kernel_module(tmp_path):
     return module
 
 
+def _compilations(run):
+    """The (function name, argument types) numba compiles while ``run()`` runs."""
+    from numba.core import event
+
+    seen = []
+
+    class Recorder(event.Listener):
+        def on_start(self, ev):
+            seen.append((ev.data["dispatcher"].py_func.__name__, str(ev.data["args"])))
+
+        def on_end(self, ev):
+            pass
+
+    recorder = Recorder()
+    event.register("numba:compile", recorder)
+    try:
+        run()
+    finally:
+        event.unregister("numba:compile", recorder)
+    return seen
+
+
 def test_a_helper_called_with_two_constants_is_compiled_once(tmp_path):
     module = _kernel_module(tmp_path)
-    assert module.caller(np.arange(6.0)) == 5.0
+    result = []
+    compiled = _compilations(lambda: result.append(module.caller(np.arange(6.0))))
+    assert result == [5.0]
     # numba alone types 0 and 3 as literals and compiles the helper twice (a fresh
     # cache compiled the stencil's helpers sixteen times more than needed).
-    assert len(module.triple.signatures) == 1
-    assert "Literal" not in str(module.triple.signatures)
+    helper = [args for name, args in compiled if name == "triple"]
+    assert len(helper) == 1 and "Literal" not in helper[0]
+    assert module.triple(np.arange(6.0), 2) == (2.0, 3.0, 4.0)  # and it is callable from Python
 
 
 def test_kernels_of_strided_views_are_compiled_once_for_any_layout():
