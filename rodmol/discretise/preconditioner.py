@@ -197,8 +197,8 @@ def block_setup(jb, jh, gamma, head, fac):
                 f[F_FWD + NX * i + j] = sv
 
 
-@jit(signature=numba.types.void(_F8, _F8C2, _F8C2, _F8C1.copy(readonly=True), _F8C1, _F8C2, _F8C2, _F8C2),
-     ahead=True)
+# Compiled here, after the right-hand side (the helper, which imports rodmol first, has more to do).
+@jit(signature=numba.types.void(_F8, _F8C2, _F8C2, _F8C1.copy(readonly=True), _F8C1, _F8C2, _F8C2, _F8C2))
 def block_solve(gamma, head, fac, r, x, y_x, y_p, h):
     """x = (I - gamma J)^-1 r with the factors of :func:`block_setup` (same gamma).
 
