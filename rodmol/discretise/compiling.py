@@ -5,6 +5,7 @@ compilation per argument type, explicit signatures compiled at a run's announced
 """
 
 import numba
+from numba.core.registry import CPUDispatcher
 
 from . import compile_ahead, kernel_cache
 
@@ -30,6 +31,8 @@ def jit(fn=None, *, signature=None, ahead=False, by_value=False):
     if fn is None:
         return lambda f: jit(f, signature=signature, ahead=ahead, by_value=by_value)
     dispatcher = numba.njit(cache=True, error_model="numpy")(fn)
+    if not isinstance(dispatcher, CPUDispatcher):  # numba's jit turned off (NUMBA_DISABLE_JIT): Python
+        return dispatcher
     if not by_value:
         dispatcher = _one_per_type(dispatcher, signature, ahead)
     if signature is None:
@@ -62,7 +65,7 @@ def _one_per_type(dispatcher, signature, ahead):
     return dispatcher
 
 
-class _Twinned(type(numba.njit(lambda: None))):
+class _Twinned(CPUDispatcher):
     """A kernel that compiled code calls through its twin (:func:`_twin`)."""
 
     @property
