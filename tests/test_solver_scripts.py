@@ -370,6 +370,15 @@ def _bending_vs_commit(out):
     assert gap < 1e-5
 
 
+def _cold_start(out):
+    runs = rows(out / "cold_start.csv")
+    cold = [r for r in runs if r["state"] == "cold"]
+    warm = [r for r in runs if r["state"] == "warm"]
+    assert cold and warm
+    # A fresh tree compiles every kernel (in the run or its helper); the warm run loads them.
+    assert min(r["self_cpu_s"] + r["helper_cpu_s"] for r in cold) > max(r["self_cpu_s"] + r["helper_cpu_s"] for r in warm)
+
+
 SCRIPTS = {
     "scaling.py": (["scaling.csv", "scaling.md", "scaling.png", "scaling_extra.csv", "scaling_long.csv"], _scaling),
     "temporal.py": (["temporal.csv", "temporal.md", "temporal.png", "temporal_rk23.csv", "temporal_options.csv"],
@@ -417,12 +426,13 @@ SCRIPTS = {
                           "step_overhead.md"], _step_overhead),
     "bending_vs_commit.py": (["bending_vs_commit.csv", "bending_vs_commit.md"], _bending_vs_commit),
     "compiled_driver.py": (["compiled_driver.csv", "compiled_driver.md"], _compiled_driver),
+    "cold_start.py": (["cold_start.csv", "cold_start.md"], _cold_start),
 }
 
 
 #: Scripts that start subprocesses themselves: the trees they compare, or a fresh run each.
-SPAWNING = {"bending_vs_commit.py", "core_speed.py", "long_output.py", "rest_strains_speed.py", "rods_touching.py",
-            "system_output.py", "view_open.py", "driver_speed.py", "crawl_speed.py"}
+SPAWNING = {"bending_vs_commit.py", "cold_start.py", "core_speed.py", "long_output.py", "rest_strains_speed.py",
+            "rods_touching.py", "system_output.py", "view_open.py", "driver_speed.py", "crawl_speed.py"}
 #: The script run as a command: one of the quickest.
 COMMAND = "release.py"
 
@@ -474,13 +484,17 @@ def _main(script):
     return importlib.import_module(script.removesuffix(".py")).main
 
 
-#: Scripts whose smoke run takes tens of seconds (an optimisation of many runs).
-SLOW = {"optimal_tensions.py"}
+#: Scripts whose smoke run takes tens of seconds (an optimisation of many runs; compiling
+#: every kernel afresh).
+SLOW = {"optimal_tensions.py", "cold_start.py"}
 
 
-@pytest.mark.parametrize("script", [pytest.param(s, marks=pytest.mark.subprocess) if s in SPAWNING
-                                    else pytest.param(s, marks=pytest.mark.slow) if s in SLOW else s
-                                    for s in sorted(SCRIPTS) if s != COMMAND])
+def _marks(script):
+    marks = [pytest.mark.subprocess] * (script in SPAWNING) + [pytest.mark.slow] * (script in SLOW)
+    return pytest.param(script, marks=marks)
+
+
+@pytest.mark.parametrize("script", [_marks(s) for s in sorted(SCRIPTS) if s != COMMAND])
 def test_script_smoke_run(script, tmp_path):
     _skip_without_what_it_needs(script)
     _main(script)(["--smoke", "--out", str(tmp_path)])

@@ -8,9 +8,11 @@ the strains (the midpoint rule, second order), which is exact at rest. The stati
 so at rest both positions agree.
 """
 
+import numba
 import numpy as np
 
-from .physics import chord, jit
+from .compiling import jit, strided
+from .physics import chord
 
 
 def chords(quat, q, k, ds):
@@ -28,7 +30,8 @@ def chords(quat, q, k, ds):
     return out
 
 
-@jit
+@jit(signature=numba.types.void(strided(3), strided(3), strided(3), numba.types.float64, strided(3, writes=True)),
+     ahead=True)
 def _chords(quat, q, k, ds, out):
     for f in range(q.shape[0]):
         for j in range(q.shape[1]):

@@ -12,42 +12,9 @@ moments [N m/m].
 equations, used only to test these.
 """
 
-import numba
 import numpy as np
 
-from . import kernel_cache
-
-kernel_cache.install()  # before any kernel is compiled or loaded
-#: Kernels with an explicit signature, compiled by :func:`compile_signatures`.
-_UNCOMPILED = []
-
-
-def jit(fn=None, *, signature=None):
-    """numba.njit with the project's options.
-
-    cache=True: the machine code is stored next to this package (or in
-    numba's user cache if that is read-only), so only the first process pays
-    the compilation. error_model="numpy" drops Python's zero-division checks
-    from the inner loops. An explicit ``signature`` is compiled by
-    :func:`compile_signatures` (not at import, so that ``import rodmol``
-    stays quick and a run can announce the wait).
-    """
-    if fn is None:
-        return lambda f: jit(f, signature=signature)
-    dispatcher = numba.njit(cache=True, error_model="numpy")(fn)
-    if signature is not None:
-        _UNCOMPILED.append((dispatcher, signature))
-    return dispatcher
-
-
-def compile_signatures():
-    """Compile (or load from the disk cache) the kernels with explicit
-    signatures, and allow no other: every later call converts to them."""
-    while _UNCOMPILED:
-        dispatcher, signature = _UNCOMPILED.pop()
-        dispatcher.compile(signature)
-        dispatcher.disable_compile()
-
+from .compiling import jit
 
 # --------------------------------------------------------------------------- vectors
 

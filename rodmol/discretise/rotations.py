@@ -1,8 +1,10 @@
 """Unit quaternions (scalar first) and rotation matrices, vectorised over rows."""
 
+import numba
 import numpy as np
 
-from .physics import jit, quaternion_product, rotation, rotation_vector_quaternion, to_global
+from .compiling import jit, strided
+from .physics import quaternion_product, rotation, rotation_vector_quaternion, to_global
 
 
 def matrices(quat):
@@ -32,7 +34,7 @@ def normalise(quat):
     _normalise(quat.reshape((-1,) + quat.shape[-2:]))
 
 
-@jit
+@jit(signature=numba.types.void(strided(3, writes=True)), ahead=True)
 def _normalise(quat):
     # Compiled: the numpy version took a tenth of the solver's time on 6001
     # frames at N = 100 (temporaries per entry of a strided view).
@@ -52,7 +54,7 @@ def rotate(matrices, vectors, out=None):
     return out
 
 
-@jit
+@jit(signature=numba.types.void(strided(3), strided(3), strided(3, writes=True)), ahead=True)
 def _rotate(m, v, out):
     for f in range(v.shape[0]):
         for n in range(v.shape[1]):

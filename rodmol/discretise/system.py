@@ -18,8 +18,8 @@ import numpy as np
 from ..inputs import knot_times
 from ..rod_contacts import LOAD_NAME as REACTION_LOAD
 from . import external, load_entries, stencil
+from .compiling import compile_signatures
 from .layout import StateLayout, merge
-from .physics import compile_signatures
 from .preconditioner import check_structure
 from .rod_scales import field_scales, first_bending_frequency, grid_damping_ratio
 from .routing import CableRouting

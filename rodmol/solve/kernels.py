@@ -14,7 +14,7 @@ import contextlib
 
 import numpy as np
 
-from ..discretise import stencil
+from ..discretise import compiling, stencil
 from ..discretise.kernel_cache import cached
 from ..result import ARRAYS, from_states
 
@@ -34,11 +34,12 @@ def ready(run, options):
 
 def stage_text():
     """What the preparing stage does, for the progress line: compiling (the first run after
-    installing rodmol or editing its kernels' sources; once, its machine code is cached) or
-    loading the kernels from the disk cache."""
+    installing rodmol or editing its kernels' sources; once, its machine code is cached; on
+    two cores where a helper process takes part) or loading the kernels from the disk cache."""
     if cached(stencil.rhs) is False:
-        return ("compiling the kernels (right-hand side, Jacobian, preconditioner, post-processing) "
-                "once: later runs load them from the cache")
+        cores = " on 2 cores" if compiling.helper_wanted() else ""
+        return (f"compiling the kernels (right-hand side, Jacobian, preconditioner, post-processing) "
+                f"once{cores}: later runs load them from the cache")
     return "preparing the compiled kernels"
 
 
