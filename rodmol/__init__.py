@@ -91,6 +91,6 @@ __all__ = [
     # rodmol.control: questions a controller asks
     "StaticFit", "SystemFit", "inverse_statics", "inverse_statics_path",
     # gradients of a run (docs/gradients.md)
-    "BodyAdvance", "BodyTarget", "Effort", "MarkerTracking", "StateLoss", "TensionPlan", "TerminalTarget", "TipTracking", "gradient",
-    "optimal_tensions",
+    "BodyAdvance", "BodyTarget", "Effort", "MarkerTracking", "StateLoss", "TensionPlan", "TerminalTarget",
+    "TipTracking", "gradient", "optimal_tensions",
 ]
