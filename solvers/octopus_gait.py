@@ -54,7 +54,7 @@ def main(argv=None):
     args = C.parse_args(__doc__.splitlines()[0], argv)
     header = C.header_lines(args, SCRIPT)
     n, span = C.pick(args, 6, 6, 4), C.pick(args, 1.5, 1.0, 0.2)
-    count, iterations = C.pick(args, 5, 4, 2), C.pick(args, 40, 15, 1)
+    count, iterations = C.pick(args, 5, 4, 2), C.pick(args, 15, 15, 1)
     settle_time = example.SETTLE  # the crawl starts then
     t0, t_end = settle_time, settle_time + span
     settled = rodmol.simulate(octopus(n), settle_time, initial="straight")
