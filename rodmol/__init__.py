@@ -65,7 +65,7 @@ from .loads import (
     PointMoment,
     SphereContact,
 )
-from .losses import Effort, StateLoss, TerminalTarget, TipTracking
+from .losses import BodyAdvance, BodyTarget, Effort, StateLoss, TerminalTarget, TipTracking
 from .markers import Marker
 from .model import Model
 from .output.formats import load_result, write_series
@@ -93,6 +93,6 @@ __all__ = [
     # rodmol.control: questions a controller asks
     "StaticFit", "SystemFit", "inverse_statics", "inverse_statics_path",
     # gradients of a run (docs/gradients.md)
-    "Effort", "MarkerTracking", "StateLoss", "TensionPlan", "TerminalTarget", "TipTracking", "gradient",
-    "optimal_tensions",
+    "BodyAdvance", "BodyTarget", "Effort", "MarkerTracking", "StateLoss", "TensionPlan", "TerminalTarget",
+    "TipTracking", "gradient", "optimal_tensions",
 ]

@@ -14,6 +14,8 @@ Effort(1e-3)``.
   owns how a measurement names the parts it sees) sum over frames and seen markers of
   |marker - measured|^2 [m^2];
 * :class:`Effort` weight * integral of the sum of squared tensions dt [weight N^2 s];
+* :class:`BodyTarget` w |x(t) - target|^2 of a System's body's position [m^2];
+* :class:`BodyAdvance` -w d . x(t), a System's body moved along d [m];
 * :class:`StateLoss` the user's own function of the states at given times, with its gradient.
 
 The gradient of a frame's number by the state is one rule,
@@ -243,6 +245,76 @@ def _quadrature(model, t0, t_end):
     x, w = np.polynomial.legendre.leggauss(GAUSS_POINTS)
     half, middle = np.diff(edges) / 2.0, (edges[1:] + edges[:-1]) / 2.0
     return (middle[:, None] + half[:, None] * x).ravel(), (half[:, None] * w).ravel()
+
+
+class BodyLoss(Loss):
+    """A loss of the position of the origin of the body ``body`` of a System at one time
+    ``t`` [s] (None: the run's end): a subclass gives :meth:`of` (the value and its gradient
+    by the position). The position is entries of the state, so dL/dy is exact."""
+
+    def __init__(self, body, t=None, weight=1.0):
+        if not isinstance(body, str):
+            raise ParameterError(f"{type(self).__name__}: `body` must be a body's name, got {_checks.short(body)}")
+        self.body = body
+        self.at = None if t is None else _checks.non_negative("t", t, " s")
+        self.weight = _checks.non_negative("weight", weight)
+
+    def of(self, position):
+        """(value, d value / d position (3,)) at the body's ``position`` (3,) [m]."""
+        raise NotImplementedError
+
+    def times(self, t0, t_end):
+        return np.array([t_end if self.at is None else self.at])
+
+    def check(self, model, t0, t_end):
+        super().check(model, t0, t_end)
+        bodies = list(model.bodies) if isinstance(model, System) else []
+        if self.body not in bodies:
+            raise ParameterError(f"{type(self).__name__}: `body` must name a body of a System "
+                                 f"({', '.join(bodies) or 'this model has none'}), got {self.body!r}")
+
+    def until(self, t):
+        return self if self.at is not None and self.at <= t else None
+
+    def evaluate(self, kind, system, t, states, span=None):
+        states = np.asarray(states, dtype=float)
+        entries = system.bodies[self.body].fields["x"]
+        value, by_position = self.of(states[0, entries])
+        gradient = np.zeros_like(states)
+        gradient[0, entries] = by_position
+        return float(value), gradient
+
+    def __repr__(self):
+        return f"{type(self).__name__}({self.body!r}, t={'end' if self.at is None else self.at})"
+
+
+class BodyTarget(BodyLoss):
+    """w |x(t) - target|^2 [m^2]: the origin of the body ``body`` of a System at ``t`` [s]
+    (None: the run's end) near ``target`` (3,) [m], global frame."""
+
+    def __init__(self, body, target, t=None, weight=1.0):
+        super().__init__(body, t, weight)
+        self.target = _finite_array("target", target, (3,))
+
+    def of(self, position):
+        moved = position - self.target
+        return self.weight * float(moved @ moved), 2.0 * self.weight * moved
+
+
+class BodyAdvance(BodyLoss):
+    """-w d . x(t) [m]: minus the position of the origin of the body ``body`` of a System
+    along the unit ``direction`` d (3,) (normalised here), global frame, at ``t`` [s] (None:
+    the run's end); minimised, the body moves along d (a crawl's head forward)."""
+
+    def __init__(self, body, direction, t=None, weight=1.0):
+        super().__init__(body, t, weight)
+        d = _finite_array("direction", direction, (3,))
+        if not np.any(d):
+            raise ParameterError(f"BodyAdvance: `direction` must not be zero, got {_checks.short(direction)}")
+        self.direction = d / np.linalg.norm(d)
+
+    def of(self, position):
+        return -self.weight * float(self.direction @ position), -self.weight * self.direction
 
 
 class StateLoss(Loss):

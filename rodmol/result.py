@@ -174,7 +174,9 @@ def from_states(system, t, y, success, message, stats):
     tensions = system.tension_history(t, y)
     lengths = system.routing.lengths(layout.field(y, "q"), layout.field(y, "k")).reshape(n_t, -1)
     actuated = [c for c in model.cables if c.actuated]
-    actuators = np.array([[c.displacement.value(ti) for c in actuated] for ti in t]).reshape(n_t, len(actuated))
+    times, at = np.unique(t, return_inverse=True)  # functions of time: once per distinct time
+    actuators = np.array([[c.displacement.value(ti) for c in actuated] for ti in times]).reshape(len(times), -1)
+    actuators = actuators[at.reshape(-1)].reshape(n_t, len(actuated))
     arrays = dict(t=t, tensions=tensions, **static_arrays(system), cable_lengths=lengths,
                   actuator_positions=actuators, states=y)
     loads = partial(_loads, system)

@@ -74,6 +74,28 @@ def test_a_systems_gradient_by_a_body_a_rod_and_a_cable_is_the_central_differenc
         agree(grads[key][component], expected, np.max(np.abs(grads[key])))
 
 
+def test_a_systems_gradient_of_a_bodys_position_is_the_central_difference():
+    keys = ["bodies.head.mass", "rods.arm.material.E", "rods.arm.tension.c"]
+    target = [0.01, -0.03, 0.005]
+    loss = rodmol.BodyTarget("head", target, t=0.2) + rodmol.BodyAdvance("head", [1.0, 2.0, 0.0], weight=0.5)
+    value, grads = rodmol.gradient(_system(), 0.3, loss, keys, rtol=RTOL)
+    times = [0.2, 0.3]
+
+    def measured(result):
+        x = result["head"].position[np.searchsorted(result.t, times)]
+        return float(np.sum((x[0] - target) ** 2) - 0.5 * x[1] @ [1.0, 2.0, 0.0] / np.sqrt(5.0))
+
+    plain = rodmol.simulate(_system(), 0.3, rtol=RTOL, output_times=times)
+    assert value == pytest.approx(measured(plain), rel=1e-6)
+    for key, component in [("bodies.head.mass", 0), ("rods.arm.material.E", 0), ("rods.arm.tension.c", 1)]:
+        p = named_parameters.parameter(_system(), key)
+        h = REFERENCE_STEP * p.scale
+        runs = [rodmol.simulate(p.at(_system(), p.value + sign * h * (np.arange(p.size) == component)), 0.3,
+                                rtol=REFERENCE_RTOL, output_times=times) for sign in (1, -1)]
+        expected = (measured(runs[0]) - measured(runs[1])) / (2 * h)
+        agree(grads[key][component], expected, np.max(np.abs(grads[key])))
+
+
 def test_the_adjoint_and_the_forward_sensitivities_agree(rod_gradient):
     _, grads = rod_gradient
     run = rodmol.simulate(_arm(), 0.5, initial="straight", rtol=RTOL, output_times=TIMES,

@@ -3,7 +3,7 @@ rodmol.gradient against central differences of simulate, sums, and what they ref
 
 import numpy as np
 import pytest
-from gradient_cases import KNOTS, REFERENCE_RTOL, REFERENCE_STEP, RTOL, TARGETS, TIMES, _arm, agree
+from gradient_cases import KNOTS, REFERENCE_RTOL, REFERENCE_STEP, RTOL, TARGETS, TIMES, _arm, _system, agree
 
 import rodmol
 from rodmol import named_parameters
@@ -146,7 +146,18 @@ def test_a_users_loss_that_raises_is_named():
     (lambda: rodmol.Effort(-1.0), "weight"),
     (lambda: rodmol.StateLoss([0.1], 3.0, 4.0), "function"),
     (lambda: rodmol.TerminalTarget([0, 0]), "target"),
+    (lambda: rodmol.BodyTarget("head", [0, 0]), "target"),
+    (lambda: rodmol.BodyTarget(3, [0, 0, 0]), "body"),
+    (lambda: rodmol.BodyAdvance("head", [0, 0, 0]), "direction"),
+    (lambda: rodmol.BodyAdvance("head", [1, 0, 0], weight=-1.0), "weight"),
 ])
 def test_what_the_losses_refuse(make, words):
     with pytest.raises(ParameterError, match=words):
         make()
+
+
+@pytest.mark.parametrize("model, body", [(_arm, "head"), (_system, "tail")])
+def test_a_body_loss_needs_a_body_of_the_system(model, body):
+    with pytest.raises(ParameterError, match=repr(body)):
+        rodmol.gradient(model(), 0.2, rodmol.BodyAdvance(body, [1, 0, 0]), ["material.E"]
+                        if model is _arm else ["rods.arm.material.E"])

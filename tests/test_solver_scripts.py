@@ -205,6 +205,13 @@ def _optimal_tensions(out):
     assert summary["loss_end"] < 1e-6 * summary["loss_start"], summary
 
 
+def _octopus_gait(out):
+    gaits = [row for row in rows(out / "octopus_gait.csv") if row["table"] == "gaits"]
+    hand, optimised = gaits
+    assert hand["success"] is True and optimised["success"] is True, gaits
+    assert optimised["dx_mm"] > hand["dx_mm"], gaits  # the target: farther than the hand-made crawl
+
+
 def _octopus(out):
     table = rows(out / "octopus.csv")
     assert all(row["success"] is True for row in table), table
@@ -406,6 +413,7 @@ SCRIPTS = {
     "adjoint_cost.py": (["adjoint_cost.csv", "adjoint_cost.md"], _adjoint_cost),
     "optimal_tensions.py": (["optimal_tensions.csv", "optimal_tensions.md", "optimal_tensions.png"],
                             _optimal_tensions),
+    "octopus_gait.py": (["octopus_gait.csv", "octopus_gait.md", "octopus_gait.png"], _octopus_gait),
     "octopus_stats.py": (["octopus_stats.csv", "octopus_stats.md"], _octopus_stats),
     "system_stepping.py": (["system_stepping.csv", "system_stepping.md"], _system_stepping),
     "system_equilibrium_speed.py": (["system_equilibrium_speed.csv", "system_equilibrium_speed.md"],
@@ -486,7 +494,7 @@ def _main(script):
 
 #: Scripts whose smoke run takes tens of seconds (an optimisation of many runs; compiling
 #: every kernel afresh).
-SLOW = {"optimal_tensions.py", "cold_start.py"}
+SLOW = {"optimal_tensions.py", "octopus_gait.py", "cold_start.py"}
 
 
 def _marks(script):

@@ -234,10 +234,13 @@ class SemiDiscrete:
                 varying.append(c)
             else:
                 out[:, c] = cable.tension_at(0.0)
-        if varying:
+        if varying and self.global_coupling:
             for i, (ti, yi) in enumerate(zip(np.asarray(t, dtype=float), states)):
-                state = self.state_view(ti, yi) if self.global_coupling else None
-                out[i, varying] = [cables[c].tension_at(ti, state) for c in varying]
+                out[i, varying] = [cables[c].tension_at(ti, self.state_view(ti, yi)) for c in varying]
+        elif varying:  # functions of time alone: once per distinct time (a gradient's moved frames share one)
+            times, at = np.unique(np.asarray(t, dtype=float), return_inverse=True)
+            values = np.array([[cables[c].tension_at(ti) for c in varying] for ti in times])
+            out[:, varying] = values[at.reshape(-1)]
         return out
 
     def state_view(self, t, y):

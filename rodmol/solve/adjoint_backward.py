@@ -52,7 +52,8 @@ class AdjointSystem:
         pattern = sparse.csc_matrix(self.jac.sparsity, dtype=float)
         pattern.sort_indices()
         self._indices, self._indptr = pattern.indices.copy(), pattern.indptr.copy()
-        self._data = np.zeros(pattern.nnz)
+        self.JT = sparse.csr_matrix((np.zeros(pattern.nnz), self._indices, self._indptr), shape=pattern.shape)
+        self._data = self.JT.data
         # J's CSC arrays read as CSR are J^T; its CSC form, for SuperLU, by a permutation.
         coded = sparse.csr_matrix((np.arange(1.0, pattern.nnz + 1), self._indices, self._indptr), shape=pattern.shape)
         transposed = coded.tocsc()
@@ -68,8 +69,7 @@ class AdjointSystem:
         if self._t != t:
             y = self.state(t)
             fy = self.system(t, y).copy()
-            self.jac(t, y, fy, self._data)
-            self.JT = sparse.csr_matrix((self._data.copy(), self._indices, self._indptr), shape=(self.n, self.n))
+            self.jac(t, y, fy, self._data)  # into J^T's own data (J's CSC order is J^T's CSR order)
             self._t = t
             self.evaluations += 1
         return self.JT
