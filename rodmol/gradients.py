@@ -18,8 +18,8 @@ from .discretise.schemes import DEFAULT_SCHEME
 from .errors import ParameterError
 from .losses import Loss
 from .parameter_rates import ParameterColumns
+from .run_arguments import check_run, fit, prepare_run
 from .run_kinds import run_kind
-from .simulate import check_run, fit, prepare_run
 from .solve.adjoint_backward import LINEAR_SOLVERS, AdjointSystem, integrate_backward
 from .solve.checkpoints import ForwardRun
 

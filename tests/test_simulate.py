@@ -33,7 +33,7 @@ def test_simulate_builds_one_system_and_hands_it_on(monkeypatch):
     model = rodmol.scenarios.get("bending").model(6)
     rodmol.simulate(model, 0.01)  # the kernels made ready: the run below builds only its own
     built, seen = [], []
-    module = sys.modules["rodmol.simulate"]
+    module = sys.modules["rodmol.run_arguments"]  # where a run's initial state is solved
     init, solve = SemiDiscrete.__init__, module.equilibrium
 
     def counting(self, *args, **kwargs):

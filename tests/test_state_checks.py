@@ -1,4 +1,4 @@
-"""One rule for every state a user gives (simulate.check_state, simulate.check_word): simulate's
+"""One rule for every state a user gives (run_arguments.check_state, run_arguments.check_word): simulate's
 and the Simulator's ``initial`` and linearize's ``state`` refuse the same states with a
 ParameterError naming the parameter, before any work; linearize never returns non-finite A, B."""
 

@@ -14,7 +14,7 @@ from ..discretise.schemes import DEFAULT_SCHEME
 from ..discretise.system import SemiDiscrete, tensions_by_hand
 from ..errors import ParameterError
 from ..model import Model
-from ..simulate import check_state, check_word, initial_state
+from ..run_arguments import check_state, check_word, initial_state
 from ..systems import System
 from .linear_columns import point_loads, refuse_non_finite, tendons, tip_rows
 from .linear_model import LinearModel

@@ -22,7 +22,7 @@ from ..cables import Tension
 from ..control.held import Held
 from ..discretise.assembly import Assembly
 from ..discretise.system_jacobian import column_groups
-from ..simulate import check_state, check_word, initial_state
+from ..run_arguments import check_state, check_word, initial_state
 from .linear_columns import point_loads, refuse_non_finite, tendons, tip_rows
 from .linear_model import LinearModel
 

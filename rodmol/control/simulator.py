@@ -14,8 +14,9 @@ from .. import _checks
 from ..discretise.schemes import DEFAULT_SCHEME
 from ..errors import IntegrationError, ParameterError
 from ..model import Model
+from ..run_arguments import check_run, fit, prepare_run
 from ..run_kinds import run_kind
-from ..simulate import _sink, check_run, fit, prepare_run
+from ..simulate import _sink
 from ..solve.stepping import Stepper
 from .held import HeldInputs
 from .held_system import SystemHeld

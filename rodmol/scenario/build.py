@@ -2,7 +2,7 @@
 level, ``[discretization]``, ``[solver]``, ``[output]``, and the Model built
 from the arm's tables (:mod:`rodmol.scenario.arm`) and the loads
 (:mod:`rodmol.scenario.loads`). Values are checked by the constructors and by
-:func:`rodmol.simulate`'s own checks (:func:`rodmol.simulate.check_run`)."""
+:func:`rodmol.simulate`'s own checks (:func:`rodmol.run_arguments.check_run`)."""
 
 import re
 
@@ -14,8 +14,9 @@ from ..discretise.system import SemiDiscrete
 from ..errors import ParameterError
 from ..model import Model
 from ..output.options import OutputOptions
+from ..run_arguments import INITIAL, check_run, fit
 from ..run_spec import RunSpec
-from ..simulate import DEFAULT_BACKEND, INITIAL, OUTPUT_DT, check_run, fit
+from ..simulate import DEFAULT_BACKEND, OUTPUT_DT
 from ..solve import options as run_options
 from . import arm as arm_tables
 from . import system as system_file
