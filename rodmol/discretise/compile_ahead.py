@@ -28,8 +28,10 @@ TIMEOUT = 120.0
 SWITCH = "RODMOL_COMPILE_AHEAD"
 _helper = None  # this process's running helper, if any
 _PARENT = str(Path(__file__).resolve().parents[2])  # the directory holding the rodmol package
-_CODE = ("import sys; sys.path.insert(0, {parent!r}); "
-         "from rodmol.discretise import compile_ahead; compile_ahead.main()")
+# The helper's work, as its command: import rodmol (which registers every kernel), then
+# compile the ``ahead`` kernels (the command does the imports: this module imports no floor above).
+_CODE = ("import sys; sys.path.insert(0, {parent!r}); import rodmol; "
+         "from rodmol.discretise import compiling; compiling.compile_ahead_here()")
 
 
 def cores():
@@ -99,11 +101,3 @@ def finish(timeout=TIMEOUT):
 
 atexit.register(finish, 0.0)  # a run that ends (or fails) before it needs the helper's work
 
-
-def main():
-    """The helper's work: import rodmol (every kernel module) and compile the ``ahead`` kernels."""
-    import rodmol  # noqa: F401  (registers every kernel)
-
-    from . import compiling
-
-    compiling.compile_ahead_here()
