@@ -38,7 +38,8 @@ RHO = 1.0 / (np.pi * R**2 * L)  # kg/m^3: a rod of 1 kg
 MU = 2e4  # Pa s: the first bending mode (12 rad/s) about 0.4 of critical
 T_TWIST, T_HOLD = 50.0, 50.0  # s
 TURNS = 10
-SLACK = 0.4 * L  # m, how far the turning end moves toward the other while turning
+SLACK = 0.3 * L  # m, how far the turning end moves toward the other, over T_SLACK
+T_SLACK = 5.0  # s
 PUSH = 1e-3  # N, sideways on the middle while turning (breaks the straight rod's symmetry)
 
 
@@ -48,7 +49,7 @@ def smooth_step(t, duration):
     return w**3 * (10 - 15 * w + 6 * w * w), 30 * w * w * (1 - w) ** 2 / duration
 
 
-def plectoneme(n=150, turns=TURNS, t_twist=T_TWIST, slack=SLACK, push=PUSH):
+def plectoneme(n=150, turns=TURNS, t_twist=T_TWIST, slack=SLACK, push=PUSH, t_slack=T_SLACK):
     """The System: the rod along global x, its base turned ``turns`` times about
     the axis (about -x: a right-handed twist from base to tip, Lk = +turns) and moved ``slack`` [m] along it over ``t_twist`` [s], its tip clamped where it is at rest."""
     material = rodmol.Material(E=E, G=E / 1.5, mu=MU, rho=RHO)
@@ -57,10 +58,10 @@ def plectoneme(n=150, turns=TURNS, t_twist=T_TWIST, slack=SLACK, push=PUSH):
         return np.array([-2 * np.pi * turns * smooth_step(t, t_twist)[1], 0.0, 0.0])
 
     def shorten(t):
-        return np.array([slack * smooth_step(t, t_twist)[1], 0.0, 0.0])
+        return np.array([slack * smooth_step(t, t_slack)[1], 0.0, 0.0])
 
     def side(t):
-        return np.array([0.0, 0.0, -push * (1.0 - smooth_step(t, t_twist)[0])])
+        return np.array([0.0, 0.0, -push * (1.0 - smooth_step(t, t_slack)[0])])
 
     model = rodmol.Model(rodmol.Rod(L, radius=R, material=material), n, gravity=(0.0, 0.0, 0.0),
                          base=rodmol.BaseMotion(velocity=shorten, angular_velocity=spin),
