@@ -8,16 +8,17 @@ shows its picture; solvers/plectoneme.py measures it.
 PyElastica's numbers: L = 1 m, r = 0.025 m, E = 1 MPa, G = E / 1.5, a mass
 of 1 kg, no gravity, 150 elements. Where it differs, and why:
 - its far end slides freely along the axis (zero axial force) while
-  turning; here the ends are brought together by SLACK (a prescribed
-  shortening, rodmol's clamped base moves, as a base motion only can);
+  turning; rodmol has no slider, so the base is first moved SLACK towards
+  the tip over T_SLACK (the rod buckles into an Euler arch) as it starts to turn;
 - it damps every node's velocity at 2 1/s; here the rod's Kelvin-Voigt
   viscosity MU (no drag on rigid motion: there is no fluid);
 - it pushes its middle node sideways while turning (1e-4 m/s per step);
-  here a small side force PUSH on the middle while turning;
+  here a small side force PUSH on the middle over T_SLACK;
 - its self-contact is a penalty k = 1e4 N/m, 10 N s/m per element pair;
   here rodmol's law with its defaults (docs/systems.md).
-The turning and the shortening follow a smooth step (no jerk at 0 and at
-T_TWIST), so the integrator meets no corner.
+The turning and the shortening follow smooth steps (no jerk at their ends),
+so the integrator meets no corner. The run stalls once the first loop lies
+on itself (t = 17-19 s; docs/systems.md, "The plectoneme").
 
     python examples/plectoneme.py [OUT_DIR] [N_ELEMENTS] [T_END] [TURNS]
 
@@ -40,7 +41,7 @@ T_TWIST, T_HOLD = 50.0, 50.0  # s
 TURNS = 10
 SLACK = 0.3 * L  # m, how far the turning end moves toward the other, over T_SLACK
 T_SLACK = 5.0  # s
-PUSH = 1e-3  # N, sideways on the middle while turning (breaks the straight rod's symmetry)
+PUSH = 1e-3  # N, sideways on the middle over T_SLACK (the arch buckles one way)
 
 
 def smooth_step(t, duration):
@@ -51,7 +52,8 @@ def smooth_step(t, duration):
 
 def plectoneme(n=150, turns=TURNS, t_twist=T_TWIST, slack=SLACK, push=PUSH, t_slack=T_SLACK):
     """The System: the rod along global x, its base turned ``turns`` times about
-    the axis (about -x: a right-handed twist from base to tip, Lk = +turns) and moved ``slack`` [m] along it over ``t_twist`` [s], its tip clamped where it is at rest."""
+    the axis (about -x: a right-handed twist from base to tip, Lk = +turns) over ``t_twist`` [s] and
+    moved ``slack`` [m] along it over ``t_slack`` [s], its tip clamped where it is at rest."""
     material = rodmol.Material(E=E, G=E / 1.5, mu=MU, rho=RHO)
 
     def spin(t):

@@ -68,7 +68,7 @@ def main(argv=None):
     P = example()
     sizes = C.pick(args, [60, 150], [60], [20])
     t_end = C.pick(args, P.T_TWIST + P.T_HOLD, P.T_TWIST + P.T_HOLD, 2.0)
-    wall = wall or C.pick(args, 1200.0, 300.0, 60.0)
+    wall = wall or C.pick(args, 300.0, 120.0, 60.0)
     rows, frames = [], []
     for n in sizes:
         row, per_frame = run(P, n, t_end, P.TURNS, wall, C.pick(args, 1.0, 1.0, 0.5))
