@@ -46,7 +46,7 @@ def test_a_helix_has_fullers_writhe(turns, pitch):
     writhe against the straight axis, turns (1 - cos alpha), alpha the
     tangent's angle to the axis (negative for a left-handed helix)."""
     a = 0.1
-    phi = np.linspace(0.0, 2 * np.pi * turns, 3000)
+    phi = np.linspace(0.0, 2 * np.pi * turns, 1200)
     x = np.stack([a * np.cos(phi), a * np.sin(phi), pitch * phi], axis=1)
     rotations = framed(x, np.stack([np.cos(phi), np.sin(phi), 0 * phi], axis=1))
     along = np.sign(pitch)
