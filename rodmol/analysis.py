@@ -8,6 +8,7 @@ import numpy as np
 from .discretise import external
 from .discretise.system import SemiDiscrete
 from .errors import ParameterError
+from .linking import link, result_link, twist, writhe  # noqa: F401 (rodmol.analysis's)
 
 
 def energy(model, result):

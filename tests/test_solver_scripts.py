@@ -299,6 +299,12 @@ def _rod_contact(out):
     assert all(abs(row["force_over_weight"] - 1.0) < 5e-3 for row in table), table
 
 
+def _plectoneme(out):
+    runs = [row for row in rows(out / "plectoneme.csv") if row.get("steps") not in ("", None)]
+    assert runs and all(row["success"] is True for row in runs)
+    assert all(row["link_error_rel"] < 1e-2 for row in runs)  # the link follows the turns applied
+
+
 def _rods_touching(out):
     table = {row["case"]: row for row in rows(out / "rods_touching.csv")}
     assert all(row["success"] is True for row in table.values())
@@ -426,6 +432,7 @@ SCRIPTS = {
     "system_output.py": (["system_output.csv", "system_output.md"], _system_output),
     "rod_contact.py": (["rod_contact.csv", "rod_contact.md"], _rod_contact),
     "rods_touching.py": (["rods_touching.csv", "rods_touching.md"], _rods_touching),
+    "plectoneme.py": (["plectoneme.csv", "plectoneme.md"], _plectoneme),
     "vtp_series_cost.py": (["vtp_series_cost.csv", "vtp_series_cost.md"], _vtp_series_cost),
     "driver_speed.py": (["driver_speed.csv", "driver_speed.md", "driver_speed_runs.csv"], _driver_speed),
     "crawl_speed.py": (["crawl_speed.csv", "crawl_speed.md", "crawl_speed_runs.csv"], _crawl_speed),
