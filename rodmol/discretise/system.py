@@ -239,7 +239,7 @@ class SemiDiscrete:
                 out[i, varying] = [cables[c].tension_at(ti, self.state_view(ti, yi)) for c in varying]
         elif varying:  # functions of time alone: once per distinct time (a gradient's moved frames share one)
             times, at = np.unique(np.asarray(t, dtype=float), return_inverse=True)
-            values = np.array([[cables[c].tension_at(ti) for c in varying] for ti in times])
+            values = np.array([[cables[c].tension_at(ti) for c in varying] for ti in times]).reshape(-1, len(varying))
             out[:, varying] = values[at.reshape(-1)]
         return out
 
