@@ -500,8 +500,11 @@ def _main(script):
 
 
 #: Scripts whose smoke run takes tens of seconds (an optimisation of many runs; compiling
-#: every kernel afresh).
-SLOW = {"optimal_tensions.py", "octopus_gait.py", "cold_start.py"}
+#: every kernel afresh) or several seconds for a study of speed alone (the compiled-callback
+#: driver compiles its own callbacks; the side-by-side drivers start a worker per version):
+#: kept out of the default run to hold it under 5 minutes (`-m slow` runs them).
+SLOW = {"optimal_tensions.py", "octopus_gait.py", "cold_start.py", "compiled_driver.py", "rods_touching.py",
+        "driver_speed.py", "crawl_speed.py", "bending_vs_commit.py"}
 
 
 def _marks(script):
