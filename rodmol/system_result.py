@@ -4,6 +4,7 @@ import numpy as np
 
 from . import derivatives
 from .base_motion import BaseMotion
+from .discretise.assembly_frames import momentum, recorded_rod
 from .discretise.contact_parts import ContactPart
 from .discretise.rotations import matrices
 from .discretise.system import SemiDiscrete
@@ -162,7 +163,7 @@ class SystemResult:
         held = next((part for part in assembly.free if name in part.rods), None)
         if held is not None:  # the same rod, its base moving as its body did at the frames
             sd = SemiDiscrete(sd.model.replace(base=self._recorded_base(name, held, sd.model.base)), sd.scheme)
-        sd = assembly.recorded_rod(name, self.t, self.states, sd)  # its penalty joints as at the frames
+        sd = recorded_rod(assembly, name, self.t, self.states, sd)  # its penalty joints as at the frames
         return from_states(sd, self.t, y_rod, self.success, self.message, dict(self.stats))
 
     def _recorded_base(self, name, part, base):
@@ -183,7 +184,7 @@ class SystemResult:
         """Total linear [kg m/s] and angular momentum about the origin [kg m^2/s]
         of the system at each frame, global: two (n_t, 3) arrays."""
         assembly = self._system("momentum")
-        pairs = [assembly.momentum(y) for y in self.states]
+        pairs = [momentum(assembly, y) for y in self.states]
         return np.array([p[0] for p in pairs]), np.array([p[1] for p in pairs])
 
     def pose_drift(self, name):

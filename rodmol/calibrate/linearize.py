@@ -10,8 +10,9 @@ discretisation for model-predictive control.
 import numpy as np
 
 from .. import _checks
+from ..discretise.hand_tensions import tensions_by_hand
 from ..discretise.schemes import DEFAULT_SCHEME
-from ..discretise.system import SemiDiscrete, tensions_by_hand
+from ..discretise.system import SemiDiscrete
 from ..errors import ParameterError
 from ..model import Model
 from ..run_arguments import check_state, check_word, initial_state

@@ -18,9 +18,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import _checks
+from ..discretise.hand_tensions import tensions_by_hand
 from ..discretise.layout import StateLayout
 from ..discretise.schemes import DEFAULT_SCHEME
-from ..discretise.system import SemiDiscrete, tensions_by_hand
+from ..discretise.system import SemiDiscrete
 from ..errors import ParameterError
 from ..model import Model
 from ..solve.tension_statics import rest_state, tension_sensitivity

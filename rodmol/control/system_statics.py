@@ -23,8 +23,8 @@ from scipy.sparse.linalg import splu
 from .. import _checks
 from ..discretise import rotations
 from ..discretise.assembly import Assembly
+from ..discretise.hand_tensions import tensions_by_hand
 from ..discretise.schemes import DEFAULT_SCHEME
-from ..discretise.system import tensions_by_hand
 from ..errors import ParameterError
 from ..solve.rest_equations import continuation, damped_newton
 from ..solve.system_equilibrium import CoupledDifferences, FreeRestEquations, floating

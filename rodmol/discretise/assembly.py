@@ -63,7 +63,7 @@ from ..inputs import knot_times
 from .body_joints import BodyJointPart, body_joint_frequency
 from .body_part import BodyPart, clamp_map
 from .contact_parts import contact_parts
-from .joints import JointPart, RecordedJoints, RodJointPart
+from .joints import JointPart, RodJointPart
 from .physics import quaternion_rate
 from .protocol import pattern_bandwidths
 from .rigid import clamp_wrench, free_body_rates
@@ -200,29 +200,6 @@ class Assembly:
         if part.body.free:
             return np.ascontiguousarray(y[part.slice])
         return np.concatenate([y[part.slice], *self.body_velocities(part, t, y)])
-
-    def recorded_rod(self, name, t, states, sd=None):
-        """Rod ``name``'s system (or ``sd``, a copy of it) for rebuilding its
-        Result from the frames ``states`` (n_t, size) at ``t``: if penalty
-        joints hold it to bodies or it touches rods (:class:`rodmol.RodContact`),
-        a :class:`RecordedJoints` replaying their held points and contact forces
-        at the frames, else ``sd`` itself."""
-        sd = self.rods[name] if sd is None else sd
-        joints = [joint for joint in self.joints + self.rod_joints if joint.joint.rod == name]
-        touching = self.rod_pairs is not None and name in self.rod_pairs.rods
-        if not joints and not touching:
-            return sd
-        replay = self.rod_pairs.replay(name, t, states) if touching else []
-        for joint in joints:
-            rows, values = np.tile(joint.row, (len(t), 1)), np.zeros((len(t), 3))
-            for i, (ti, yi) in enumerate(zip(t, states)):
-                yi = np.ascontiguousarray(yi)
-                if isinstance(joint, RodJointPart):
-                    joint.wrench(yi, rows[i], values[i])
-                else:
-                    joint.wrench(yi, self.body_state(joint.part, ti, yi), rows[i], values[i])
-            replay.append((joint.entry, rows, values))
-        return RecordedJoints(sd.model, sd.scheme, t, replay)
 
     def body_velocities(self, part, t, y):
         """(v, w) of a body's origin at (t, y) [m/s, rad/s], body frame."""
@@ -413,26 +390,3 @@ class Assembly:
         """The stall's diagnosis of the most compressed rod (its ``describe_stall``), naming it."""
         name = min(self.rods, key=lambda n: least_stretch(self.rods[n].layout, y[self.parts[n]]))
         return f"In rod {name!r}: {self.rods[name].describe_stall(y[self.parts[name]])}"
-
-    def momentum(self, y):
-        """Total linear momentum [kg m/s] and angular momentum about the
-        global origin [kg m^2/s] of the bodies and rods, global, at the state
-        ``y``: the nodes' as their mass per length times the length each
-        stands for, at their integrated positions; a free body's with the
-        rods' base segments it carries (:meth:`BodyPart.carry`)."""
-        linear, angular = np.zeros(3), np.zeros(3)
-        for name, sd in self.rods.items():
-            y_rod, lay = y[self.parts[name]], sd.layout
-            rot = matrices(lay.field(y_rod, "Q"))
-            lengths = sd.node_lengths[:, None]
-            p = np.einsum("nij,nj->ni", rot, sd.sampled.mass * lay.field(y_rod, "v") * lengths)
-            h = np.einsum("nij,nj->ni", rot, sd.sampled.inertia * lay.field(y_rod, "w") * lengths)
-            linear += p.sum(axis=0)
-            angular += (np.cross(lay.field(y_rod, "u"), p) + h).sum(axis=0)
-        for part in self.free:
-            r = matrices(y[part.fields["Q"]])
-            v, w = y[part.fields["v"]], y[part.fields["w"]]
-            momentum = part.rigid_mass @ np.concatenate([v, w])
-            linear += r @ momentum[:3]
-            angular += np.cross(y[part.fields["x"]], r @ momentum[:3]) + r @ momentum[3:]
-        return linear, angular

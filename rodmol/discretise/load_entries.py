@@ -20,6 +20,8 @@ from ..loads import (
     P_TURN_DAMPING,
     P_TURN_STIFFNESS,
 )
+from ..rod_contacts import LOAD_NAME as REACTION_LOAD
+from . import external
 from .layout import StateLayout
 from .rotations import from_matrix
 from .undeformed import undeformed_state
@@ -190,3 +192,23 @@ def load_scale(model, t=0.0, tensions=None, grid=None):
     quantity = np.array([by_code[int(k)] for k in g.kind], dtype=object)
     return scale + float(np.sum(size[quantity == "force"]) + np.sum(size[quantity == "moment"])
                          / model.rod.length)
+
+
+def kernel_rows(entries, model, node_lengths):
+    """The compiled right-hand side's arrays of the load ``entries`` of ``model``
+    (:func:`of_model`) on velocity nodes standing for ``node_lengths`` [m]: kinds, element
+    blocks, weights (a point load's share spread over its node's own length), parameter
+    rows (E, ``external.N_PARAMS``), values (E, 3), which are holds (rodmol.Hold), and
+    which are the reactions a system's rod contacts write (rodmol.RodContact: not a load
+    the continuation ramps)."""
+    kinds = np.ascontiguousarray(entries.kind, dtype=np.int64)
+    nodes = np.ascontiguousarray(entries.node - 1, dtype=np.int64)
+    stretch = np.where(entries.concentrated, model.ds / node_lengths[nodes], 1.0)
+    weights = np.ascontiguousarray(entries.weight * stretch, dtype=float)
+    params = np.ascontiguousarray(entries.params, dtype=float).reshape(-1, external.N_PARAMS)
+    values = np.ascontiguousarray(entries.initial, dtype=float).reshape(-1, 3)
+    reactions = np.zeros(len(kinds), dtype=bool)
+    ends = np.cumsum([count(item, model.s_nodes) for item in model.loads])[:-1]
+    for load, rows in zip(model.loads, np.split(np.arange(len(kinds)), ends)):
+        reactions[rows] = getattr(load, "name", None) == REACTION_LOAD
+    return kinds, nodes, weights, params, values, np.isin(kinds, external.HOLDS), reactions

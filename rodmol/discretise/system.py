@@ -11,12 +11,9 @@ Newton matrix also read its rod's own members (``layout``, ``model``,
 ``depends``, ``global_coupling``, ``update_inputs``, ``kernel_arguments``).
 """
 
-from dataclasses import replace
-
 import numpy as np
 
 from ..inputs import knot_times
-from ..rod_contacts import LOAD_NAME as REACTION_LOAD
 from . import external, load_entries, stencil
 from .compiling import compile_signatures
 from .layout import StateLayout, merge
@@ -43,17 +40,6 @@ GMRES_MIN_ELEMENTS = 50
 
 #: The undeformed state under its former name (the same function: straight unless the rod has rest strains).
 straight_state = undeformed_state
-
-
-def tensions_by_hand(model):
-    """The same model with every cable in the kernel and its tension given by
-    hand (``tensions=`` to :meth:`SemiDiscrete.rest_rates`): a constant
-    nonzero tension keeps each cable in the kernel, and displacement control
-    and feedback laws are dropped. The routing and friction of each cable
-    stay as they are. The linearisation and the inverse statics differentiate
-    with respect to the tensions of this model."""
-    return model.replace(cables=[replace(c, tension=1.0, displacement=None, compliance=None,
-                                         base_to_actuator=0.0, rest_length=None) for c in model.cables])
 
 
 class SemiDiscrete:
@@ -162,19 +148,8 @@ class SemiDiscrete:
 
     def _setup_loads(self):
         entries = load_entries.of_model(self.model, self._undeformed)
-        self._kinds = np.ascontiguousarray(entries.kind, dtype=np.int64)
-        self._nodes = np.ascontiguousarray(entries.node - 1, dtype=np.int64)  # element blocks
-        # A point load's share of a node is spread over the node's own length.
-        stretch = np.where(entries.concentrated, self.model.ds / self.node_lengths[self._nodes], 1.0)
-        self._entry_weights = np.ascontiguousarray(entries.weight * stretch, dtype=float)
-        self._entry_params = np.ascontiguousarray(entries.params, dtype=float).reshape(-1, external.N_PARAMS)
-        self.entry_values = np.ascontiguousarray(entries.initial, dtype=float).reshape(-1, 3)
-        self._hold_entries = np.isin(self._kinds, external.HOLDS)  # rodmol.Hold
-        # A system's rod contacts write their forces here (rodmol.RodContact): a reaction, not a load to ramp.
-        self._reaction_entries = np.zeros(len(self._kinds), dtype=bool)
-        for load, rows in zip(self.model.loads, np.split(np.arange(len(self._kinds)), np.cumsum(
-                [load_entries.count(item, self.model.s_nodes) for item in self.model.loads])[:-1])):
-            self._reaction_entries[rows] = getattr(load, "name", None) == REACTION_LOAD
+        (self._kinds, self._nodes, self._entry_weights, self._entry_params, self.entry_values,
+         self._hold_entries, self._reaction_entries) = load_entries.kernel_rows(entries, self.model, self.node_lengths)
         self.grid_loads = entries
 
     @property

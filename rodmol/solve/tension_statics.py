@@ -23,7 +23,7 @@ def tension_sensitivity(system, y, tensions, t=0.0):
     system : SemiDiscrete
         A system whose kernel sees every cable (a cable slack by its constant
         input is left out of the kernel; see
-        :func:`rodmol.discretise.system.tensions_by_hand`).
+        :func:`rodmol.discretise.hand_tensions.tensions_by_hand`).
     y : (size,) array
         A rest state under ``tensions`` (``rodmol.equilibrium``).
     tensions : (n_cables,) array [N]

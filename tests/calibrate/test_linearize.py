@@ -166,7 +166,7 @@ def test_reduced_model_keeps_the_tips_step_response_and_static_gain(hanging):
             out.append(sampled.C @ x + sampled.D @ u)
         responses.append(np.array(out))
     assert np.max(np.abs(responses[1] - responses[0])) < 0.05 * np.abs(responses[0]).max()
-    system = rodmol.SemiDiscrete(rodmol.discretise.system.tensions_by_hand(model))
+    system = rodmol.SemiDiscrete(rodmol.discretise.hand_tensions.tensions_by_hand(model))
     exact = tension_sensitivity(system, lin.state, model.tensions(0.0))[system.layout.tip_slice("u")]
     scale = np.abs(exact).max()
     assert np.allclose(reduced.static_gain(), lin.reduced(output="tip").static_gain(), atol=1e-9 * scale)

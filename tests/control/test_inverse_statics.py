@@ -95,7 +95,7 @@ def test_sensitivity_matches_differences_of_whole_equilibria(arm):
     equilibria solved from scratch."""
     tensions = np.zeros(12)
     tensions[[10, 11, 2]] = 1.0, 0.5, 0.4
-    system = rodmol.SemiDiscrete(rodmol.discretise.system.tensions_by_hand(arm))
+    system = rodmol.SemiDiscrete(rodmol.discretise.hand_tensions.tensions_by_hand(arm))
     y = rodmol.equilibrium(rodmol.paper_arm(N, tensions=PULLED))
     exact = tension_sensitivity(system, y, tensions)
     tip = system.layout.tip_slice("u")
